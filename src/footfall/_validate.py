@@ -1,0 +1,62 @@
+"""Small validation helpers shared by the frozen parameter dataclasses."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from footfall.errors import InputError
+
+
+def positive(field: str, value: object) -> float:
+    """Return ``value`` as a float after checking it is a finite number > 0."""
+    v = finite(field, value)
+    if v <= 0.0:
+        raise InputError(field, value, "a finite number > 0")
+    return v
+
+
+def non_negative(field: str, value: object) -> float:
+    """Return ``value`` as a float after checking it is a finite number >= 0."""
+    v = finite(field, value)
+    if v < 0.0:
+        raise InputError(field, value, "a finite number >= 0")
+    return v
+
+
+def finite(field: str, value: object) -> float:
+    """Return ``value`` as a float after checking it is a finite real number (not bool)."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise InputError(field, value, "a finite real number")
+    v = float(value)
+    if not math.isfinite(v):
+        raise InputError(field, value, "a finite real number")
+    return v
+
+
+def finite_vector(field: str, value: object, length: int | None = None) -> NDArray[np.float64]:
+    """Return ``value`` as a 1-D float array after checking every entry is finite.
+
+    Args:
+        field: parameter name used in the error message.
+        value: a sequence of numbers.
+        length: required length, or None for any non-empty length.
+    """
+    if isinstance(value, str | bytes) or not isinstance(value, Sequence | np.ndarray):
+        raise InputError(field, value, "a sequence of finite numbers")
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InputError(field, value, "a sequence of finite numbers") from None
+    if arr.ndim != 1:
+        raise InputError(field, value, "a flat (1-D) sequence of numbers")
+    if length is not None and arr.shape[0] != length:
+        raise InputError(field, value, f"exactly {length} numbers")
+    if arr.shape[0] == 0:
+        raise InputError(field, value, "at least one number")
+    if not np.all(np.isfinite(arr)):
+        raise InputError(field, value, "finite numbers (no NaN or inf)")
+    return arr
