@@ -6,14 +6,13 @@ Every command that computes something writes JSON and a figure into ``--out``. I
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
-from typing import Any
 
 import typer
 from rich.console import Console
 
+from footfall._io import write_json
 from footfall.errors import FootfallError, InputError
 
 app = typer.Typer(
@@ -26,18 +25,17 @@ app = typer.Typer(
 console = Console(stderr=True)
 
 
+@app.callback()
+def _root() -> None:
+    """Footstep planning for legged robots (LIP/ALIP, MIQCQP planner, quadruped ZMP gaits)."""
+
+
 def parse_floats(field: str, text: str) -> list[float]:
     """Parse a comma-separated list of numbers, naming ``field`` on error."""
     try:
         return [float(v) for v in text.split(",") if v.strip() != ""]
     except ValueError:
         raise InputError(field, text, "comma-separated numbers, e.g. 0,0.3,0.3") from None
-
-
-def write_json(path: Path, payload: dict[str, Any]) -> None:
-    """Write ``payload`` as indented JSON, creating parent folders."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(payload, indent=2) + "\n")
 
 
 def main() -> None:
@@ -47,3 +45,72 @@ def main() -> None:
     except FootfallError as exc:
         console.print(f"[bold red]error:[/] {exc}")
         sys.exit(2)
+
+
+# --- LIP walk (document 004) ---
+@app.command()
+def lip(
+    out: Path = typer.Option(Path("out/lip"), help="Output folder for lip_walk.json and .png."),
+    example: str | None = typer.Option(
+        None, help="A document example: straight, diagonal, turn or circle (overrides the rest)."
+    ),
+    zc: float = typer.Option(0.8, help="CoM height z_c [m]."),
+    t_sup: float = typer.Option(0.8, help="Support duration T_sup [s]."),
+    sx: str = typer.Option("0,0.3,0.3,0.3,0", help="Forward walk parameters per step [m]."),
+    sy: str = typer.Option("0.2,0.2,0.2,0.2,0.2", help="Lateral walk parameters per step [m]."),
+    theta_deg: str | None = typer.Option(None, help="Heading per step [deg]; default all 0."),
+    a: float = typer.Option(10.0, help="Position weight of the foot placement cost."),
+    b: float = typer.Option(1.0, help="Velocity weight of the foot placement cost."),
+    a_stop: float = typer.Option(1.0, help="Position weight for the stop step."),
+    b_stop: float = typer.Option(1.0, help="Velocity weight for the stop step."),
+    g: float = typer.Option(9.81, help="Gravity [m/s^2] (the document's code uses 9.8)."),
+    dt: float = typer.Option(0.01, help="Sampling period of the CoM trajectory in the JSON [s]."),
+) -> None:
+    """Kajita LIP walking pattern with foot placement modification (document 004)."""
+    import math
+
+    from footfall.planning.lip_examples import example as get_example
+    from footfall.planning.lip_io import lip_walk_to_dict
+    from footfall.planning.lip_walk import LipWalkParams, lip_walk
+    from footfall.viz.lip_plot import plot_lip_walk
+
+    if example is not None:
+        params = get_example(example)
+        title = f"LIP walk: {example} (document 004)"
+    else:
+        theta = None
+        if theta_deg is not None:
+            theta = tuple(math.radians(v) for v in parse_floats("theta_deg", theta_deg))
+        params = LipWalkParams(
+            z_c=zc,
+            t_sup=t_sup,
+            sx=tuple(parse_floats("sx", sx)),
+            sy=tuple(parse_floats("sy", sy)),
+            theta=theta,
+            a=a,
+            b=b,
+            a_stop=a_stop,
+            b_stop=b_stop,
+            g=g,
+        )
+        title = "LIP walk"
+    walk = lip_walk(params)
+    write_json(out / "lip_walk.json", lip_walk_to_dict(walk, dt))
+    plot_lip_walk(walk, out / "lip_walk.png", title=title)
+    speed = math.hypot(*walk.final_vel)
+    typer.echo(
+        f"{walk.footholds.shape[0]} support phases, final CoM speed {speed:.4f} m/s; "
+        f"wrote {out / 'lip_walk.json'} and {out / 'lip_walk.png'}"
+    )
+
+
+# --- demo ---
+@app.command()
+def demo(out: Path = typer.Option(Path("out/demo"), help="Output folder.")) -> None:
+    """Run the main demo on built-in defaults and write figures and JSON into OUT."""
+    from footfall.demo import run_demo
+
+    summary = run_demo(out)
+    for line in summary["lines"]:
+        typer.echo(line)
+    typer.echo(f"wrote {out / 'demo.json'}")

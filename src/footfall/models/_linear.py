@@ -44,12 +44,12 @@ class LinearModel:
     nu: int
 
     @property
-    def A(self) -> FloatArray:  # noqa: N802 - matrix names follow the documents
+    def A(self) -> FloatArray:
         """Continuous state matrix, shape (nx, nx)."""
         raise NotImplementedError
 
     @property
-    def B(self) -> FloatArray:  # noqa: N802
+    def B(self) -> FloatArray:
         """Continuous input matrix, shape (nx, nu)."""
         raise NotImplementedError
 

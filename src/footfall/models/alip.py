@@ -65,7 +65,7 @@ class ALIP(LinearModel):
         object.__setattr__(self, "g", positive("g", self.g))
 
     @property
-    def A(self) -> FloatArray:  # noqa: N802
+    def A(self) -> FloatArray:
         """Continuous state matrix of eq. (5.2), shape (4, 4)."""
         m, zh, g = self.mass, self.com_height, self.g
         return np.array(
@@ -78,12 +78,12 @@ class ALIP(LinearModel):
         )
 
     @property
-    def B(self) -> FloatArray:  # noqa: N802
+    def B(self) -> FloatArray:
         """Input matrix of eq. (5.4), ``[0_2x2; I_2x2]``, shape (4, 2)."""
         return np.vstack([np.zeros((2, 2)), np.eye(2)])
 
     @property
-    def E(self) -> FloatArray:  # noqa: N802
+    def E(self) -> FloatArray:
         """Map from a contact-point displacement (3,) [m] to the equivalent torque (eq. 5.10), (4, 3)."""
         mg = self.mass * self.g
         e = np.zeros((4, 3))

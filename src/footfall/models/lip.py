@@ -43,12 +43,12 @@ class LIP(LinearModel):
         object.__setattr__(self, "g", positive("g", self.g))
 
     @property
-    def Tc(self) -> float:  # noqa: N802 - Kajita's symbol
+    def Tc(self) -> float:
         """Time constant ``Tc = sqrt(z_c / g)`` [s]."""
         return float(np.sqrt(self.z_c / self.g))
 
     @property
-    def A(self) -> FloatArray:  # noqa: N802
+    def A(self) -> FloatArray:
         w2 = 1.0 / self.Tc**2
         a = np.zeros((4, 4))
         a[0, 2] = a[1, 3] = 1.0
@@ -56,7 +56,7 @@ class LIP(LinearModel):
         return a
 
     @property
-    def B(self) -> FloatArray:  # noqa: N802
+    def B(self) -> FloatArray:
         w2 = 1.0 / self.Tc**2
         b = np.zeros((4, 2))
         b[2, 0] = b[3, 1] = -w2
@@ -85,11 +85,11 @@ class LIP(LinearModel):
         s = np.sinh(tt / tc)[..., None]
         pos = (x0 - p) * c + tc * v0 * s + p
         vel = (x0 - p) / tc * s + v0 * c
-        if tt.ndim == 0:
-            return pos[0], vel[0]
         return pos, vel
 
-    def orbital_energy(self, pos: ArrayLike, vel: ArrayLike, foot: ArrayLike) -> NDArray[np.float64]:
+    def orbital_energy(
+        self, pos: ArrayLike, vel: ArrayLike, foot: ArrayLike
+    ) -> NDArray[np.float64]:
         """Orbital energy per axis ``E = v^2 / 2 - g / (2 z_c) (x - p)^2`` [m^2/s^2].
 
         It is conserved along every LIP trajectory (Kajita eq. 4.21).

@@ -1,0 +1,165 @@
+"""LIP walking pattern generator of document 004."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.optimize import minimize_scalar
+
+from footfall.errors import InputError
+from footfall.planning import LipWalkParams, lip_example, lip_walk
+from tests.conftest import IVP_ATOL, IVP_RTOL
+
+#: the document's stop criterion
+STOP_SPEED = 0.01  # m/s
+#: the circle must close on itself within this distance (issue 2)
+CIRCLE_CLOSURE = 0.05  # m
+EXAMPLES = ("straight", "diagonal", "turn", "circle")
+
+
+@pytest.mark.parametrize("name", EXAMPLES)
+def test_trajectory_matches_piecewise_integration(name: str) -> None:
+    """The whole CoM path equals an integration of x'' = g/z_c (x - p) over the footholds.
+
+    Each phase is integrated from the generator's start state; its end must be the next phase's
+    start state, so position and velocity are continuous across every step switch. (Phases are
+    not chained through the integrator: the LIP's unstable mode would amplify its own error.)
+    """
+    walk = lip_walk(lip_example(name))
+    p = walk.params
+    t_sup = p.t_sup
+
+    def f(_: float, s: np.ndarray, foot: np.ndarray) -> np.ndarray:
+        return np.concatenate([s[2:], p.g / p.z_c * (s[:2] - foot)])
+
+    state = np.concatenate([p.com0, p.vel0])
+    worst = 0.0
+    for k in range(walk.footholds.shape[0]):
+        sol = solve_ivp(
+            f, (0.0, t_sup), state, args=(walk.footholds[k],), rtol=IVP_RTOL, atol=IVP_ATOL
+        )
+        assert sol.success
+        end = sol.y[:, -1]
+        if k + 1 < walk.footholds.shape[0]:
+            worst = max(worst, np.max(np.abs(end[:2] - walk.com_start[k + 1])))
+            worst = max(worst, np.max(np.abs(end[2:] - walk.vel_start[k + 1])))
+            state = np.concatenate([walk.com_start[k + 1], walk.vel_start[k + 1]])
+    worst = max(worst, np.max(np.abs(end - np.concatenate([walk.final_com, walk.final_vel]))))
+    assert worst < 1e-8
+
+
+@pytest.mark.parametrize("name", EXAMPLES)
+def test_sampled_path_is_continuous_at_switches(name: str) -> None:
+    walk = lip_walk(lip_example(name))
+    dt = 1e-4
+    traj = walk.com_trajectory(dt)
+    switch = np.flatnonzero(np.diff(traj["step"]) != 0)
+    assert switch.size == walk.footholds.shape[0] - 1
+    for key, rate in (("x", "vx"), ("y", "vy")):
+        jump = np.abs(traj[key][switch + 1] - traj[key][switch])
+        # Over one sample the position moves by about v dt; anything more is a discontinuity.
+        assert np.all(jump <= np.abs(traj[rate][switch]) * dt * 1.01 + 1e-9)
+        accel_bound = walk.params.g / walk.params.z_c * 1.0  # |x - p| < 1 m
+        assert np.all(np.abs(np.diff(traj[rate])[switch]) <= accel_bound * dt)
+
+
+@pytest.mark.parametrize("name", EXAMPLES)
+def test_each_foothold_minimises_the_placement_cost(name: str) -> None:
+    """Kajita eq. (4.58): checked with a numerical minimiser, not the closed form (4.59)."""
+    walk = lip_walk(lip_example(name))
+    lip = walk.lip
+    p = walk.params
+    t_sup = p.t_sup
+    # Recover each step's target from the generator's own targets by re-deriving them independently.
+    sx = np.array([*p.sx, 0.0])
+    sy = np.array([*p.sy, 0.0])
+    th = np.array([*p.headings, p.headings[-1]])
+    c = np.cosh(t_sup / lip.Tc)
+    s = np.sinh(t_sup / lip.Tc)
+    for n in range(sx.size):
+        rot = np.array([[np.cos(th[n]), -np.sin(th[n])], [np.sin(th[n]), np.cos(th[n])]])
+        bar = rot @ np.array([sx[n] / 2, (-1) ** n * sy[n] / 2])
+        vbar = np.array([(c + 1) / (lip.Tc * s) * bar[0], (c - 1) / (lip.Tc * s) * bar[1]])
+        target = walk.ideal_footholds[n] + bar
+        last = n == sx.size - 1
+        a, b = (p.a_stop, p.b_stop) if last else (p.a, p.b)
+        for axis in range(2):
+
+            def cost(q: float, axis: int = axis) -> float:
+                x, v = lip.state_at(
+                    [walk.com_start[n, axis]], [walk.vel_start[n, axis]], [q], t_sup
+                )
+                return float(a * (target[axis] - x[0]) ** 2 + b * (vbar[axis] - v[0]) ** 2)
+
+            best = minimize_scalar(cost, bracket=(-5.0, 5.0), tol=1e-12).x
+            assert walk.footholds[n, axis] == pytest.approx(best, abs=1e-6)
+
+
+def test_ideal_footholds_follow_walk_parameters() -> None:
+    walk = lip_walk(lip_example("straight"))
+    np.testing.assert_allclose(
+        walk.ideal_footholds,
+        [[0, 0], [0, 0.2], [0.3, 0.0], [0.6, 0.2], [0.9, 0.0], [0.9, 0.2]],
+        atol=1e-12,
+    )
+
+
+@pytest.mark.parametrize("name", ["straight", "turn"])
+def test_stop_brings_com_to_rest(name: str) -> None:
+    walk = lip_walk(lip_example(name))
+    assert np.linalg.norm(walk.final_vel) < STOP_SPEED
+    # ... over the last foot, within half a sole length
+    assert np.linalg.norm(walk.final_com - walk.footholds[-1]) < 0.1
+
+
+def test_turning_example_reproduces_document_final_speed() -> None:
+    """Document 004 section 3.3 reports v_x = 0, v_y = 0.0044 m/s for this example."""
+    walk = lip_walk(lip_example("turn"))
+    assert walk.final_vel[0] == pytest.approx(0.0, abs=1e-9)
+    assert walk.final_vel[1] == pytest.approx(0.0044, abs=5e-5)
+
+
+def test_circle_closes_on_itself() -> None:
+    walk = lip_walk(lip_example("circle"))
+    # Step 19 is the same foot at the same place of the circle as step 1, one lap later.
+    assert np.linalg.norm(walk.footholds[19] - walk.footholds[1]) < CIRCLE_CLOSURE
+    assert np.linalg.norm(walk.final_com - np.array(walk.params.com0)) < CIRCLE_CLOSURE
+    # and it is a real circle, not a walk on the spot: the path spans more than 1.5 m
+    traj = walk.com_trajectory(0.01)
+    assert np.ptp(traj["x"]) > 1.5 and np.ptp(traj["y"]) > 1.5
+
+
+def test_velocity_target_is_not_rotated_twice() -> None:
+    """Document 004's erratum on Kajita eq. (4.62): a walk at a constant heading phi is NOT the
+    rotated copy of the straight walk, because the velocity target is computed per world axis from
+    the rotated position target and then left unrotated (as the reference MATLAB code does)."""
+    phi = np.deg2rad(30.0)
+    base = dict(z_c=0.8, t_sup=0.8, sx=(0.0, 0.3, 0.3, 0.0), sy=(0.2,) * 4, g=9.8)
+    rotated = lip_walk(LipWalkParams(theta=(phi,) * 4, **base))
+    straight = lip_walk(LipWalkParams(**base))
+    r = np.array([[np.cos(phi), -np.sin(phi)], [np.sin(phi), np.cos(phi)]])
+    copy = straight.footholds @ r.T
+    assert np.max(np.abs(rotated.footholds[1:] - copy[1:])) > 1e-3
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"sy": (0.2, 0.3, 0.2, 0.2)}, "sy"),  # the document's own example is one short
+        ({"theta": (0.0, 0.1)}, "theta"),
+        ({"z_c": 0.0}, "z_c"),
+        ({"t_sup": -0.8}, "t_sup"),
+        ({"sx": (0.0, float("nan"), 0.3, 0.3, 0.0)}, "sx"),
+        ({"sx": ()}, "sx"),
+        ({"a": -1.0}, "a"),
+        ({"a": 0.0, "b": 0.0}, "a, b"),
+        ({"com0": (0.0,)}, "com0"),
+    ],
+)
+def test_bad_input_names_the_parameter(kwargs: dict, field: str) -> None:
+    args = dict(z_c=0.8, t_sup=0.8, sx=(0.0, 0.25, 0.25, 0.25, 0.0), sy=(0.2,) * 5)
+    args.update(kwargs)
+    with pytest.raises(InputError) as err:
+        LipWalkParams(**args)
+    assert err.value.field == field
