@@ -1,0 +1,58 @@
+"""Optimisation backends behind one interface: build a :class:`MIQCQP`, then :func:`solve` it.
+
+Backends register themselves when their Python package imports: ``scip`` (PySCIPOpt, the default,
+installed with footfall) and ``gurobi`` (optional: ``pip install "footfall[gurobi]"`` and a licence).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from collections.abc import Callable
+
+from footfall.errors import InputError, SolverUnavailableError
+from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
+from footfall.solvers.problem import MIQCQP, ProblemBuilder
+
+#: every backend footfall knows: name -> (python module to import, pip hint)
+KNOWN_BACKENDS = {
+    "scip": ("pyscipopt", 'pip install pyscipopt (installed with footfall by default)'),
+    "gurobi": ("gurobipy", 'pip install "footfall[gurobi]" and a Gurobi licence'),
+}
+DEFAULT_SOLVER = "scip"
+
+
+def available_solvers() -> list[str]:
+    """Backends whose Python package is importable here."""
+    return [n for n, (mod, _) in KNOWN_BACKENDS.items() if importlib.util.find_spec(mod) is not None]
+
+
+def _backend(name: str) -> Callable[[MIQCQP, SolverOptions], SolverResult]:
+    if name not in KNOWN_BACKENDS:
+        raise InputError("solver", name, f"one of {', '.join(KNOWN_BACKENDS)}")
+    module, hint = KNOWN_BACKENDS[name]
+    if importlib.util.find_spec(module) is None:
+        raise SolverUnavailableError(f"solver {name!r} needs the package {module!r}: {hint}")
+    if name == "scip":
+        from footfall.solvers import scip
+
+        return scip.solve
+    from footfall.solvers import gurobi
+
+    return gurobi.solve
+
+
+def solve(problem: MIQCQP, solver: str = DEFAULT_SOLVER, options: SolverOptions | None = None) -> SolverResult:
+    """Solve a built problem with the named backend."""
+    return _backend(solver)(problem, options or SolverOptions())
+
+
+__all__ = [
+    "DEFAULT_SOLVER",
+    "MIQCQP",
+    "ProblemBuilder",
+    "SolveStatus",
+    "SolverOptions",
+    "SolverResult",
+    "available_solvers",
+    "solve",
+]

@@ -1,0 +1,81 @@
+"""Solver options, results and statuses shared by every backend."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from footfall._validate import non_negative, positive
+
+
+class SolveStatus(str, Enum):
+    """Outcome of a solve, as written to ``plan.json``."""
+
+    OPTIMAL = "optimal"  # proven optimal within the requested relative gap
+    FEASIBLE = "feasible"  # a solution, stopped for another reason (gap reported)
+    TIME_LIMIT = "time_limit"  # stopped by the time limit; a solution may or may not exist
+    INFEASIBLE = "infeasible"  # proven infeasible
+    ERROR = "error"  # the solver failed or reported unboundedness
+
+
+@dataclass(frozen=True)
+class SolverOptions:
+    """Options every backend understands.
+
+    Attributes:
+        time_limit: wall-clock limit [s].
+        gap: relative optimality gap at which to stop (|primal - dual| / |primal|).
+        threads: number of threads the backend may use.
+        verbose: print the backend's log.
+        seed: random seed of the backend.
+        initial_solution: optional full variable vector used as a warm start (MIP start).
+    """
+
+    time_limit: float = 60.0
+    gap: float = 1e-4
+    threads: int = 1
+    verbose: bool = False
+    seed: int = 0
+    initial_solution: NDArray[np.float64] | None = field(default=None, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "time_limit", positive("time_limit", self.time_limit))
+        object.__setattr__(self, "gap", non_negative("gap", self.gap))
+        if not isinstance(self.threads, int) or self.threads < 1:
+            from footfall.errors import InputError
+
+            raise InputError("threads", self.threads, "an integer >= 1")
+
+
+@dataclass(frozen=True)
+class SolverResult:
+    """What a backend returns.
+
+    Attributes:
+        status: see :class:`SolveStatus`.
+        x: best solution found, shape (n,), or None.
+        objective: objective of ``x`` (nan without a solution).
+        bound: proven lower bound on the optimum (nan if unknown).
+        gap: relative gap between ``objective`` and ``bound`` (inf if unknown).
+        solve_time: wall time spent in the backend [s].
+        solver: backend name.
+        stats: backend statistics (nodes, number of solutions, raw status, ...).
+    """
+
+    status: SolveStatus
+    x: NDArray[np.float64] | None
+    objective: float
+    bound: float
+    gap: float
+    solve_time: float
+    solver: str
+    stats: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def has_solution(self) -> bool:
+        """True when ``x`` holds a solution."""
+        return self.x is not None
