@@ -56,7 +56,7 @@ def test_non_convex_rejected_naming_region() -> None:
 def test_self_intersecting_star_rejected() -> None:
     ang = np.radians(90 + 144 * np.arange(5))
     star = np.column_stack([np.cos(ang), np.sin(ang)])
-    with pytest.raises(SceneError, match="star|winds|convex"):
+    with pytest.raises(SceneError, match=r"winds|convex"):
         Region.from_height("star", 0.0, star)
 
 
@@ -77,7 +77,7 @@ def test_degenerate_rejected(vertices: list[list[float]], message: str) -> None:
 
 def test_vertical_plane_rejected() -> None:
     # A wall x = 1: normal (1, 0, 0).
-    with pytest.raises(SceneError, match="vertical|horizontal") as exc:
+    with pytest.raises(SceneError, match=r"vertical|horizontal") as exc:
         Region.from_plane("wall", [1.0, 0.0, 0.0], -1.0, SQUARE)
     assert "wall" in str(exc.value)
     # 80 deg is too steep, 70 deg is accepted.
@@ -132,8 +132,8 @@ def test_plane_rows_eq_5_17() -> None:
     a, b = r.plane_rows()
     on = np.array([0.5, 0.25, (1 - 0.5 - 0.5) / 4])
     assert np.all(a @ on <= b + 1e-12)
-    assert np.any(a @ (on + [0, 0, 1e-3]) > b)
-    assert np.any(a @ (on - [0, 0, 1e-3]) > b)
+    assert np.any(a @ (on + np.array([0, 0, 1e-3])) > b)
+    assert np.any(a @ (on - np.array([0, 0, 1e-3])) > b)
 
 
 def test_contains_needs_plane_and_polygon() -> None:
@@ -149,6 +149,12 @@ def test_halfspaces_vs_winding_number_and_signed_distance() -> None:
     r = Region.from_height("hex", 0.0, hexagon)
     a, b = r.halfspaces()
     np.testing.assert_allclose(np.linalg.norm(a, axis=1), 1.0)
+    # eq. 5.18: row j is n_j . xy <= n_j . v_j with n_j normal to edge j and pointing away from
+    # the interior.
+    edges = np.roll(hexagon, -1, axis=0) - hexagon
+    np.testing.assert_allclose(np.einsum("ij,ij->i", a, edges), 0.0, atol=1e-12)
+    np.testing.assert_allclose(b, np.einsum("ij,ij->i", a, hexagon))
+    assert np.all(a @ hexagon.mean(axis=0) < b)
     rng = np.random.default_rng(1)
     pts = rng.uniform(-0.5, 2.0, size=(3000, 2))
     sd = r.signed_distance(pts)
