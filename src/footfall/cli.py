@@ -114,3 +114,70 @@ def demo(out: Path = typer.Option(Path("out/demo"), help="Output folder.")) -> N
     for line in summary["lines"]:
         typer.echo(line)
     typer.echo(f"wrote {out / 'demo.json'}")
+
+
+# --- terrain scenes ---
+@app.command("scenes")
+def scenes_command(
+    show: str | None = typer.Option(
+        None, "--show", help="Scene to draw: a built-in name or a YAML file path."
+    ),
+    out: Path = typer.Option(
+        Path("."), "--out", help="Folder for scene.png and scene.yaml."
+    ),
+) -> None:
+    """List the built-in scenes, or draw one (top and side view) and write it as YAML."""
+    import math
+
+    from rich.table import Table
+
+    from footfall.terrain import builtin_scene, builtin_scene_names, load_scene, scene_to_yaml
+
+    if show is None:
+        table = Table(title="Built-in scenes")
+        for col in ("name", "regions", "goal: x, y, z (m), heading (deg)", "description"):
+            table.add_column(col)
+        for name in builtin_scene_names():
+            sc = builtin_scene(name)
+            g = sc.goal
+            goal = f"({g.position[0]:.2f}, {g.position[1]:.2f}, {g.position[2]:.2f}), "
+            goal += f"{math.degrees(g.heading):.0f}"
+            table.add_row(name, str(len(sc.terrain)), goal, sc.description)
+        Console().print(table)
+        return
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from footfall.viz.terrain_plot import plot_terrain, plot_terrain_side
+
+    is_file = show.endswith((".yaml", ".yml")) or Path(show).is_file()
+    scene = load_scene(Path(show)) if is_file else builtin_scene(show)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "scene.yaml").write_text(scene_to_yaml(scene))
+    fig, (ax_top, ax_side) = plt.subplots(
+        2, 1, figsize=(9, 8), gridspec_kw={"height_ratios": [3, 1]}, constrained_layout=True
+    )
+    sm = plot_terrain(ax_top, scene.terrain)
+    plot_terrain_side(ax_side, scene.terrain)
+    for foot, mark in ((scene.start.left, "^"), (scene.start.right, "v")):
+        ax_top.plot(foot[0], foot[1], mark, color="tab:red", ms=8)
+        ax_side.plot(foot[0], foot[2], mark, color="tab:red", ms=8)
+    g = scene.goal
+    ax_top.plot(g.position[0], g.position[1], "*", color="gold", mec="k", ms=14)
+    ax_top.arrow(
+        g.position[0],
+        g.position[1],
+        0.2 * math.cos(g.heading),
+        0.2 * math.sin(g.heading),
+        width=0.01,
+        color="k",
+    )
+    ax_side.plot(g.position[0], g.position[2], "*", color="gold", mec="k", ms=14)
+    ax_top.set_title(f"{scene.name}: {scene.description}", fontsize=9)
+    fig.colorbar(sm, ax=ax_top, label="z [m]", shrink=0.8)
+    fig.savefig(out / "scene.png", dpi=120)
+    plt.close(fig)
+    console.print(f"wrote {out / 'scene.png'} and {out / 'scene.yaml'}")

@@ -1,0 +1,113 @@
+"""Planar convex-polygon helpers shared by the reach trapezoid and the terrain regions.
+
+All polygons are arrays of shape (V, 2) [m], vertices in order, the last edge closing back to the
+first vertex. "CCW" means a positive signed (shoelace) area.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+FloatArray = NDArray[np.float64]
+
+#: turning angles smaller than this [rad] count as straight (collinear vertices are allowed)
+ANGLE_TOL = 1e-9
+
+
+def signed_area(vertices: FloatArray) -> float:
+    """Shoelace signed area [m^2] of a polygon (V, 2): > 0 for counter-clockwise order."""
+    x, y = vertices[:, 0], vertices[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def turning_angles(vertices: FloatArray) -> FloatArray:
+    """Signed turning angle [rad] at every vertex (V,), positive for a left (CCW) turn.
+
+    Entry ``j`` is the angle from edge ``j-1 -> j`` to edge ``j -> j+1``.
+    """
+    edges = np.roll(vertices, -1, axis=0) - vertices
+    prev = np.roll(edges, 1, axis=0)
+    cross = prev[:, 0] * edges[:, 1] - prev[:, 1] * edges[:, 0]
+    dot = np.einsum("ij,ij->i", prev, edges)
+    return np.arctan2(cross, dot)
+
+
+def convexity_defect(vertices: FloatArray) -> str | None:
+    """Why a CCW polygon (V, 2) is not convex, or None when it is.
+
+    A simple CCW polygon is convex iff it never turns right. Summing the turning angles to exactly
+    2 pi also rejects self-intersecting "stars" (a pentagram turns left everywhere but winds twice),
+    and a turn of +-pi (an edge doubling back on itself) is rejected as a degenerate spike.
+    """
+    ang = turning_angles(vertices)
+    for j, a in enumerate(ang):
+        if abs(abs(a) - np.pi) < 1e-9:
+            return f"the boundary doubles back on itself at vertex {j}"
+        if a < -ANGLE_TOL:
+            return f"it turns clockwise (reflex angle) at vertex {j}"
+    total = float(np.sum(ang))
+    if abs(total - 2.0 * np.pi) > 1e-6:
+        return f"the boundary winds {total / (2 * np.pi):.2f} times (self-intersecting)"
+    return None
+
+
+def outward_halfspaces(vertices: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Half-spaces ``A q <= b`` of a convex CCW polygon (V, 2) (eq. 5.18).
+
+    For the edge ``v_j -> v_{j+1}`` of a CCW polygon the interior lies to the left, so the outward
+    normal is the edge direction turned right, ``(e_y, -e_x)``; rows are normalised to unit length
+    so that ``A q - b`` is a true Euclidean distance to each edge line.
+
+    Returns:
+        ``(A, b)`` of shapes (V, 2) and (V,).
+    """
+    edges = np.roll(vertices, -1, axis=0) - vertices
+    normals = np.stack([edges[:, 1], -edges[:, 0]], axis=1)
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    b = np.einsum("ij,ij->i", normals, vertices)
+    return normals, b
+
+
+def point_segment_distance(p: FloatArray, a: FloatArray, b: FloatArray) -> float:
+    """Euclidean distance [m] from point ``p`` (2,) to the segment ``a``-``b``."""
+    ab = b - a
+    denom = float(np.dot(ab, ab))
+    t = 0.0 if denom == 0.0 else float(np.clip(np.dot(p - a, ab) / denom, 0.0, 1.0))
+    return float(np.linalg.norm(p - (a + t * ab)))
+
+
+def polygons_intersect(p: FloatArray, q: FloatArray, tol: float = 1e-9) -> bool:
+    """Whether two convex CCW polygons overlap or touch (separating-axis theorem)."""
+    for poly, other in ((p, q), (q, p)):
+        a, b = outward_halfspaces(poly)
+        # An edge normal separates the two iff every vertex of `other` lies strictly outside it.
+        if np.any(np.min(other @ a.T - b, axis=0) > tol):
+            return False
+    return True
+
+
+def polygon_distance(p: FloatArray, q: FloatArray) -> float:
+    """Minimum Euclidean distance [m] between two convex CCW polygons; 0 when they overlap.
+
+    For disjoint convex polygons the closest pair involves a vertex of one and an edge of the other.
+    """
+    if polygons_intersect(p, q):
+        return 0.0
+    best = np.inf
+    for poly, other in ((p, q), (q, p)):
+        nxt = np.roll(other, -1, axis=0)
+        for v in poly:
+            for a, b in zip(other, nxt, strict=True):
+                best = min(best, point_segment_distance(v, a, b))
+    return float(best)
+
+
+def as_points(xy: ArrayLike) -> tuple[FloatArray, bool]:
+    """Return ``xy`` as an (N, 2) float array and whether a single point (2,) was given."""
+    arr = np.asarray(xy, dtype=float)
+    single = arr.ndim == 1
+    pts = np.atleast_2d(arr)
+    if pts.shape[-1] < 2:
+        raise ValueError(f"expected points with at least 2 coordinates, got shape {arr.shape}")
+    return pts[:, :2], single

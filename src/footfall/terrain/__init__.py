@@ -1,0 +1,30 @@
+"""Terrain: convex planar regions (document 000, eq. 5.15-5.18), scenes, YAML files, built-ins.
+
+The scene file schema is in ``SCHEMA.md`` next to this file.
+"""
+
+from footfall.terrain.region import Region
+from footfall.terrain.scene import (
+    Goal,
+    Scene,
+    Start,
+    builtin_scene,
+    builtin_scene_names,
+    load_scene,
+    random_stepping_stones,
+    scene_to_yaml,
+)
+from footfall.terrain.terrain import Terrain
+
+__all__ = [
+    "Goal",
+    "Region",
+    "Scene",
+    "Start",
+    "Terrain",
+    "builtin_scene",
+    "builtin_scene_names",
+    "load_scene",
+    "random_stepping_stones",
+    "scene_to_yaml",
+]

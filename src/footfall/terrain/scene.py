@@ -1,0 +1,632 @@
+"""Scenes: a robot, a terrain, a start and a goal; YAML files, built-ins and a random generator.
+
+The YAML schema is documented in ``SCHEMA.md`` next to this file. Loading validates the file with
+pydantic, then builds the frozen dataclasses (which validate the geometry); every error is a
+:class:`~footfall.errors.SceneError` whose field names the path in the file and its line, e.g.
+``regions[2].vertices (line 31)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+import yaml
+from numpy.typing import ArrayLike, NDArray
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from footfall._geometry import outward_halfspaces, polygon_distance
+from footfall._validate import finite, finite_vector
+from footfall.errors import InputError, SceneError
+from footfall.models.biped import BipedParams, ReachTrapezoid, Side
+from footfall.terrain.region import Region
+from footfall.terrain.terrain import Terrain
+
+FloatArray = NDArray[np.float64]
+
+#: tolerance [m] for the start feet and the goal to count as on a region (plane and polygon); looser
+#: than Region.contains' default because hand-written YAML heights are rounded
+SCENE_TOL = 1e-3
+
+
+# ============================================================================= scene dataclasses
+@dataclass(frozen=True, eq=False)
+class Start:
+    """Initial stance of the robot.
+
+    Attributes:
+        left: left foot position (3,) [m].
+        right: right foot position (3,) [m].
+        heading: heading of both feet theta_0 [rad].
+        stance: the foot standing at t = 0 (footstep 0); the other foot moves first.
+        alip_state: initial ALIP state ``[x_c, y_c, L_x, L_y]`` (4,) relative to the stance foot
+            ([m, m, kg m^2/s, kg m^2/s], eq. 5.12c); zeros (CoM over the stance foot, at rest)
+            by default.
+    """
+
+    left: FloatArray
+    right: FloatArray
+    heading: float
+    stance: Side
+    alip_state: FloatArray = field(default_factory=lambda: np.zeros(4))
+
+    def __post_init__(self) -> None:
+        for name in ("left", "right"):
+            v = _wrap(f"start.{name}", lambda n=name: finite_vector(n, getattr(self, n), 3))
+            v.setflags(write=False)
+            object.__setattr__(self, name, v)
+        object.__setattr__(
+            self, "heading", _wrap("start.heading", lambda: finite("h", self.heading))
+        )
+        try:
+            object.__setattr__(self, "stance", Side(self.stance))
+        except ValueError:
+            raise SceneError("start.stance", self.stance, "'left' or 'right'") from None
+        x0 = _wrap("start.alip_state", lambda: finite_vector("x", self.alip_state, 4))
+        x0.setflags(write=False)
+        object.__setattr__(self, "alip_state", x0)
+
+    def foot(self, side: Side) -> FloatArray:
+        """Position (3,) [m] of the ``side`` foot."""
+        return self.left if Side(side) is Side.LEFT else self.right
+
+    @property
+    def stance_foot(self) -> FloatArray:
+        """Position (3,) [m] of the standing foot (footstep 0)."""
+        return self.foot(self.stance)
+
+
+@dataclass(frozen=True, eq=False)
+class Goal:
+    """Where the walk ends.
+
+    Attributes:
+        position: midpoint between the two final feet (3,) [m], z on the terrain.
+        heading: final heading [rad].
+    """
+
+    position: FloatArray
+    heading: float
+
+    def __post_init__(self) -> None:
+        p = _wrap("goal.position", lambda: finite_vector("p", self.position, 3))
+        p.setflags(write=False)
+        object.__setattr__(self, "position", p)
+        object.__setattr__(
+            self, "heading", _wrap("goal.heading", lambda: finite("h", self.heading))
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A footstep-planning problem instance.
+
+    Attributes:
+        name: short identifier.
+        description: one-line human description.
+        robot: the biped.
+        terrain: the walkable regions.
+        start: initial feet, heading, stance foot and ALIP state.
+        goal: final feet midpoint and heading.
+
+    Construction checks that both start feet and the goal lie on some region (within
+    ``SCENE_TOL``), naming the offending foot.
+    """
+
+    name: str
+    description: str
+    robot: BipedParams
+    terrain: Terrain
+    start: Start
+    goal: Goal
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name.strip():
+            raise SceneError("name", self.name, "a non-empty string")
+        if not isinstance(self.description, str):
+            raise SceneError("description", self.description, "a string")
+        for attr, typ in (
+            ("robot", BipedParams),
+            ("terrain", Terrain),
+            ("start", Start),
+            ("goal", Goal),
+        ):
+            if not isinstance(getattr(self, attr), typ):
+                raise SceneError(attr, getattr(self, attr), f"a {typ.__name__}")
+        for fld, p in (
+            ("start.left", self.start.left),
+            ("start.right", self.start.right),
+            ("goal.position", self.goal.position),
+        ):
+            if not self.terrain.locate(p, SCENE_TOL):
+                name, gap, dz = self.terrain.nearest(p)
+                raise SceneError(
+                    fld,
+                    [round(float(c), 6) for c in p],
+                    f"a point on some region within {SCENE_TOL} m (nearest is {name!r}: "
+                    f"{gap:.3f} m outside it in plan view, {dz:+.3f} m off its plane)",
+                )
+
+    def start_regions(self) -> dict[Side, str]:
+        """Name of the (first) region under each start foot."""
+        return {s: self.terrain.locate(self.start.foot(s), SCENE_TOL)[0] for s in Side}
+
+    def goal_region(self) -> str:
+        """Name of the (first) region containing the goal."""
+        return self.terrain.locate(self.goal.position, SCENE_TOL)[0]
+
+
+def _wrap(fld: str, fn: Any) -> Any:
+    """Run ``fn`` and re-raise an InputError as a SceneError naming ``fld``."""
+    try:
+        return fn()
+    except InputError as e:
+        raise SceneError(fld, e.value, e.expected) from None
+
+
+# ============================================================================= YAML schema
+Vec2 = Annotated[list[float], Field(min_length=2, max_length=2)]
+Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+Vec4 = Annotated[list[float], Field(min_length=4, max_length=4)]
+
+
+class _Spec(BaseModel):
+    # strict: no "0.5" strings or booleans for numbers; no NaN/inf; unknown keys are typos.
+    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
+
+
+class _RobotSpec(_Spec):
+    mass: float | None = None
+    com_height: float | None = None
+    t_ss: float | None = None
+    t_ds: float | None = None
+    n_nodes: int | None = None
+    u_max: float | None = None
+    reach: Annotated[list[Vec2], Field(min_length=4, max_length=4)] | None = None
+    theta_max: float | None = None
+    theta_max_deg: float | None = None
+    stance_width: float | None = None
+    step_height_max: float | None = None
+    foot_length: float | None = None
+    foot_width: float | None = None
+    g: float | None = None
+
+
+class _StartSpec(_Spec):
+    left: Vec3
+    right: Vec3
+    heading: float | None = None
+    heading_deg: float | None = None
+    stance: Literal["left", "right"]
+    alip_state: Vec4 | None = None
+
+
+class _GoalSpec(_Spec):
+    position: Vec3
+    heading: float | None = None
+    heading_deg: float | None = None
+
+
+class _RegionSpec(_Spec):
+    name: str
+    vertices: Annotated[list[list[float]], Field(min_length=3)]
+    normal: Vec3 | None = None
+    offset: float | None = None
+    height: float | None = None
+
+
+class _SceneSpec(_Spec):
+    name: str
+    description: str = ""
+    robot: _RobotSpec = Field(default_factory=_RobotSpec)
+    start: _StartSpec
+    goal: _GoalSpec
+    regions: Annotated[list[_RegionSpec], Field(min_length=1)]
+
+
+# ============================================================================= YAML loading
+Path_ = tuple[str | int, ...]
+
+
+class _Missing:
+    def __repr__(self) -> str:
+        return "nothing (the field is missing)"
+
+
+class _Locator:
+    """Maps a path in the document (keys and list indices) to a 1-based line number."""
+
+    def __init__(self, root: yaml.Node | None, source: str | None) -> None:
+        self.root = root
+        self.source = source
+
+    def line(self, path: Path_) -> int | None:
+        node = self.root
+        if node is None:
+            return None
+        line = node.start_mark.line + 1
+        for key in path:
+            nxt: yaml.Node | None = None
+            if isinstance(node, yaml.MappingNode) and isinstance(key, str):
+                for k, v in node.value:
+                    if isinstance(k, yaml.ScalarNode) and k.value == key:
+                        # The key's line, not the value's: a block list starts on the next line.
+                        line, nxt = k.start_mark.line + 1, v
+                        break
+            elif isinstance(node, yaml.SequenceNode) and isinstance(key, int):
+                if 0 <= key < len(node.value):
+                    nxt = node.value[key]
+                    line = nxt.start_mark.line + 1
+            if nxt is None:
+                # The path goes deeper than the document (a missing field): report its parent.
+                break
+            node = nxt
+        return line
+
+    def field(self, path: Path_) -> str:
+        text = ""
+        for key in path:
+            text += f"[{key}]" if isinstance(key, int) else (f".{key}" if text else key)
+        text = text or "<document>"
+        line = self.line(path)
+        if line is None:
+            return text
+        where = f"line {line}" + (f" of {self.source}" if self.source else "")
+        return f"{text} ({where})"
+
+    def error(self, path: Path_, value: object, expected: str) -> SceneError:
+        return SceneError(self.field(path), value, expected)
+
+
+def _split_field(fld: str) -> Path_:
+    """``"start.left"`` -> ``("start", "left")``; ``"reach"`` -> ``("reach",)``."""
+    return tuple(fld.split("."))
+
+
+def _angle(loc: _Locator, path: Path_, rad: float | None, deg: float | None, name: str) -> float:
+    if rad is not None and deg is not None:
+        raise loc.error(
+            (*path, f"{name}_deg"), deg, f"only one of {name} [rad] or {name}_deg [deg]"
+        )
+    if rad is None and deg is None:
+        raise loc.error(path, _Missing(), f"{name} [rad] or {name}_deg [deg]")
+    return float(rad) if rad is not None else math.radians(float(deg))  # type: ignore[arg-type]
+
+
+def _build_robot(spec: _RobotSpec, loc: _Locator) -> BipedParams:
+    kw: dict[str, Any] = {}
+    for name in spec.model_fields_set:
+        value = getattr(spec, name)
+        if value is not None and name not in ("reach", "theta_max", "theta_max_deg"):
+            kw[name] = value
+    if spec.theta_max is not None or spec.theta_max_deg is not None:
+        kw["theta_max"] = _angle(loc, ("robot",), spec.theta_max, spec.theta_max_deg, "theta_max")
+    if spec.reach is not None:
+        try:
+            kw["reach"] = ReachTrapezoid(np.array(spec.reach, dtype=float))
+        except InputError as e:
+            raise loc.error(("robot", "reach"), e.value, e.expected) from None
+    try:
+        return BipedParams(**kw)
+    except InputError as e:
+        path: Path_ = (
+            "robot",
+            "theta_max_deg"
+            if e.field == "theta_max" and spec.theta_max_deg is not None
+            else e.field,
+        )
+        raise loc.error(path, e.value, e.expected) from None
+
+
+def _build_region(i: int, spec: _RegionSpec, loc: _Locator) -> Region:
+    here: Path_ = ("regions", i)
+    dims = 2 if (spec.normal is not None or spec.height is not None) else 3
+    form = {2: "[x, y] (with normal/offset or height)", 3: "[x, y, z] (no normal or height)"}[dims]
+    for j, v in enumerate(spec.vertices):
+        if len(v) != dims:
+            raise loc.error((*here, "vertices", j), v, f"a vertex {form}")
+    if spec.normal is not None and spec.height is not None:
+        raise loc.error(
+            (*here, "height"), spec.height, "either normal + offset or height, not both"
+        )
+    if spec.normal is not None and spec.offset is None:
+        raise loc.error(
+            (*here, "offset"), _Missing(), "an offset d [m] with the normal (n.p + d = 0)"
+        )
+    if spec.offset is not None and spec.normal is None:
+        raise loc.error((*here, "normal"), _Missing(), "a normal [a, b, c] with the offset")
+    try:
+        if spec.normal is not None:
+            return Region.from_plane(
+                spec.name, spec.normal, float(spec.offset or 0.0), spec.vertices
+            )
+        if spec.height is not None:
+            return Region.from_height(spec.name, spec.height, spec.vertices)
+        return Region.from_3d(spec.name, spec.vertices)
+    except SceneError as e:
+        attr = e.field.rsplit(" ", 1)[-1]
+        path = (*here, attr) if attr in spec.model_fields_set else here
+        raise loc.error(path, e.value, f"{e.expected} [region {spec.name!r}]") from None
+
+
+def _build_scene(spec: _SceneSpec, loc: _Locator) -> Scene:
+    robot = _build_robot(spec.robot, loc)
+    names: dict[str, int] = {}
+    for i, r in enumerate(spec.regions):
+        if r.name in names:
+            raise loc.error(
+                ("regions", i, "name"), r.name, f"a unique name (regions[{names[r.name]}] has it)"
+            )
+        names[r.name] = i
+    regions = tuple(_build_region(i, r, loc) for i, r in enumerate(spec.regions))
+    st, gl = spec.start, spec.goal
+    try:
+        start = Start(
+            left=np.array(st.left),
+            right=np.array(st.right),
+            heading=_angle(loc, ("start", "heading"), st.heading, st.heading_deg, "heading"),
+            stance=Side(st.stance),
+            alip_state=np.zeros(4) if st.alip_state is None else np.array(st.alip_state),
+        )
+        goal = Goal(
+            position=np.array(gl.position),
+            heading=_angle(loc, ("goal", "heading"), gl.heading, gl.heading_deg, "heading"),
+        )
+        return Scene(spec.name, spec.description, robot, Terrain(regions), start, goal)
+    except SceneError as e:
+        if "(line" in e.field:  # already located
+            raise
+        raise loc.error(_split_field(e.field), e.value, e.expected) from None
+
+
+def _pydantic_error(err: ValidationError, loc: _Locator) -> SceneError:
+    errors = err.errors()
+    first = errors[0]
+    path: Path_ = tuple(k for k in first["loc"] if isinstance(k, str | int))
+    more = f" (and {len(errors) - 1} more problem(s))" if len(errors) > 1 else ""
+    if first["type"] == "missing":
+        return loc.error(path, _Missing(), f"this required field{more}")
+    if first["type"] == "extra_forbidden":
+        return loc.error(path, first["input"], f"no such field (unknown key){more}")
+    return loc.error(path, first.get("input"), f"{first['msg'].lower()}{more}")
+
+
+def load_scene(path_or_text: str | Path) -> Scene:
+    """Load and validate a scene from a YAML file path or YAML text.
+
+    A ``str`` is a path when it has no newline and names an existing file or ends in ``.yaml`` /
+    ``.yml``; otherwise it is YAML text.
+
+    Raises:
+        SceneError: naming the field path and the line, e.g. ``start.left (line 12 of a.yaml)``.
+    """
+    source: str | None = None
+    if isinstance(path_or_text, Path) or (
+        "\n" not in path_or_text
+        and (path_or_text.endswith((".yaml", ".yml")) or Path(path_or_text).is_file())
+    ):
+        p = Path(path_or_text)
+        try:
+            text = p.read_text()
+        except OSError as e:
+            raise SceneError("scene file", str(p), f"a readable YAML file ({e.strerror})") from None
+        source = p.name
+    else:
+        text = path_or_text
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = f" (line {mark.line + 1}" + (f" of {source})" if source else ")") if mark else ""
+        problem = getattr(e, "problem", None) or str(e)
+        raise SceneError(
+            f"yaml{where}",
+            text.splitlines()[mark.line] if mark else None,
+            f"valid YAML ({problem})",
+        ) from None
+    loc = _Locator(root, source)
+    if not isinstance(data, dict):
+        raise loc.error((), type(data).__name__, "a mapping with name, start, goal and regions")
+    try:
+        spec = _SceneSpec.model_validate(data)
+    except ValidationError as e:
+        raise _pydantic_error(e, loc) from None
+    return _build_scene(spec, loc)
+
+
+# ============================================================================= YAML writing
+def _floats(a: ArrayLike) -> Any:
+    """Nested lists of Python floats (YAML writes their repr, so they round-trip exactly)."""
+    return (np.asarray(a, dtype=float) + 0.0).tolist()  # + 0.0 turns -0.0 into 0.0
+
+
+def scene_to_dict(scene: Scene) -> dict[str, Any]:
+    """The scene as plain data following the YAML schema (every robot field written out)."""
+    r = scene.robot
+    robot: dict[str, Any] = {
+        "mass": r.mass,
+        "com_height": r.com_height,
+        "t_ss": r.t_ss,
+        "t_ds": r.t_ds,
+        "n_nodes": r.n_nodes,
+        "u_max": r.u_max,
+        "reach": _floats(r.reach.vertices),
+        "theta_max": r.theta_max,
+        "stance_width": r.stance_width,
+        "step_height_max": r.step_height_max,
+        "foot_length": r.foot_length,
+        "foot_width": r.foot_width,
+        "g": r.g,
+    }
+    regions: list[dict[str, Any]] = []
+    for reg in scene.terrain:
+        entry: dict[str, Any] = {"name": reg.name}
+        if reg.is_flat:
+            entry["height"] = -reg.offset + 0.0  # + 0.0 turns -0.0 into 0.0
+        else:
+            entry["normal"] = _floats(reg.normal)
+            entry["offset"] = reg.offset
+        entry["vertices"] = _floats(reg.vertices)
+        regions.append(entry)
+    return {
+        "name": scene.name,
+        "description": scene.description,
+        "robot": robot,
+        "start": {
+            "left": _floats(scene.start.left),
+            "right": _floats(scene.start.right),
+            "heading": scene.start.heading,
+            "stance": scene.start.stance.value,
+            "alip_state": _floats(scene.start.alip_state),
+        },
+        "goal": {"position": _floats(scene.goal.position), "heading": scene.goal.heading},
+        "regions": regions,
+    }
+
+
+def scene_to_yaml(scene: Scene) -> str:
+    """The scene as YAML text that :func:`load_scene` reads back to an equal scene."""
+    return yaml.safe_dump(scene_to_dict(scene), sort_keys=False, default_flow_style=None, width=100)
+
+
+# ============================================================================= built-in scenes
+def builtin_scene_names() -> list[str]:
+    """Names of the scenes shipped in ``footfall/terrain/scenes/*.yaml``, sorted."""
+    folder = resources.files("footfall.terrain").joinpath("scenes")
+    return sorted(p.name[: -len(".yaml")] for p in folder.iterdir() if p.name.endswith(".yaml"))
+
+
+def builtin_scene(name: str) -> Scene:
+    """Load the built-in scene ``name`` (see :func:`builtin_scene_names`)."""
+    names = builtin_scene_names()
+    if name not in names:
+        raise SceneError("scene", name, f"one of {', '.join(names)}")
+    text = resources.files("footfall.terrain").joinpath("scenes", f"{name}.yaml").read_text()
+    try:
+        return load_scene(text)
+    except SceneError as e:  # pragma: no cover - the shipped files are tested
+        raise SceneError(f"{name}.yaml: {e.field}", e.value, e.expected) from None
+
+
+# ============================================================================= random stones
+def _rect(centre: FloatArray, length: float, width: float, yaw: float) -> FloatArray:
+    """CCW rectangle (4, 2) [m] of size length x width centred at ``centre``, rotated by ``yaw``."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    local = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=float) * [length / 2, width / 2]
+    return centre + local @ np.array([[c, s], [-s, c]])
+
+
+def _rot(yaw: float) -> FloatArray:
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([[c, -s], [s, c]])
+
+
+def _sample_reach(
+    rng: np.random.Generator, reach: ReachTrapezoid, stance: Side, forward_min: float, margin: float
+) -> FloatArray:
+    """Uniform sample of the reach set (heading frame) at least ``margin`` inside its edges."""
+    verts = reach.for_stance(stance)
+    a, b = outward_halfspaces(verts)
+    lo, hi = verts.min(axis=0), verts.max(axis=0)
+    for _ in range(10_000):
+        q = rng.uniform(lo, hi)
+        if q[0] >= forward_min and np.all(a @ q - b <= -margin):
+            return q
+    raise InputError("robot.reach", verts.tolist(), f"room for steps >= {forward_min} m forward")
+
+
+def random_stepping_stones(
+    seed: int,
+    n_regions: int = 8,
+    *,
+    robot: BipedParams | None = None,
+    stone_length: tuple[float, float] = (0.25, 0.35),
+    stone_width: tuple[float, float] = (0.20, 0.28),
+    max_turn: float = math.radians(10.0),
+    max_rise: float = 0.10,
+    min_gap: float = 0.03,
+    forward_min: float = 0.10,
+    margin: float = 0.02,
+) -> Scene:
+    """Seeded random stepping-stone scene, reachable by construction (for benchmarks).
+
+    A start pad holds both feet; then ``n_regions - 2`` rectangular stones and a goal pad follow
+    as a chain. Stone ``k+1``'s centre is the centre of stone ``k`` plus ``Rot(psi_k) q`` with ``q``
+    drawn inside the reach trapezoid of the alternating stance side (eq. 5.12f), at least
+    ``margin`` from its edges; the stone heading ``psi`` changes by at most ``max_turn`` and its
+    height by at most ``max_rise`` per stone. So stepping from centre to centre is a feasible
+    footstep sequence. Stones are kept ``min_gap`` from all earlier regions (else resampled).
+
+    Args:
+        seed: random seed; equal arguments give an identical scene.
+        n_regions: total number of regions including both pads, >= 2.
+        robot: robot parameters (defaults to ``BipedParams()``).
+        stone_length: range of stone sizes along the walking direction [m].
+        stone_width: range of stone sizes across it [m].
+        max_turn: heading change bound per stone [rad], <= robot.theta_max.
+        max_rise: height change bound per stone [m], <= robot.step_height_max.
+        min_gap: smallest distance between non-overlapping regions [m].
+        forward_min: smallest forward component of a step [m] (keeps the chain moving on).
+        margin: distance of the sampled step from the trapezoid edges [m].
+    """
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
+        raise InputError("seed", seed, "an integer")
+    if isinstance(n_regions, bool) or not isinstance(n_regions, int | np.integer) or n_regions < 2:
+        raise InputError("n_regions", n_regions, "an integer >= 2 (start pad + goal pad + stones)")
+    robot = BipedParams() if robot is None else robot
+    if not 0.0 <= max_turn <= robot.theta_max:
+        raise InputError(
+            "max_turn", max_turn, f"an angle in [0, theta_max = {robot.theta_max:.3f}]"
+        )
+    if not 0.0 <= max_rise <= robot.step_height_max:
+        raise InputError("max_rise", max_rise, f"a height in [0, {robot.step_height_max}] m")
+    rng = np.random.default_rng(int(seed))
+    half_w = robot.stance_width / 2
+    left, right = np.array([0.0, half_w, 0.0]), np.array([0.0, -half_w, 0.0])
+    # The pad ends just ahead of the feet so that the first stone can be within one step.
+    regions = [Region.from_height("start", 0.0, _rect(np.array([-0.2, 0.0]), 0.5, 0.7, 0.0))]
+    point, side, psi, z = right[:2].copy(), Side.RIGHT, 0.0, 0.0
+    goal: Goal | None = None
+    for k in range(int(n_regions) - 1):
+        last = k == int(n_regions) - 2
+        for _ in range(2_000):
+            q = _sample_reach(rng, robot.reach, side, forward_min, margin)
+            new_psi = psi + float(rng.uniform(-max_turn, max_turn))
+            centre = point + _rot(psi) @ q  # reach is in the stance foot's frame (eq. 5.12f)
+            if last:
+                # Goal pad: big enough for both feet, the reached point 0.2 m behind its centre.
+                pad_centre = centre + _rot(new_psi) @ np.array([0.2, 0.0])
+                poly = _rect(pad_centre, 0.6, 0.7, new_psi)
+            else:
+                length = float(rng.uniform(*stone_length))
+                width = float(rng.uniform(*stone_width))
+                poly = _rect(centre, length, width, new_psi)
+            if all(polygon_distance(poly, r.vertices) >= min_gap for r in regions):
+                break
+        else:
+            raise InputError(
+                "n_regions",
+                n_regions,
+                f"fewer regions (no room for region {k + 1} after 2000 tries)",
+            )
+        z = z + float(rng.uniform(-max_rise, max_rise))
+        if last:
+            regions.append(Region.from_height("goal", z, poly))
+            goal = Goal(np.array([pad_centre[0], pad_centre[1], z]), new_psi)
+        else:
+            regions.append(Region.from_height(f"stone{k + 1}", z, poly))
+        point, side, psi = centre, side.other, new_psi
+    assert goal is not None
+    return Scene(
+        name=f"random_stones_s{seed}_n{n_regions}",
+        description=f"Random stepping stones (seed {seed}, {n_regions} regions), reachable",
+        robot=robot,
+        terrain=Terrain(tuple(regions)),
+        start=Start(left=left, right=right, heading=0.0, stance=Side.RIGHT),
+        goal=goal,
+    )

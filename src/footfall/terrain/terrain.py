@@ -1,0 +1,113 @@
+"""A terrain: an ordered collection of uniquely named convex regions (document 000, eq. 5.12i-j)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from footfall._geometry import polygon_distance
+from footfall.errors import SceneError
+from footfall.terrain.region import Region
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class Terrain:
+    """The walkable regions of a scene; footstep ``i`` must lie in exactly one of them (eq. 5.12j).
+
+    Attributes:
+        regions: the regions, in a fixed order (the planner's region index ``r`` is the position
+            in this tuple); names are unique.
+    """
+
+    regions: tuple[Region, ...]
+
+    def __post_init__(self) -> None:
+        regions = tuple(self.regions)
+        if not regions:
+            raise SceneError("regions", [], "at least one region")
+        seen: set[str] = set()
+        for i, r in enumerate(regions):
+            if not isinstance(r, Region):
+                raise SceneError(f"regions[{i}]", r, "a Region")
+            if r.name in seen:
+                raise SceneError(f"regions[{i}].name", r.name, "a name not used by another region")
+            seen.add(r.name)
+        object.__setattr__(self, "regions", regions)
+
+    def __getitem__(self, name: str) -> Region:
+        for r in self.regions:
+            if r.name == name:
+                return r
+        raise KeyError(name)
+
+    def __len__(self) -> int:
+        return len(self.regions)
+
+    def __iter__(self) -> Iterator[Region]:
+        return iter(self.regions)
+
+    @property
+    def names(self) -> list[str]:
+        """Region names in order."""
+        return [r.name for r in self.regions]
+
+    def index(self, name: str) -> int:
+        """Position of the region called ``name`` (raises KeyError if absent)."""
+        for i, r in enumerate(self.regions):
+            if r.name == name:
+                return i
+        raise KeyError(name)
+
+    def locate(self, p: ArrayLike, tol: float = 1e-6) -> list[str]:
+        """Names of the regions containing the 3-D point ``p`` (3,) [m] (on plane and inside)."""
+        return [r.name for r in self.regions if r.contains(p, tol)]
+
+    def nearest(self, p: ArrayLike) -> tuple[str, float, float]:
+        """Closest region to ``p`` (3,) [m] in plan view.
+
+        Returns:
+            ``(name, horizontal_gap, height_error)``: the horizontal distance [m] outside the
+            polygon (0 inside) by the edge half-spaces, and ``z - height_at(xy)`` [m].
+        """
+        q = np.asarray(p, dtype=float)
+        best: tuple[str, float, float] | None = None
+        for r in self.regions:
+            gap = max(0.0, float(r.signed_distance(q[:2])))
+            dz = float(q[2] - float(r.height_at(q[:2])))
+            key = (gap, abs(dz))
+            if best is None or key < (best[1], abs(best[2])):
+                best = (r.name, gap, dz)
+        assert best is not None  # non-empty by construction
+        return best
+
+    def bounds(self) -> FloatArray:
+        """Bounding box of all region corners, shape (2, 3): ``[min xyz, max xyz]`` [m]."""
+        pts = np.vstack([r.vertices3d for r in self.regions])
+        return np.vstack([pts.min(axis=0), pts.max(axis=0)])
+
+    def adjacency(self, reach_radius: float) -> dict[str, set[str]]:
+        """Regions whose horizontal polygons are within ``reach_radius`` [m] of each other.
+
+        A cheap necessary condition for stepping from one region to another (it ignores heights and
+        the trapezoid shape): when the goal region is not connected to the start region in this
+        graph for the robot's largest step, the scene is infeasible for any number of steps.
+
+        Returns:
+            For each region name, the set of other region names within the radius.
+        """
+        radius = float(reach_radius)
+        if not np.isfinite(radius) or radius < 0.0:
+            raise SceneError("reach_radius", reach_radius, "a finite distance >= 0 [m]")
+        adj: dict[str, set[str]] = {r.name: set() for r in self.regions}
+        regs = self.regions
+        for i, a in enumerate(regs):
+            for b in regs[i + 1 :]:
+                if polygon_distance(a.vertices, b.vertices) <= radius:
+                    adj[a.name].add(b.name)
+                    adj[b.name].add(a.name)
+        return adj

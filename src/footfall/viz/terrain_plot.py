@@ -1,0 +1,132 @@
+"""Top and side views of a terrain (regions of document 000, eq. 5.15-5.18)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.cm import ScalarMappable
+from matplotlib.colors import Colormap, Normalize
+from matplotlib.patches import Polygon
+from matplotlib.tri import Triangulation
+
+from footfall.terrain.terrain import Terrain
+
+
+def height_norm(terrain: Terrain) -> Normalize:
+    """Colour normalisation spanning the terrain's heights [m] (never zero-width)."""
+    lo, hi = terrain.bounds()[:, 2]
+    if hi - lo < 1e-3:
+        lo, hi = lo - 0.05, hi + 0.05
+    return Normalize(vmin=float(lo), vmax=float(hi))
+
+
+def plot_terrain(
+    ax: Axes,
+    terrain: Terrain,
+    *,
+    cmap: str | Colormap = "viridis",
+    norm: Normalize | None = None,
+    labels: bool = True,
+) -> ScalarMappable:
+    """Top view: every region filled with its height as colour, outlined, optionally labelled.
+
+    Tilted regions are shaded per vertex (Gouraud), so a slope shows its gradient.
+
+    Args:
+        ax: axes to draw into (x, y in metres; the aspect is set equal).
+        terrain: the terrain.
+        cmap: colour map for the height.
+        norm: height normalisation; by default spans the terrain's heights.
+        labels: write each region's name at its centroid.
+
+    Returns:
+        A ScalarMappable of the height colouring, for ``fig.colorbar(..., label="z [m]")``.
+    """
+    norm = height_norm(terrain) if norm is None else norm
+    sm = ScalarMappable(norm=norm, cmap=cmap)
+    for region in terrain:
+        v3 = region.vertices3d
+        n = len(v3)
+        # A fan from vertex 0 triangulates any convex polygon.
+        tris = np.array([[0, j, j + 1] for j in range(1, n - 1)])
+        tri = Triangulation(v3[:, 0], v3[:, 1], tris)
+        ax.tripcolor(tri, v3[:, 2], shading="gouraud", cmap=sm.cmap, norm=norm)
+        ax.add_patch(Polygon(region.vertices, closed=True, fill=False, ec="k", lw=0.8))
+        if labels:
+            c = region.centroid
+            ax.annotate(region.name, (c[0], c[1]), ha="center", va="center", fontsize=7, alpha=0.8)
+    lo, hi = terrain.bounds()
+    pad = 0.05 * max(hi[0] - lo[0], hi[1] - lo[1])
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    return sm
+
+
+def plot_terrain_side(
+    ax: Axes,
+    terrain: Terrain,
+    *,
+    cmap: str | Colormap = "viridis",
+    norm: Normalize | None = None,
+    alpha: float = 0.6,
+) -> list[Any]:
+    """Side view (x against z): each region drawn as a block from its outline down to a floor.
+
+    The block of a region is the convex hull in the x-z plane of its corners and of two floor points
+    below its x extent, so flat regions appear as boxes and slopes as wedges.
+
+    Args:
+        ax: axes to draw into (x and z in metres).
+        terrain: the terrain.
+        cmap: colour map for the height (same as the top view for a shared colour bar).
+        norm: height normalisation; by default spans the terrain's heights.
+        alpha: fill opacity (overlapping regions stay visible).
+
+    Returns:
+        The patches added.
+    """
+    norm = height_norm(terrain) if norm is None else norm
+    sm = ScalarMappable(norm=norm, cmap=cmap)
+    lo, hi = terrain.bounds()
+    floor = float(lo[2]) - 0.1
+    patches: list[Any] = []
+    for region in terrain:
+        xz = region.vertices3d[:, [0, 2]]
+        pts = np.vstack([xz, [[xz[:, 0].min(), floor], [xz[:, 0].max(), floor]]])
+        hull = _hull(pts)
+        colour = sm.cmap(float(norm(float(region.centroid[2]))))
+        patch = Polygon(hull, closed=True, fc=colour, ec="k", lw=0.8, alpha=alpha)
+        ax.add_patch(patch)
+        patches.append(patch)
+    ax.set_xlim(float(lo[0]) - 0.1, float(hi[0]) + 0.1)
+    ax.set_ylim(floor, float(hi[2]) + 0.3)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("z [m]")
+    return patches
+
+
+def _hull(points: np.ndarray) -> np.ndarray:
+    """Convex hull (monotone chain) of 2-D points (N, 2), CCW without repeated end point."""
+    pts = sorted({(float(x), float(y)) for x, y in points})
+    if len(pts) < 3:
+        return np.array(pts)
+
+    def cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower: list[tuple[float, float]] = []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
+            lower.pop()
+        lower.append(p)
+    upper: list[tuple[float, float]] = []
+    for p in reversed(pts):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
+            upper.pop()
+        upper.append(p)
+    return np.array(lower[:-1] + upper[:-1])
