@@ -122,9 +122,7 @@ def scenes_command(
     show: str | None = typer.Option(
         None, "--show", help="Scene to draw: a built-in name or a YAML file path."
     ),
-    out: Path = typer.Option(
-        Path("."), "--out", help="Folder for scene.png and scene.yaml."
-    ),
+    out: Path = typer.Option(Path("."), "--out", help="Folder for scene.png and scene.yaml."),
 ) -> None:
     """List the built-in scenes, or draw one (top and side view) and write it as YAML."""
     import math

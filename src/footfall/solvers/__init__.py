@@ -15,7 +15,7 @@ from footfall.solvers.problem import MIQCQP, ProblemBuilder
 
 #: every backend footfall knows: name -> (python module to import, pip hint)
 KNOWN_BACKENDS = {
-    "scip": ("pyscipopt", 'pip install pyscipopt (installed with footfall by default)'),
+    "scip": ("pyscipopt", "pip install pyscipopt (installed with footfall by default)"),
     "gurobi": ("gurobipy", 'pip install "footfall[gurobi]" and a Gurobi licence'),
 }
 DEFAULT_SOLVER = "scip"
@@ -23,7 +23,9 @@ DEFAULT_SOLVER = "scip"
 
 def available_solvers() -> list[str]:
     """Backends whose Python package is importable here."""
-    return [n for n, (mod, _) in KNOWN_BACKENDS.items() if importlib.util.find_spec(mod) is not None]
+    return [
+        n for n, (mod, _) in KNOWN_BACKENDS.items() if importlib.util.find_spec(mod) is not None
+    ]
 
 
 def _backend(name: str) -> Callable[[MIQCQP, SolverOptions], SolverResult]:
@@ -41,7 +43,9 @@ def _backend(name: str) -> Callable[[MIQCQP, SolverOptions], SolverResult]:
     return gurobi.solve
 
 
-def solve(problem: MIQCQP, solver: str = DEFAULT_SOLVER, options: SolverOptions | None = None) -> SolverResult:
+def solve(
+    problem: MIQCQP, solver: str = DEFAULT_SOLVER, options: SolverOptions | None = None
+) -> SolverResult:
     """Solve a built problem with the named backend."""
     return _backend(solver)(problem, options or SolverOptions())
 

@@ -81,7 +81,9 @@ class MIQCQP:
 
     def violation(self, x: FloatArray) -> float:
         """Largest violation of any bound, row or cone at ``x`` (0 when feasible)."""
-        worst = max(0.0, float(np.max(self.lb - x, initial=0.0)), float(np.max(x - self.ub, initial=0.0)))
+        worst = max(
+            0.0, float(np.max(self.lb - x, initial=0.0)), float(np.max(x - self.ub, initial=0.0))
+        )
         if self.a_eq.shape[0]:
             worst = max(worst, float(np.max(np.abs(self.a_eq @ x - self.b_eq))))
         if self.a_le.shape[0]:
@@ -202,7 +204,9 @@ class ProblemBuilder:
         """Add ``||x[indices]||_2 <= radius``."""
         self._cones.append((np.asarray(indices, dtype=np.int64).ravel(), float(radius)))
 
-    def add_square(self, coeffs: dict[int, float], target: float, weight: float, label: str) -> None:
+    def add_square(
+        self, coeffs: dict[int, float], target: float, weight: float, label: str
+    ) -> None:
         """Add the cost term ``weight * (sum coeffs x - target)^2``."""
         if weight < 0:
             raise ValueError("cost weights must be >= 0")
@@ -231,3 +235,16 @@ class ProblemBuilder:
             le_labels=list(self._le.labels),
             cones=list(self._cones),
         )
+
+
+def fix_variables(problem: MIQCQP, indices: IntArray, values: FloatArray) -> MIQCQP:
+    """A copy of ``problem`` with ``x[indices]`` fixed to ``values`` (through their bounds)."""
+    import dataclasses
+
+    lb = problem.lb.copy()
+    ub = problem.ub.copy()
+    idx = np.asarray(indices, dtype=np.int64).ravel()
+    vals = np.asarray(values, dtype=float).ravel()
+    lb[idx] = vals
+    ub[idx] = vals
+    return dataclasses.replace(problem, lb=lb, ub=ub)

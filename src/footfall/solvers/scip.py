@@ -44,7 +44,8 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
         for r in range(mat.shape[0]):
             lo, hi = mat.indptr[r], mat.indptr[r + 1]
             expr = scip.quicksum(
-                float(v) * x[int(c)] for c, v in zip(mat.indices[lo:hi], mat.data[lo:hi], strict=True)
+                float(v) * x[int(c)]
+                for c, v in zip(mat.indices[lo:hi], mat.data[lo:hi], strict=True)
             )
             if sense == "eq":
                 m.addCons(expr == float(rhs[r]), name=labels[r][:200])
@@ -54,7 +55,9 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
     rows(problem.a_eq, problem.b_eq, problem.eq_labels, "eq")
     rows(problem.a_le, problem.b_le, problem.le_labels, "le")
     for k, (idx, radius) in enumerate(problem.cones):
-        m.addCons(scip.quicksum(x[int(i)] * x[int(i)] for i in idx) <= radius * radius, name=f"cone{k}")
+        m.addCons(
+            scip.quicksum(x[int(i)] * x[int(i)] for i in idx) <= radius * radius, name=f"cone{k}"
+        )
 
     groups: dict[str, list[int]] = {}
     for r, g in enumerate(problem.cost_group):

@@ -1,0 +1,237 @@
+"""Independent checker of footstep plans.
+
+It shares no code path with the planners: regions are tested with cross products on the region
+corners (not the planner's half-space rows), the plane height with a normal recomputed from three
+corners, reachability by rotating the step into the stance frame with the true sin/cos and testing
+the trapezoid corners, and the ALIP states are re-simulated by integrating the CoM dynamics about
+the centre of pressure with scipy's ``solve_ivp`` (not the ZOH / reset matrices).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.integrate import solve_ivp
+
+from footfall.models.biped import BipedParams, Side
+from footfall.planning.plan import FootstepPlan
+from footfall.terrain.scene import Scene
+
+FloatArray = NDArray[np.float64]
+
+#: geometric tolerance [m]
+GEOM_TOL = 1e-5
+#: heading tolerance [rad]
+ANGLE_TOL = 1e-6
+#: ALIP state tolerance (mixed units: m and kg m^2/s, states are O(0.1 .. 10))
+STATE_TOL = 1e-4
+#: relative tolerance on the torque bound
+TORQUE_RTOL = 1e-6
+
+
+@dataclass(frozen=True)
+class Violation:
+    """One failed check: ``kind`` (e.g. ``region``), the footstep/phase ``step``, by how much."""
+
+    kind: str
+    step: int
+    amount: float
+    message: str
+
+
+@dataclass(frozen=True)
+class CheckReport:
+    """Result of :func:`check_plan`.
+
+    Attributes:
+        violations: every failed check.
+        dynamics_error: largest difference between the plan's ALIP states and the re-simulation.
+        checked: names of the checks that ran.
+    """
+
+    violations: tuple[Violation, ...]
+    dynamics_error: float
+    checked: tuple[str, ...] = field(default=())
+
+    @property
+    def ok(self) -> bool:
+        """True when nothing is violated."""
+        return not self.violations
+
+    def kinds(self) -> set[str]:
+        """Kinds of the violations."""
+        return {v.kind for v in self.violations}
+
+    def summary(self) -> str:
+        """One line per violation (or "ok")."""
+        if self.ok:
+            return "ok"
+        return "\n".join(f"{v.kind} (step {v.step}): {v.message}" for v in self.violations)
+
+
+def _inside_polygon(xy: FloatArray, corners: FloatArray, tol: float) -> float:
+    """Largest outward violation [m] of ``xy`` against a convex polygon given by its corners.
+
+    Uses the sign of cross products along the boundary in whichever orientation the corners have.
+    """
+    n = corners.shape[0]
+    area2 = sum(
+        corners[k, 0] * corners[(k + 1) % n, 1] - corners[(k + 1) % n, 0] * corners[k, 1]
+        for k in range(n)
+    )
+    orient = 1.0 if area2 > 0 else -1.0
+    worst = -math.inf
+    for k in range(n):
+        a, b = corners[k], corners[(k + 1) % n]
+        edge = b - a
+        cross = edge[0] * (xy[1] - a[1]) - edge[1] * (xy[0] - a[0])
+        worst = max(worst, -orient * cross / float(np.hypot(*edge)))
+    return worst
+
+
+def _plane_height(corners3d: FloatArray, xy: FloatArray) -> float:
+    a, b, c = corners3d[0], corners3d[1], corners3d[2]
+    normal = np.cross(b - a, c - a)
+    return float(a[2] - (normal[0] * (xy[0] - a[0]) + normal[1] * (xy[1] - a[1])) / normal[2])
+
+
+def _simulate_single_support(
+    robot: BipedParams, x0: FloatArray, torque: FloatArray, duration: float
+) -> FloatArray:
+    """Integrate c'' = g/z_H (c - cop) with the CoP of a constant ankle torque; ALIP in and out."""
+    mzh = robot.mass * robot.com_height
+    mg = robot.mass * robot.g
+    cop = np.array([-torque[1], torque[0]]) / mg
+    return _integrate(robot, x0, lambda t: cop, duration, mzh)
+
+
+def _integrate(robot, x0, cop_fn, duration, mzh):  # type: ignore[no-untyped-def]
+    omega2 = robot.g / robot.com_height
+    pos = x0[:2]
+    vel = np.array([x0[3], -x0[2]]) / mzh
+
+    def f(t: float, s: FloatArray) -> FloatArray:
+        return np.concatenate([s[2:], omega2 * (s[:2] - cop_fn(t))])
+
+    sol = solve_ivp(f, (0.0, duration), np.concatenate([pos, vel]), rtol=1e-10, atol=1e-12)
+    end = sol.y[:, -1]
+    return np.array([end[0], end[1], -mzh * end[3], mzh * end[2]])
+
+
+def _simulate_double_support(
+    robot: BipedParams, x_minus: FloatArray, step: FloatArray
+) -> FloatArray:
+    """Contact point moving linearly from the old foot to the new one over T_ds; result relative to
+    the new foot (the assumption behind eq. 5.10)."""
+    mzh = robot.mass * robot.com_height
+    t_ds = robot.t_ds
+    end = _integrate(robot, x_minus, lambda t: step[:2] * t / t_ds, t_ds, mzh)
+    end[:2] -= step[:2]
+    return end
+
+
+def check_plan(plan: FootstepPlan, scene: Scene, robot: BipedParams | None = None) -> CheckReport:
+    """Check every constraint of the planning problem on ``plan``, independently of the planners.
+
+    Checks: start pose and state, regions (inside polygon and on the plane), reachability with the
+    true sin/cos, step height, heading rate, torque bound, ALIP dynamics and resets (re-simulated),
+    and the goal (last two footsteps at the goal pose).
+    """
+    robot = robot or plan.robot
+    out: list[Violation] = []
+    checked: list[str] = []
+    if not plan.has_solution:
+        return CheckReport((Violation("no_solution", 0, math.inf, plan.message),), math.inf)
+    feet = plan.footsteps
+    n = plan.n_steps
+    start = scene.start
+
+    checked.append("start")
+    d0 = float(np.max(np.abs(feet[0] - start.foot(start.stance))))
+    if d0 > GEOM_TOL or plan.sides[0] is not start.stance:
+        out.append(Violation("start", 0, d0, "footstep 0 is not the given stance foot"))
+    if abs(plan.headings[0] - start.heading) > ANGLE_TOL:
+        out.append(
+            Violation("start", 0, abs(plan.headings[0] - start.heading), "heading 0 differs")
+        )
+    for i in range(1, n + 1):
+        if plan.sides[i] is plan.sides[i - 1]:
+            out.append(Violation("alternation", i, 1.0, "two consecutive steps with the same foot"))
+
+    checked.append("region")
+    by_name = {r.name: r for r in scene.terrain}
+    for i in range(1, n + 1):
+        region = by_name.get(plan.regions[i])
+        if region is None:
+            out.append(Violation("region", i, math.inf, f"unknown region {plan.regions[i]!r}"))
+            continue
+        corners = region.vertices3d
+        outside = _inside_polygon(feet[i, :2], corners[:, :2], GEOM_TOL)
+        if outside > GEOM_TOL:
+            out.append(Violation("region", i, outside, f"{outside:.2e} m outside {region.name}"))
+        dz = abs(feet[i, 2] - _plane_height(corners, feet[i, :2]))
+        if dz > GEOM_TOL:
+            out.append(Violation("region", i, dz, f"{dz:.2e} m off the plane of {region.name}"))
+
+    checked.append("reach")
+    for i in range(n):
+        th = plan.headings[i]
+        d = feet[i + 1, :2] - feet[i, :2]
+        q = np.array(
+            [math.cos(th) * d[0] + math.sin(th) * d[1], -math.sin(th) * d[0] + math.cos(th) * d[1]]
+        )
+        corners = np.array(robot.reach.vertices, dtype=float)  # for a right stance foot
+        if plan.sides[i] is Side.LEFT:
+            corners = corners * np.array([1.0, -1.0])
+        outside = _inside_polygon(q, corners, GEOM_TOL)
+        if outside > GEOM_TOL:
+            out.append(Violation("reach", i + 1, outside, f"{outside:.2e} m outside the reach set"))
+        dz = abs(feet[i + 1, 2] - feet[i, 2])
+        if dz > robot.step_height_max + GEOM_TOL:
+            out.append(Violation("step_height", i + 1, dz, f"step height {dz:.3f} m"))
+
+    checked.append("heading_rate")
+    rates = np.abs(np.diff(plan.headings))
+    for i, r in enumerate(rates):
+        if r > robot.theta_max + ANGLE_TOL:
+            out.append(Violation("heading_rate", i + 1, float(r), f"heading change {r:.4f} rad"))
+
+    checked.append("torque")
+    norms = np.linalg.norm(plan.torques, axis=-1)
+    if norms.size and norms.max() > robot.u_max * (1 + TORQUE_RTOL):
+        i = int(np.argmax(norms.max(axis=1)))
+        out.append(Violation("torque", i, float(norms.max()), f"|u| = {norms.max():.3f} N m"))
+
+    checked.append("dynamics")
+    worst = 0.0
+    x_init_err = float(np.max(np.abs(plan.states[0, 0] - start.alip_state)))
+    if x_init_err > STATE_TOL:
+        out.append(Violation("dynamics", 0, x_init_err, "initial state differs from the scene's"))
+    dt = robot.node_dt
+    for i in range(n):
+        for k in range(robot.n_nodes - 1):
+            sim = _simulate_single_support(robot, plan.states[i, k], plan.torques[i, k], dt)
+            worst = max(worst, float(np.max(np.abs(sim - plan.states[i, k + 1]))))
+        nxt = plan.states[i + 1, 0] if i + 1 < n else plan.final_state
+        sim = _simulate_double_support(robot, plan.states[i, -1], feet[i + 1] - feet[i])
+        worst = max(worst, float(np.max(np.abs(sim - nxt))))
+    if worst > STATE_TOL:
+        out.append(
+            Violation("dynamics", -1, worst, f"ALIP states differ from simulation by {worst:.2e}")
+        )
+
+    checked.append("goal")
+    th_goal = scene.goal.heading
+    left_normal = np.array([-math.sin(th_goal), math.cos(th_goal)])
+    for i in (n - 1, n):
+        want = scene.goal.position[:2] + plan.sides[i].sign * 0.5 * robot.stance_width * left_normal
+        err = float(np.linalg.norm(feet[i, :2] - want))
+        if err > GEOM_TOL:
+            out.append(Violation("goal", i, err, f"footstep {i} is {err:.3f} m from its goal spot"))
+        dth = abs((plan.headings[i] - th_goal + math.pi) % (2 * math.pi) - math.pi)
+        if dth > ANGLE_TOL * 10:
+            out.append(Violation("goal", i, dth, f"footstep {i} heading off by {dth:.4f} rad"))
+    return CheckReport(tuple(out), worst, tuple(checked))

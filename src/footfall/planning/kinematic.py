@@ -1,0 +1,87 @@
+"""Kinematic baseline: the navigation-goal planner without dynamics (Deits & Tedrake 2014 style).
+
+Same regions, reachability, heading-rate, heading-smoothness, step and goal terms as the MIQCQP of
+document 000, but no ALIP states or ankle torques. To compare it with the full-horizon planner, the
+ALIP trajectory these footsteps need is computed afterwards with the footsteps fixed: the
+least-torque states and torques (same torque and terminal terms) under the torque bound; when the
+bound cannot hold for these footsteps, the bound is lifted and the plan says so (the checker then
+reports the torque violation).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from footfall.models.biped import BipedParams
+from footfall.planning.miqcqp import build_footstep_problem, extract_plan
+from footfall.planning.plan import FootstepPlan, PlannerOptions
+from footfall.solvers import SolverOptions, SolveStatus, solve
+from footfall.solvers.problem import fix_variables
+from footfall.terrain.scene import Scene
+
+
+def plan_kinematic(
+    scene: Scene,
+    robot: BipedParams | None = None,
+    n_steps: int = 8,
+    options: PlannerOptions | None = None,
+) -> FootstepPlan:
+    """Plan footsteps without dynamics, then attach the least-torque ALIP trajectory."""
+    from dataclasses import replace
+
+    from footfall.planning.diagnose import diagnose_infeasible
+
+    options = options or PlannerOptions()
+    solver_opts = SolverOptions(
+        time_limit=options.time_limit,
+        gap=options.gap,
+        threads=options.threads,
+        verbose=options.verbose,
+    )
+    kin = build_footstep_problem(scene, robot, n_steps, options, dynamics=False)
+    res = solve(kin.problem, options.solver, solver_opts)
+    meta = dict(
+        status=res.status,
+        objective=res.objective,
+        bound=res.bound,
+        gap=res.gap,
+        solve_time=res.solve_time,
+        solver=res.solver,
+        stats=dict(res.stats),
+    )
+    if res.x is None:
+        msg = (
+            diagnose_infeasible(scene, kin.robot, n_steps)
+            if res.status is SolveStatus.INFEASIBLE
+            else f"kinematic planner found no plan ({res.stats.get('raw_status')})"
+        )
+        return FootstepPlan.empty("kinematic", robot=kin.robot, message=msg, **meta)  # type: ignore[arg-type]
+
+    # Dynamics for the chosen footsteps: the full model with every discrete choice and footstep fixed.
+    full = build_footstep_problem(scene, robot, n_steps, options, dynamics=True)
+    fixed_idx = [full.p.ravel(), full.theta, full.s, full.c]
+    fixed_val = [res.x[kin.p].ravel(), res.x[kin.theta], res.x[kin.s], res.x[kin.c]]
+    for a_full, a_kin in ((full.regions, kin.regions), (full.segments, kin.segments)):
+        mask = a_full >= 0
+        fixed_idx.append(a_full[mask])
+        fixed_val.append(np.round(res.x[a_kin[mask]]))
+    dyn_problem = fix_variables(full.problem, np.concatenate(fixed_idx), np.concatenate(fixed_val))
+    dyn = solve(dyn_problem, options.solver, solver_opts)
+    note = "kinematic plan; ALIP trajectory of least torque for its footsteps"
+    if dyn.x is None:
+        relaxed = replace(full.robot, u_max=1e6)
+        full = build_footstep_problem(scene, relaxed, n_steps, options, dynamics=True)
+        dyn_problem = fix_variables(
+            full.problem, np.concatenate(fixed_idx), np.concatenate(fixed_val)
+        )
+        dyn = solve(dyn_problem, options.solver, solver_opts)
+        note += f"; these footsteps need more than U_max = {kin.robot.u_max:g} N m of ankle torque"
+    meta["stats"]["dynamics_status"] = dyn.status.value
+    meta["stats"]["dynamics_objective"] = dyn.objective
+    meta["solve_time"] = res.solve_time + dyn.solve_time
+    if dyn.x is None:
+        return FootstepPlan.empty(
+            "kinematic", robot=kin.robot, message=note + ": dynamics failed", **meta
+        )  # type: ignore[arg-type]
+    plan = extract_plan(full, dyn.x, message=note, **meta)
+    return replace(plan, planner="kinematic", robot=kin.robot)

@@ -1,0 +1,203 @@
+"""The result every footstep planner returns, and the planner options."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from footfall._validate import non_negative, positive
+from footfall.errors import InputError
+from footfall.models.biped import BipedParams, Side
+from footfall.solvers.base import SolveStatus
+
+FloatArray = NDArray[np.float64]
+
+PLANNERS = ("miqcqp", "kinematic", "reactive")
+
+
+@dataclass(frozen=True)
+class PlannerWeights:
+    """Weights of the objective (5.11). Defaults are chosen so each term is O(1) on a 10-step walk.
+
+    Attributes:
+        torque: Q_u = torque * I, on every ankle torque [1/(N m)^2]. 1e-3 makes a 30 N m torque
+            held over a node cost about 1.
+        terminal: lambda_x, on the terminal-state error.
+        terminal_state: diagonal of the norm on ``x_N - x_goal``: CoM position [1/m^2] and angular
+            momentum [1/(kg m^2/s)^2]; the momentum entries default to ``1/(m z_H)^2`` so they
+            weigh the CoM velocity error in (m/s)^2 (set per robot by :func:`terminal_scale`).
+        heading: lambda_theta, on the heading second difference [1/rad^2].
+        step: lambda_l, on the step vectors.
+        step_matrix: diagonal of Q_l on (p_{i+1} - p_i) [1/m^2] (x, y, z).
+    """
+
+    torque: float = 1e-3
+    terminal: float = 10.0
+    terminal_state: tuple[float, float, float, float] | None = None
+    heading: float = 1.0
+    step: float = 1.0
+    step_matrix: tuple[float, float, float] = (1.0, 1.0, 1.0)
+
+    def __post_init__(self) -> None:
+        for name in ("torque", "terminal", "heading", "step"):
+            object.__setattr__(self, name, non_negative(f"weights.{name}", getattr(self, name)))
+
+    def terminal_diag(self, robot: BipedParams) -> FloatArray:
+        """Diagonal of the terminal norm for ``robot`` (see ``terminal_state``)."""
+        if self.terminal_state is not None:
+            return np.asarray(self.terminal_state, dtype=float)
+        mzh = robot.mass * robot.com_height
+        return np.array([1.0, 1.0, 1.0 / mzh**2, 1.0 / mzh**2])
+
+
+@dataclass(frozen=True)
+class PlannerOptions:
+    """Options of the footstep planners.
+
+    Attributes:
+        weights: objective weights (eq. 5.11).
+        heading_segments: L, number of sin/cos segments over a full turn (eq. 5.12g-h).
+        solver: backend name (``scip`` default, ``gurobi`` optional).
+        time_limit: solver wall-time limit [s].
+        gap: relative optimality gap at which the solver stops.
+        threads: solver threads.
+        verbose: print the solver log.
+        momentum_bound: bound on |L| as a CoM speed [m/s] (|L| <= m z_H * bound); a physical limit
+            that also gives the solver finite bounds.
+    """
+
+    weights: PlannerWeights = field(default_factory=PlannerWeights)
+    heading_segments: int = 16
+    solver: str = "scip"
+    time_limit: float = 60.0
+    gap: float = 1e-4
+    threads: int = 1
+    verbose: bool = False
+    momentum_bound: float = 3.0
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.heading_segments, int) or self.heading_segments < 4:
+            raise InputError("heading_segments", self.heading_segments, "an integer >= 4")
+        object.__setattr__(self, "time_limit", positive("time_limit", self.time_limit))
+        object.__setattr__(self, "gap", non_negative("gap", self.gap))
+        object.__setattr__(self, "momentum_bound", positive("momentum_bound", self.momentum_bound))
+
+
+@dataclass(frozen=True)
+class FootstepPlan:
+    """A footstep plan with its ALIP trajectory.
+
+    Footstep 0 is the given initial stance foot; footsteps 1..N are planned. Single-support phase
+    ``i`` (0..N-1) stands on footstep ``i`` and has K ALIP nodes; a double-support reset (eq. 5.8)
+    moves to footstep ``i + 1``. ``final_state`` is the state after the last reset, relative to
+    footstep N.
+
+    Attributes:
+        planner: ``miqcqp``, ``kinematic`` or ``reactive``.
+        status: solve status.
+        robot: the robot parameters used.
+        footsteps: shape (N + 1, 3) [m].
+        headings: shape (N + 1,) [rad].
+        sides: foot of each footstep, length N + 1.
+        regions: region name of each footstep, length N + 1.
+        states: ALIP states per phase and node, shape (N, K, 4), relative to the stance foot.
+        torques: ankle torques per phase and interval, shape (N, K - 1, 2) [N m].
+        final_state: shape (4,).
+        objective: objective value (nan without a solution).
+        bound: proven lower bound (nan if none).
+        gap: relative gap (inf if unknown).
+        solve_time: planning wall time [s].
+        solver: backend name (or "none" for planners without a solver).
+        stats: solver statistics.
+        message: human-readable explanation (diagnosis when infeasible).
+        sin_cos: the piecewise-linear (sin, cos) of each heading, shape (N + 1, 2), when the
+            planner models them (eq. 5.12g-h); empty otherwise.
+    """
+
+    planner: str
+    status: SolveStatus
+    robot: BipedParams
+    footsteps: FloatArray
+    headings: FloatArray
+    sides: tuple[Side, ...]
+    regions: tuple[str, ...]
+    states: FloatArray
+    torques: FloatArray
+    final_state: FloatArray
+    objective: float = math.nan
+    bound: float = math.nan
+    gap: float = math.inf
+    solve_time: float = 0.0
+    solver: str = "none"
+    stats: dict[str, Any] = field(default_factory=dict)
+    message: str = ""
+    sin_cos: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
+
+    @property
+    def n_steps(self) -> int:
+        """Number of planned footsteps N (0 when there is no solution)."""
+        return max(0, self.footsteps.shape[0] - 1)
+
+    @property
+    def has_solution(self) -> bool:
+        """True when the plan holds footsteps."""
+        return self.footsteps.shape[0] > 0
+
+    @classmethod
+    def empty(
+        cls, planner: str, status: SolveStatus, robot: BipedParams, message: str, **kw: Any
+    ) -> FootstepPlan:
+        """A plan without a solution (infeasible, time limit without incumbent, error)."""
+        return cls(
+            planner=planner,
+            status=status,
+            robot=robot,
+            footsteps=np.zeros((0, 3)),
+            headings=np.zeros(0),
+            sides=(),
+            regions=(),
+            states=np.zeros((0, robot.n_nodes, 4)),
+            torques=np.zeros((0, robot.n_nodes - 1, 2)),
+            final_state=np.full(4, np.nan),
+            message=message,
+            **kw,
+        )
+
+    def com_positions(self) -> FloatArray:
+        """World CoM horizontal positions at every node, shape (N, K, 2) [m]."""
+        return self.states[:, :, :2] + self.footsteps[: self.n_steps, None, :2]
+
+    def zmp_offsets(self) -> FloatArray:
+        """ZMP offset from the stance point at every torque node, shape (N, K - 1, 2) [m]."""
+        mg = self.robot.mass * self.robot.g
+        u = self.torques
+        return np.stack([-u[..., 1], u[..., 0]], axis=-1) / mg
+
+
+def wrap_near(angle: float, reference: float) -> float:
+    """``angle`` shifted by a multiple of 2 pi into [reference - pi, reference + pi)."""
+    return reference + (angle - reference + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def rot2(theta: float) -> FloatArray:
+    """2-D rotation matrix Rot(theta) of eq. (5.13)."""
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s], [s, c]])
+
+
+def goal_feet(robot: BipedParams, goal_xy: FloatArray, heading: float) -> dict[Side, FloatArray]:
+    """Horizontal positions of the two final feet: the goal midpoint -/+ half the stance width."""
+    left_normal = np.array([-math.sin(heading), math.cos(heading)])
+    half = 0.5 * robot.stance_width
+    return {Side.LEFT: goal_xy + half * left_normal, Side.RIGHT: goal_xy - half * left_normal}
+
+
+def check_planner_name(name: str) -> str:
+    """Validate a planner name."""
+    if name not in PLANNERS:
+        raise InputError("planner", name, f"one of {', '.join(PLANNERS)}")
+    return name

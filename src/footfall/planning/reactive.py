@@ -1,0 +1,225 @@
+"""Reactive baseline: one-step-ahead ALIP foot placement toward the goal (no horizon).
+
+At every step the planner looks one step ahead from the current ALIP state: it chooses the next
+footstep, and the ankle torques of the current single support, so that the angular momentum at
+the end of the next single support is as close as possible to a desired value (the
+angular-momentum foot placement of Gong & Grizzle): forward ``L_y = m z_H v_des`` toward the goal
+and the lateral ``L_x`` of a periodic gait of the nominal stance width. The footstep is restricted
+to points that are reachable and lie on a terrain region (a small mixed-integer QP: the ideal
+placement snapped into the reachable regions), and the heading turns toward the goal by at most
+theta_max per step. When both goal feet are within reach, the last two footsteps go there.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from numpy.typing import NDArray
+
+from footfall.models.biped import BipedParams, Side
+from footfall.planning.plan import FootstepPlan, goal_feet, rot2, wrap_near
+from footfall.solvers import ProblemBuilder, SolverOptions, SolveStatus, solve
+from footfall.terrain.scene import Scene
+
+FloatArray = NDArray[np.float64]
+
+#: nominal forward walking speed of the reactive planner [m/s]
+NOMINAL_SPEED = 0.5
+
+
+def _one_step(
+    scene: Scene,
+    robot: BipedParams,
+    x0: FloatArray,
+    stance: FloatArray,
+    heading: float,
+    side: Side,
+    l_des: FloatArray | None,
+    target: FloatArray | None,
+) -> tuple[FloatArray, str, FloatArray, FloatArray] | None:
+    """One-step-ahead choice of the next footstep and the current phase's ankle torques.
+
+    Minimises the error of the ALIP angular momentum at the end of the *next* single support
+    (assuming zero torque there) against ``l_des`` (or, when ``target`` is given, the distance of
+    the footstep to ``target``), plus the torque effort, over footsteps that are reachable from the
+    ``side`` stance foot (true rotation: the heading is known) and lie on a region.
+
+    Returns:
+        ``(footstep (3,), region, states (K, 4), torques (K-1, 2))`` or None when nothing is
+        reachable.
+    """
+    alip = robot.alip()
+    k_nodes = robot.n_nodes
+    ad, bd = alip.discretize(robot.node_dt)
+    a_r, b_r = alip.reset_map(robot.t_ds)
+    ad_ss = np.linalg.matrix_power(ad, k_nodes - 1)
+    mzh = robot.mass * robot.com_height
+    b = ProblemBuilder()
+    lo, hi = scene.terrain.bounds()
+    p = b.add_vars("p", (3,), lb=lo, ub=hi)
+    x = b.add_vars("x", (k_nodes, 4))
+    u = b.add_vars("u", (k_nodes - 1, 2), lb=-robot.u_max, ub=robot.u_max)
+    for j in range(4):
+        b.add_eq({int(x[0, j]): 1.0}, float(x0[j]), "initial state")
+    for k in range(k_nodes - 1):
+        b.add_cone(u[k], robot.u_max)
+        for j in range(4):
+            row = {int(x[k + 1, j]): 1.0}
+            row.update({int(x[k, jj]): -ad[j, jj] for jj in range(4) if ad[j, jj] != 0.0})
+            row.update({int(u[k, jj]): -bd[j, jj] for jj in range(2) if bd[j, jj] != 0.0})
+            b.add_eq(row, 0.0, "dynamics")
+    g_rows, h_rows = robot.reach.halfspaces(side)
+    rot = rot2(heading)
+    for g, h in zip(g_rows, h_rows, strict=True):
+        a = rot @ g
+        b.add_le(
+            {int(p[0]): float(a[0]), int(p[1]): float(a[1])}, float(h + a @ stance[:2]), "reach"
+        )
+    b.add_le({int(p[2]): 1.0}, float(stance[2] + robot.step_height_max), "step height")
+    b.add_le({int(p[2]): -1.0}, float(robot.step_height_max - stance[2]), "step height")
+    h_vars = [int(b.add_binaries(f"H[{r.name}]", ())[()]) for r in scene.terrain]
+    b.add_eq(dict.fromkeys(h_vars, 1.0), 1.0, "one region")
+    for z, region in zip(h_vars, scene.terrain, strict=True):
+        for rows, rhs, dim in ((*region.plane_rows(), 3), (*region.halfspaces(), 2)):
+            for ra, rb in zip(rows, rhs, strict=True):
+                b.add_le_big_m(
+                    {int(p[j]): float(ra[j]) for j in range(dim)}, float(rb), z, region.name
+                )
+    if target is not None:
+        for j in range(2):
+            b.add_eq({int(p[j]): 1.0}, float(target[j]), "target")
+    else:
+        assert l_des is not None
+        # L at the end of the next phase: M_x x_K + M_p (p - stance), M = (ad_ss [A_r, B_r])[2:].
+        m_x = (ad_ss @ a_r)[2:]
+        m_p = (ad_ss @ b_r)[2:]
+        for j in range(2):
+            row = {int(x[k_nodes - 1, jj]): float(m_x[j, jj]) for jj in range(4)}
+            for jj in range(3):
+                if m_p[j, jj] != 0.0:
+                    row[int(p[jj])] = row.get(int(p[jj]), 0.0) + float(m_p[j, jj])
+            offset = float(m_p[j] @ stance)
+            b.add_square(row, float(l_des[j]) + offset, 1.0 / mzh**2, "momentum")
+    for k in range(k_nodes - 1):
+        for j in range(2):
+            b.add_square({int(u[k, j]): 1.0}, 0.0, 1e-4, "torque")
+    res = solve(b.build(), "scip", SolverOptions(time_limit=10.0, gap=1e-6))
+    if res.x is None:
+        return None
+    names = scene.terrain.names
+    return res.x[p], names[int(np.argmax(res.x[h_vars]))], res.x[x], res.x[u]
+
+
+def plan_reactive(
+    scene: Scene,
+    robot: BipedParams | None = None,
+    max_steps: int = 40,
+) -> FootstepPlan:
+    """Walk toward the goal one step at a time (see the module docstring).
+
+    Args:
+        scene: terrain, start and goal.
+        robot: robot parameters (default ``scene.robot``).
+        max_steps: give up after this many footsteps.
+
+    Returns:
+        A plan with status ``feasible`` when the goal was reached, ``infeasible`` otherwise (the
+        partial plan is kept so it can be inspected).
+    """
+    t0 = time.perf_counter()
+    robot = robot or scene.robot
+    alip = robot.alip()
+    k = robot.n_nodes
+    a_r, b_r = alip.reset_map(robot.t_ds)
+    mzh = robot.mass * robot.com_height
+    omega = alip.omega
+    t_ss = robot.t_ss
+    start = scene.start
+    theta_goal = wrap_near(scene.goal.heading, start.heading)
+    feet_goal = goal_feet(robot, scene.goal.position[:2], theta_goal)
+
+    side = start.stance
+    feet = [np.array(start.stance_foot, dtype=float)]
+    headings = [float(start.heading)]
+    sides = [side]
+    regions = [scene.start_regions()[side]]
+    states: list[FloatArray] = []
+    torques: list[FloatArray] = []
+    x = np.array(start.alip_state, dtype=float)
+    message = ""
+    reached = False
+    # Lateral momentum at the end of a step of a periodic gait with the nominal stance width
+    # (Gong & Grizzle's ALIP foot placement).
+    lx_mag = (
+        0.5
+        * mzh
+        * robot.stance_width
+        * omega
+        * math.sinh(omega * t_ss)
+        / (1 + math.cosh(omega * t_ss))
+    )
+    while len(feet) <= max_steps:
+        stance, th, side = feet[-1], headings[-1], sides[-1]
+        nxt_side = side.other
+        if len(feet) >= 2 and all(
+            np.linalg.norm(feet[-1 - j][:2] - feet_goal[sides[-1 - j]]) < 1e-6 for j in (0, 1)
+        ):
+            reached = True
+            break
+        # Heading: toward the goal position, then the goal heading when close.
+        to_goal = scene.goal.position[:2] - stance[:2]
+        dist = float(np.linalg.norm(to_goal))
+        desired_th = math.atan2(to_goal[1], to_goal[0]) if dist > 0.5 else theta_goal
+        desired_th = wrap_near(desired_th, th)
+        new_th = th + max(-robot.theta_max, min(robot.theta_max, desired_th - th))
+        target_goal = feet_goal[nxt_side]
+        q_goal = rot2(th).T @ (target_goal - stance[:2])
+        target = None
+        l_des = None
+        if dist < 0.6 and robot.reach.contains(q_goal, side):
+            # Goal feet within reach: step onto them.
+            target = target_goal
+            new_th = th + max(-robot.theta_max, min(robot.theta_max, theta_goal - th))
+        else:
+            speed = min(NOMINAL_SPEED, dist / (2 * (t_ss + robot.t_ds)))
+            # At the end of a left stance the CoM moves right (v_y < 0), so L_x = -m z_H v_y > 0;
+            # (L_x, L_y) rotates with the heading like a vector.
+            l_des = rot2(new_th) @ np.array([nxt_side.sign * lx_mag, mzh * speed])
+        step = _one_step(scene, robot, x, stance, th, side, l_des, target)
+        if step is None:
+            message = f"no reachable region from footstep {len(feet) - 1}"
+            break
+        p_next, region, phase_x, phase_u = step
+        states.append(phase_x)
+        torques.append(phase_u)
+        x = a_r @ phase_x[-1] + b_r @ (p_next - stance)
+        feet.append(p_next)
+        headings.append(new_th)
+        sides.append(nxt_side)
+        regions.append(region)
+    n = len(feet) - 1
+    states_arr = np.array(states) if n else np.zeros((0, k, 4))
+    torques_arr = np.array(torques) if n else np.zeros((0, k - 1, 2))
+    final = x if n else np.full(4, np.nan)
+    if reached:
+        status, message = SolveStatus.FEASIBLE, f"reached the goal in {n} footsteps"
+    else:
+        status = SolveStatus.INFEASIBLE
+        message = message or f"did not reach the goal within {max_steps} footsteps"
+    return FootstepPlan(
+        planner="reactive",
+        status=status,
+        robot=robot,
+        footsteps=np.array(feet),
+        headings=np.array(headings),
+        sides=tuple(sides),
+        regions=tuple(regions),
+        states=states_arr,
+        torques=torques_arr,
+        final_state=final,
+        solve_time=time.perf_counter() - t0,
+        solver="scip",
+        message=message,
+    )
