@@ -10,6 +10,7 @@ the centre of pressure with scipy's ``solve_ivp`` (not the ZOH / reset matrices)
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -108,7 +109,13 @@ def _simulate_single_support(
     return _integrate(robot, x0, lambda t: cop, duration, mzh)
 
 
-def _integrate(robot, x0, cop_fn, duration, mzh):  # type: ignore[no-untyped-def]
+def _integrate(
+    robot: BipedParams,
+    x0: FloatArray,
+    cop_fn: Callable[[float], FloatArray],
+    duration: float,
+    mzh: float,
+) -> FloatArray:
     omega2 = robot.g / robot.com_height
     pos = x0[:2]
     vel = np.array([x0[3], -x0[2]]) / mzh

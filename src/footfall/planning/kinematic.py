@@ -10,6 +10,8 @@ reports the torque violation).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from footfall.models.biped import BipedParams
@@ -40,7 +42,7 @@ def plan_kinematic(
     )
     kin = build_footstep_problem(scene, robot, n_steps, options, dynamics=False)
     res = solve(kin.problem, options.solver, solver_opts)
-    meta = dict(
+    meta: dict[str, Any] = dict(
         status=res.status,
         objective=res.objective,
         bound=res.bound,
@@ -55,7 +57,7 @@ def plan_kinematic(
             if res.status is SolveStatus.INFEASIBLE
             else f"kinematic planner found no plan ({res.stats.get('raw_status')})"
         )
-        return FootstepPlan.empty("kinematic", robot=kin.robot, message=msg, **meta)  # type: ignore[arg-type]
+        return FootstepPlan.empty("kinematic", robot=kin.robot, message=msg, **meta)
 
     # Dynamics for the chosen footsteps: the full model with every discrete choice and footstep fixed.
     full = build_footstep_problem(scene, robot, n_steps, options, dynamics=True)
@@ -82,6 +84,6 @@ def plan_kinematic(
     if dyn.x is None:
         return FootstepPlan.empty(
             "kinematic", robot=kin.robot, message=note + ": dynamics failed", **meta
-        )  # type: ignore[arg-type]
+        )
     plan = extract_plan(full, dyn.x, message=note, **meta)
     return replace(plan, planner="kinematic", robot=kin.robot)

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -175,7 +176,7 @@ def build_footstep_problem(
     for i in range(n if dynamics else 0):
         for k in range(k_nodes - 1):
             for j in range(4):
-                row = {int(x[i, k + 1, j]): 1.0}
+                row: dict[int, float] = {int(x[i, k + 1, j]): 1.0}
                 for jj in range(4):
                     row[int(x[i, k, jj])] = row.get(int(x[i, k, jj]), 0.0) - ad[j, jj]
                 for jj in range(2):
@@ -185,7 +186,7 @@ def build_footstep_problem(
     for i in range(n if dynamics else 0):
         nxt = x[i + 1, 0] if i + 1 < n else x_final
         for j in range(4):
-            row: dict[int, float] = {int(nxt[j]): 1.0}
+            row = {int(nxt[j]): 1.0}
             for jj in range(4):
                 row[int(x[i, k_nodes - 1, jj])] = -a_r[j, jj]
             for jj in range(3):
@@ -338,7 +339,7 @@ def _combine(d: tuple[dict[int, float], dict[int, float]], a: FloatArray) -> dic
     return row
 
 
-def extract_plan(fp: FootstepProblem, x: FloatArray, **meta: object) -> FootstepPlan:
+def extract_plan(fp: FootstepProblem, x: FloatArray, **meta: Any) -> FootstepPlan:
     """Read a :class:`FootstepPlan` out of a solution vector of ``fp.problem``."""
     names = fp.scene.terrain.names
     regions = [fp.scene.start_regions()[fp.sides[0]]]
@@ -355,7 +356,7 @@ def extract_plan(fp: FootstepProblem, x: FloatArray, **meta: object) -> Footstep
         torques=x[fp.u],
         final_state=x[fp.x_final],
         sin_cos=np.stack([x[fp.s], x[fp.c]], axis=1),
-        **meta,  # type: ignore[arg-type]
+        **meta,
     )
 
 
@@ -385,7 +386,7 @@ def plan_footsteps(
             verbose=options.verbose,
         ),
     )
-    meta = dict(
+    meta: dict[str, Any] = dict(
         status=result.status,
         objective=result.objective,
         bound=result.bound,
@@ -401,7 +402,7 @@ def plan_footsteps(
             message = f"no feasible plan found within the time limit of {options.time_limit:g} s"
         else:
             message = f"solver {result.solver} failed: {result.stats.get('raw_status')}"
-        return FootstepPlan.empty("miqcqp", robot=fp.robot, message=message, **meta)  # type: ignore[arg-type]
+        return FootstepPlan.empty("miqcqp", robot=fp.robot, message=message, **meta)
     message = {
         SolveStatus.OPTIMAL: f"optimal within gap {options.gap:g}",
         SolveStatus.TIME_LIMIT: f"time limit reached; best plan has gap {result.gap:.3g}",

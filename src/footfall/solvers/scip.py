@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import Any
 
 import numpy as np
 
@@ -40,7 +41,7 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
             vtype = "B" if lb == 0.0 and ub == 1.0 else "I"
         x.append(m.addVar(name=name, vtype=vtype, lb=lb, ub=ub))
 
-    def rows(mat, rhs, labels, sense):  # type: ignore[no-untyped-def]
+    def rows(mat: Any, rhs: Any, labels: list[str], sense: str) -> None:
         for r in range(mat.shape[0]):
             lo, hi = mat.indptr[r], mat.indptr[r + 1]
             expr = scip.quicksum(
