@@ -134,18 +134,40 @@ def build_footstep_problem(
     lo_box, hi_box = terrain.bounds()
     mzh = robot.mass * robot.com_height
 
-    b = ProblemBuilder()
-    # Footsteps (3-D) inside the terrain bounding box; footstep 0 fixed to the stance foot.
-    p = b.add_vars("p", (n + 1, 3), lb=lo_box, ub=hi_box)
+    feet = goal_feet(robot, scene.goal.position[:2], theta_goal)
+    reach = float(np.max(np.linalg.norm(robot.reach.vertices, axis=1)))
     p0 = start.foot(start.stance)
+
+    b = ProblemBuilder()
+    # Footsteps (3-D). Tight bounds, all implied by the constraints (so the optimum is unchanged):
+    # inside the terrain box, within i steps of reach of footstep 0 and within N - i (N - 1 - i) of
+    # the final footstep N (N - 1), whose positions the goal fixes; heights likewise.
+    p = b.add_vars("p", (n + 1, 3), lb=lo_box, ub=hi_box)
+    for i in range(n + 1):
+        anchors = [(p0[:2], i), (feet[sides[n]], n - i)]
+        if i <= n - 1:
+            anchors.append((feet[sides[n - 1]], n - 1 - i))
+        for j in range(2):
+            lo = max(float(centre[j]) - k * reach for centre, k in anchors)
+            hi = min(float(centre[j]) + k * reach for centre, k in anchors)
+            b.set_bounds(int(p[i, j]), lo, hi)
+        b.set_bounds(
+            int(p[i, 2]), p0[2] - i * robot.step_height_max, p0[2] + i * robot.step_height_max
+        )
     for j in range(3):
         b.set_bounds(int(p[0, j]), float(p0[j]), float(p0[j]))
 
-    # Headings: |theta_i - theta_0| <= i theta_max follows from (5.12e); the window is one turn.
+    # Headings: |theta_i - theta_0| <= i theta_max and |theta_i - theta_goal| <= (N - i) theta_max
+    # follow from (5.12e) and the goal heading; the window is one turn around theta_0.
     theta = b.add_vars("theta", (n + 1,))
     for i in range(n + 1):
         span = min(i * robot.theta_max, math.pi)
-        b.set_bounds(int(theta[i]), theta0 - span, theta0 + span)
+        to_goal = (n - i) * robot.theta_max
+        b.set_bounds(
+            int(theta[i]),
+            max(theta0 - span, theta_goal - to_goal),
+            min(theta0 + span, theta_goal + to_goal),
+        )
     s = b.add_vars("s", (n + 1,), lb=-1.0, ub=1.0)
     c = b.add_vars("c", (n + 1,), lb=-1.0, ub=1.0)
     for arr, val in ((s, math.sin(theta0)), (c, math.cos(theta0))):
@@ -258,15 +280,27 @@ def build_footstep_problem(
                     row = _combine(d, rot2(float(phi)) @ g)
                     b.add_le_big_m(row, h_eff, z, f"5.12f reach {i} segment {ell} row {j}")
 
-    # (5.12i-k) region assignment for footsteps 1..N
+    # (5.12i-k) region assignment for footsteps 1..N. A region whose bounding box misses the
+    # footstep's bounds can never hold it, so it gets no binary (H fixed to 0).
     regions = np.full((n + 1, len(terrain)), -1, dtype=np.int64)
     for i in range(1, n + 1):
+        box = [b.bounds(int(p[i, j])) for j in range(3)]
         for r_idx, region in enumerate(terrain):
-            regions[i, r_idx] = int(b.add_binaries(f"H[{i},{region.name}]", ())[()])
-        b.add_eq({int(v): 1.0 for v in regions[i]}, 1.0, f"5.12j one region {i}")
+            corners = region.vertices3d
+            if all(
+                corners[:, j].min() <= box[j][1] + 1e-9 and corners[:, j].max() >= box[j][0] - 1e-9
+                for j in range(3)
+            ):
+                regions[i, r_idx] = int(b.add_binaries(f"H[{i},{region.name}]", ())[()])
+        live = [int(v) for v in regions[i] if v >= 0]
+        if not live:  # no region near enough: keep the model well formed, it is infeasible
+            live = [int(b.add_vars(f"H[{i},none]", (), 0.0, 0.0)[()])]
+        b.add_eq(dict.fromkeys(live, 1.0), 1.0, f"5.12j one region {i}")
         pv = [int(p[i, j]) for j in range(3)]
         for r_idx, region in enumerate(terrain):
             z = int(regions[i, r_idx])
+            if z < 0:
+                continue
             a_pl, b_pl = region.plane_rows()  # eq. 5.17
             for row_a, row_b in zip(a_pl, b_pl, strict=True):
                 b.add_le_big_m(
@@ -281,7 +315,6 @@ def build_footstep_problem(
                 )  # fmt: skip
 
     # Goal: the last two footsteps stand at the goal pose.
-    feet = goal_feet(robot, scene.goal.position[:2], theta_goal)
     for i in (n - 1, n):
         for j in range(2):
             b.add_eq({int(p[i, j]): 1.0}, float(feet[sides[i]][j]), f"goal footstep {i}")
@@ -344,7 +377,8 @@ def extract_plan(fp: FootstepProblem, x: FloatArray, **meta: Any) -> FootstepPla
     names = fp.scene.terrain.names
     regions = [fp.scene.start_regions()[fp.sides[0]]]
     for i in range(1, fp.n_steps + 1):
-        regions.append(names[int(np.argmax(x[fp.regions[i]]))])
+        live = np.flatnonzero(fp.regions[i] >= 0)
+        regions.append(names[int(live[np.argmax(x[fp.regions[i, live]])])])
     return FootstepPlan(
         planner="miqcqp",
         robot=fp.robot,
@@ -376,6 +410,15 @@ def plan_footsteps(
 
     options = options or PlannerOptions()
     fp = build_footstep_problem(scene, robot, n_steps, options)
+    if fp.problem.bounds_conflict():
+        # The bounds implied by reach, heading rate and goal already contradict each other.
+        return FootstepPlan.empty(
+            "miqcqp",
+            SolveStatus.INFEASIBLE,
+            fp.robot,
+            diagnose_infeasible(scene, fp.robot, n_steps),
+            solver=options.solver,
+        )
     result = solve(
         fp.problem,
         options.solver,

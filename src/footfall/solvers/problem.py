@@ -65,6 +65,10 @@ class MIQCQP:
         """Number of integer variables."""
         return int(np.count_nonzero(self.integer))
 
+    def bounds_conflict(self, tol: float = 1e-9) -> bool:
+        """True when some variable has ``lb > ub`` (the problem is trivially infeasible)."""
+        return bool(np.any(self.lb > self.ub + tol))
+
     def objective(self, x: FloatArray) -> float:
         """Objective value at ``x``."""
         r = self.cost_matrix @ x - self.cost_target
