@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import Any
 
 import typer
 from rich.console import Console
@@ -179,3 +180,70 @@ def scenes_command(
     fig.savefig(out / "scene.png", dpi=120)
     plt.close(fig)
     console.print(f"wrote {out / 'scene.png'} and {out / 'scene.yaml'}")
+
+
+# --- footstep planning (document 000, section 5.3) ---
+def resolve_scene(scene_file: Path | None, scene: str | None) -> Any:
+    """Load a scene from a YAML file or by built-in name (exactly one of the two)."""
+    from footfall.terrain import builtin_scene, load_scene
+
+    if (scene_file is None) == (scene is None):
+        raise InputError(
+            "scene", scene_file or scene, "either a SCENE.yaml argument or --scene NAME"
+        )
+    if scene_file is not None:
+        return load_scene(scene_file)
+    assert scene is not None
+    if scene.endswith((".yaml", ".yml")):
+        return load_scene(Path(scene))
+    return builtin_scene(scene)
+
+
+@app.command()
+def plan(
+    scene_file: Path | None = typer.Argument(None, help="Scene YAML file (or use --scene)."),
+    scene: str | None = typer.Option(None, help="Built-in scene name (see `footfall scenes`)."),
+    steps: int | None = typer.Option(
+        None, help="Footsteps N to plan; omitted: the smallest N with a plan (like --min-steps)."
+    ),
+    min_steps: bool = typer.Option(False, help="Search the smallest feasible N."),
+    planner: str = typer.Option("miqcqp", help="miqcqp, kinematic or reactive."),
+    time_limit: float = typer.Option(60.0, help="Solver time limit per solve [s]."),
+    gap: float = typer.Option(1e-4, help="Relative optimality gap at which to stop."),
+    solver: str = typer.Option("scip", help="Optimisation backend: scip or gurobi."),
+    out: Path = typer.Option(Path("out/plan"), help="Output folder for plan.json and plan.png."),
+) -> None:
+    """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists."""
+    from footfall.planning import PlannerOptions, check_plan, make_plan, plan_min_steps
+    from footfall.planning.plan import check_planner_name
+    from footfall.planning.plan_io import plan_to_dict
+    from footfall.viz.plan_plot import plot_plan
+
+    check_planner_name(planner)
+    sc = resolve_scene(scene_file, scene)
+    if steps is not None and (steps < 1):
+        raise InputError("steps", steps, "an integer >= 1")
+    options = PlannerOptions(time_limit=time_limit, gap=gap, solver=solver)
+    with console.status(f"planning {sc.name} with {planner} ...") as status:
+
+        def progress(n: int, result: Any) -> None:
+            status.update(f"planning {sc.name} with {planner}: N = {n} -> {result.status.value}")
+
+        if planner != "reactive" and (min_steps or steps is None):
+            result = plan_min_steps(sc, planner, options, progress=progress)
+        else:
+            result = make_plan(sc, planner, steps, options)
+    payload = plan_to_dict(result, sc.name)
+    if result.has_solution:
+        report = check_plan(result, sc)
+        payload["check"] = {"ok": report.ok, "violations": report.summary().splitlines()}
+    write_json(out / "plan.json", payload)
+    if result.has_solution:
+        plot_plan(result, sc, out / "plan.png")
+    console.print(
+        f"{sc.name}: {planner} -> {result.status.value}, {result.n_steps} steps, "
+        f"objective {result.objective:.4g}, {result.solve_time:.2f} s. {result.message}"
+    )
+    console.print(f"wrote {out / 'plan.json'}" + (" and plan.png" if result.has_solution else ""))
+    if not result.has_solution:
+        raise typer.Exit(1)

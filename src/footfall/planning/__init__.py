@@ -1,6 +1,42 @@
-"""Footstep and walking-pattern planners."""
+"""Footstep and walking-pattern planners.
 
+- :func:`lip_walk` — Kajita's LIP walking pattern (document 004).
+- :func:`plan_footsteps` — the full-horizon MIQCQP of document 000 (section 5.3);
+  :func:`build_footstep_problem` returns its inspectable model.
+- :func:`plan_kinematic`, :func:`plan_reactive` — the two baselines; :func:`make_plan` dispatches
+  by name and :func:`plan_min_steps` searches the smallest N.
+- :func:`check_plan` — an independent constraint checker.
+"""
+
+from footfall.planning.check import CheckReport, Violation, check_plan
+from footfall.planning.kinematic import plan_kinematic
 from footfall.planning.lip_examples import example as lip_example
 from footfall.planning.lip_walk import LipWalk, LipWalkParams, lip_walk, optimal_foothold
+from footfall.planning.miqcqp import FootstepProblem, build_footstep_problem, plan_footsteps
+from footfall.planning.plan import PLANNERS, FootstepPlan, PlannerOptions, PlannerWeights
+from footfall.planning.plan_io import plan_to_dict
+from footfall.planning.reactive import plan_reactive
+from footfall.planning.run import make_plan, plan_min_steps
 
-__all__ = ["LipWalk", "LipWalkParams", "lip_example", "lip_walk", "optimal_foothold"]
+__all__ = [
+    "PLANNERS",
+    "CheckReport",
+    "FootstepPlan",
+    "FootstepProblem",
+    "LipWalk",
+    "LipWalkParams",
+    "PlannerOptions",
+    "PlannerWeights",
+    "Violation",
+    "build_footstep_problem",
+    "check_plan",
+    "lip_example",
+    "lip_walk",
+    "make_plan",
+    "optimal_foothold",
+    "plan_footsteps",
+    "plan_kinematic",
+    "plan_min_steps",
+    "plan_reactive",
+    "plan_to_dict",
+]
