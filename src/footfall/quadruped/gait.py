@@ -23,8 +23,8 @@ from footfall.errors import InputError
 from footfall.quadruped.kinematics import (
     body_rotation,
     foot_in_leg_frame,
-    leg_fk,
     leg_ik,
+    leg_points,
     whole_body_com,
 )
 from footfall.quadruped.posture import BodyPosture, SlopePosture
@@ -36,8 +36,8 @@ from footfall.quadruped.zmp_planning import ZmpStrategy, swing_groups, swing_ord
 FloatArray = NDArray[np.float64]
 
 #: fixed-point iterations placing the body so that the whole-body CoM is on the ZMP target;
-#: the legs move < 1 cm of CoM per iteration, three iterations converge to < 0.1 mm
-_COM_ITERATIONS = 4
+#: the legs hold 20 % of the mass, so each iteration shrinks the CoM error about fivefold
+_COM_ITERATIONS = 3
 #: bisection steps for the largest feasible slope / step reported in error messages
 _BISECT_STEPS = 30
 
@@ -277,17 +277,27 @@ def _body_for_com(
     post: SlopePosture,
     target: FloatArray,
     feet: FloatArray,
-    guess: FloatArray,
+    step: float,
 ) -> FloatArray:
-    """Body position whose whole-body CoM projects on ``target`` with the feet at ``feet``."""
-    body = post.body_position(float(guess[0]), float(guess[1]))
+    """Body position whose whole-body CoM projects on ``target`` with the feet at ``feet``.
+
+    Raises:
+        InputError: named ``step`` when that body position is outside the leg workspace.
+    """
+    # the trunk carries 80 % of the mass, so the target itself is a close first guess
+    body = post.body_position(float(target[0]), float(target[1]))
+    rot = body_rotation(post.body_pitch)
+    hips = robot.hip_offsets()
     for _ in range(_COM_ITERATIONS):
-        q = np.concatenate(
-            [
-                leg_ik(robot, foot_in_leg_frame(robot, leg, body, post.body_pitch, feet[i]), leg)
-                for i, leg in enumerate(LEGS)
-            ]
-        )
+        try:
+            q = leg_ik(robot, (feet - body) @ rot - hips)
+        except InputError as exc:
+            raise InputError(
+                "step",
+                f"{step:.3f} m",
+                f"a step for which the body can reach the ZMP target "
+                f"({target[0]:.3f}, {target[1]:.3f}) m: leg out of reach ({exc.expected})",
+            ) from None
         com = whole_body_com(robot, body, post.body_pitch, q)
         xy = body[:2] + (target - com[:2])
         body = post.body_position(float(xy[0]), float(xy[1]))
@@ -328,7 +338,7 @@ def plan_gait(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
                 triangles.append(support_polygon(tri_feet[stance]))
                 tri_feet[leg.idx] = tri_feet[leg.idx] + u * params.step
             target, margin = zmp_target(triangles)
-            new_body = _body_for_com(robot, post, target, feet, body)
+            new_body = _body_for_com(robot, post, target, feet, params.step)
             phases.append(
                 GaitPhase(
                     PhaseKind.SHIFT,
@@ -364,7 +374,7 @@ def plan_gait(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
                 t += params.swing_period
                 feet[leg.idx] = land
     centre = feet[:, :2].mean(axis=0)
-    final = _body_for_com(robot, post, centre, feet, body)
+    final = _body_for_com(robot, post, centre, feet, params.step)
     phases.append(
         GaitPhase(
             PhaseKind.SHIFT,
@@ -397,22 +407,37 @@ def plan_gait(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
 
 def _check_plan_reach(plan: GaitPlan) -> None:
     """Every phase's start and end configuration must be reachable (IK), else name ``step``."""
-    robot, pitch = plan.robot, plan.posture.body_pitch
+    robot, rot = plan.robot, body_rotation(plan.posture.body_pitch)
+    bodies, feet, when = [], [], []
     for ph in plan.phases:
         feet_end = ph.feet_start.copy()
         if ph.leg is not None and ph.foot_end is not None:
             feet_end[ph.leg.idx] = ph.foot_end
-        for body, feet in ((ph.body_start, ph.feet_start), (ph.body_end, feet_end)):
-            try:
-                for i, leg in enumerate(LEGS):
-                    leg_ik(robot, foot_in_leg_frame(robot, leg, body, pitch, feet[i]), leg)
-            except InputError as exc:
-                raise InputError(
-                    "step",
-                    f"{plan.params.step:.3f} m",
-                    f"a step whose body shifts stay in the leg workspace ({ph.kind.value} at "
-                    f"t={ph.t0:.2f} s: {exc.field} expected {exc.expected})",
-                ) from None
+        bodies += [ph.body_start, ph.body_end]
+        feet += [ph.feet_start, feet_end]
+        when += [ph, ph]
+    body_arr, feet_arr = np.array(bodies), np.array(feet)
+    for i, leg in enumerate(LEGS):
+        p_leg = (feet_arr[:, i] - body_arr) @ rot - robot.hip_offset(leg)
+        try:
+            leg_ik(robot, p_leg, leg)
+        except InputError as exc:
+            k = next(k for k in range(len(when)) if _unreachable(robot, p_leg[k], leg))
+            ph = when[k]
+            raise InputError(
+                "step",
+                f"{plan.params.step:.3f} m",
+                f"a step whose body shifts stay in the leg workspace ({ph.kind.value} at "
+                f"t={ph.t0:.2f} s: {exc.field} expected {exc.expected})",
+            ) from None
+
+
+def _unreachable(robot: QuadrupedRobot, p_leg: FloatArray, leg: Leg) -> bool:
+    try:
+        leg_ik(robot, p_leg, leg)
+    except InputError:
+        return True
+    return False
 
 
 def sample_plan(plan: GaitPlan, dt: float = 0.01, with_zmp: bool = True) -> GaitTrajectory:
@@ -475,17 +500,11 @@ def _point_masses(
     masses = np.empty(13)
     pos[:, 0] = body
     masses[0] = robot.body_mass
-    l1 = robot.thigh_length
     for i, leg in enumerate(LEGS):
-        q = joints[:, 3 * i : 3 * i + 3]
-        hip = robot.hip_offset(leg)
-        q1, q2 = q[:, 0], q[:, 1]
-        knee = np.stack(
-            [-l1 * np.sin(q2), l1 * np.cos(q2) * np.sin(q1), -l1 * np.cos(q2) * np.cos(q1)], axis=-1
-        )
-        foot = leg_fk(robot, q)
-        local = np.stack([np.zeros_like(knee), 0.5 * knee, 0.5 * (knee + foot)], axis=1) + hip
-        pos[:, 1 + 3 * i : 4 + 3 * i] = body[:, None, :] + local @ rot.T
+        pts = leg_points(robot, joints[:, 3 * i : 3 * i + 3])
+        knee, foot = pts[:, 0], pts[:, 1]
+        local = np.stack([np.zeros_like(knee), 0.5 * knee, 0.5 * (knee + foot)], axis=1)
+        pos[:, 1 + 3 * i : 4 + 3 * i] = body[:, None, :] + (local + robot.hip_offset(leg)) @ rot.T
         masses[1 + 3 * i : 4 + 3 * i] = (robot.hip_mass, robot.thigh_mass, robot.shank_mass)
     return pos, masses
 

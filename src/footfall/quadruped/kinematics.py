@@ -167,6 +167,15 @@ def whole_body_ik(
     return out
 
 
+def leg_points(robot: QuadrupedRobot, q: ArrayLike) -> FloatArray:
+    """Knee and foot positions in the leg frame, vectorised: shape (..., 2, 3) [m]."""
+    qa = np.asarray(q, dtype=float)
+    q1, q2 = qa[..., 0], qa[..., 1]
+    r1 = robot.thigh_length * np.cos(q2)
+    knee = np.stack([-robot.thigh_length * np.sin(q2), r1 * np.sin(q1), -r1 * np.cos(q1)], axis=-1)
+    return np.stack([knee, leg_fk(robot, qa)], axis=-2)
+
+
 def whole_body_com(
     robot: QuadrupedRobot, body_pos: ArrayLike, pitch_up: float, q: ArrayLike
 ) -> FloatArray:
@@ -181,15 +190,9 @@ def whole_body_com(
     Returns:
         CoM position p_c in ``{W}``, shape (3,) [m].
     """
-    qa = np.asarray(q, dtype=float)
-    rot = body_rotation(pitch_up)
-    acc = np.zeros(3)
-    for i, leg in enumerate(LEGS):
-        hip, knee, foot = leg_link_points(robot, qa[3 * i : 3 * i + 3])
-        local = (
-            robot.hip_mass * hip
-            + robot.thigh_mass * 0.5 * (hip + knee)
-            + robot.shank_mass * 0.5 * (knee + foot)
-        )
-        acc += robot.leg_mass * robot.hip_offset(leg) + local
-    return np.asarray(body_pos, dtype=float) + rot @ acc / robot.total_mass
+    pts = leg_points(robot, np.asarray(q, dtype=float).reshape(4, 3))  # (4, 2, 3)
+    knee, foot = pts[:, 0], pts[:, 1]
+    # hip at the leg-frame origin; thigh mass at the thigh midpoint, shank at the shank midpoint
+    local = 0.5 * robot.thigh_mass * knee + 0.5 * robot.shank_mass * (knee + foot)
+    acc = robot.leg_mass * robot.hip_offsets().sum(axis=0) + local.sum(axis=0)
+    return np.asarray(body_pos, dtype=float) + body_rotation(pitch_up) @ acc / robot.total_mass

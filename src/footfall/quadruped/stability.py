@@ -35,7 +35,12 @@ def support_polygon(points: ArrayLike) -> FloatArray:
     pts = np.asarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[0] == 0 or pts.shape[1] < 2:
         raise InputError("points", pts.shape, "an array of shape (N, 2) or (N, 3), N >= 1")
-    p = np.unique(np.round(pts[:, :2], 12), axis=0)  # sorted by x then y (monotone chain)
+    xy = pts[:, :2]
+    p = xy[np.lexsort((xy[:, 1], xy[:, 0]))]  # sorted by x then y (monotone chain)
+    if p.shape[0] > 1:  # drop duplicates, which would stall the chain
+        keep = np.ones(p.shape[0], dtype=bool)
+        keep[1:] = np.any(np.abs(np.diff(p, axis=0)) > _GEOM_EPS, axis=1)
+        p = p[keep]
     if p.shape[0] <= 2:
         return p
     lower: list[FloatArray] = []
