@@ -73,7 +73,7 @@ class GaitParams:
     step: float = 0.4
     swing_height: float = 0.1
     swing_period: float = 0.5
-    shift_period: float = 1.0
+    shift_period: float = 1.5
     cycles: int = 6
     strategy: ZmpStrategy = ZmpStrategy.OSP
     posture: BodyPosture = BodyPosture.COMPROMISE

@@ -1,4 +1,4 @@
-"""Names of the MuJoCo elements of the document-001 quadruped (one place, no string literals elsewhere)."""
+"""Names of the MuJoCo elements of the document-001 quadruped, defined once."""
 
 from __future__ import annotations
 
