@@ -226,7 +226,8 @@ def simulate(
     sim.set_pose(ref.body_pos[0], ref.body_pitch, ref.joints[0])
     substeps = max(1, round(control_dt / m.opt.timestep))
 
-    renderer, note = (None, "")
+    renderer: Any = None
+    note = ""
     writer = None
     if video_path is not None:
         renderer, note = _make_renderer(sim, *video_size)
