@@ -89,7 +89,9 @@ class LIP(LinearModel):
             return pos[0], vel[0]
         return pos, vel
 
-    def orbital_energy(self, pos: ArrayLike, vel: ArrayLike, foot: ArrayLike) -> NDArray[np.float64]:
+    def orbital_energy(
+        self, pos: ArrayLike, vel: ArrayLike, foot: ArrayLike
+    ) -> NDArray[np.float64]:
         """Orbital energy per axis ``E = v^2 / 2 - g / (2 z_c) (x - p)^2`` [m^2/s^2].
 
         It is conserved along every LIP trajectory (Kajita eq. 4.21).

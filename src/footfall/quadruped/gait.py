@@ -12,7 +12,7 @@ velocity and acceleration at both ends); the ZMP excursion they cause is compute
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import Enum
 
 import numpy as np
@@ -212,64 +212,40 @@ def _legs_ok(robot: QuadrupedRobot, body: FloatArray, pitch: float, feet: FloatA
     return True
 
 
-def _nominal_ok(
-    robot: QuadrupedRobot, slope: float, pitch: float, params: GaitParams, h: float, step: float
-) -> bool:
-    """Stance reachable at the neutral point and both step ends (body at its nominal place)."""
-    post = SlopePosture(slope, min(pitch, slope), h, params.posture)
+def _neutral_ok(robot: QuadrupedRobot, post: SlopePosture) -> bool:
+    """Neutral stance (body at its nominal place, feet at the neutral footholds) reachable."""
     body = post.body_position()
-    neutral = post.neutral_feet(robot, body)
-    u = post.slope_direction
-    return all(
-        _legs_ok(robot, body, post.body_pitch, neutral + sgn * 0.5 * step * u)
-        for sgn in (0.0, -1.0, 1.0)
-    )
+    return _legs_ok(robot, body, post.body_pitch, post.neutral_feet(robot, body))
 
 
 def check_reachability(robot: QuadrupedRobot, params: GaitParams) -> SlopePosture:
-    """Check the posture and step fit the leg workspace before planning.
+    """Check that the posture's neutral stance fits the leg workspace, before planning.
+
+    Returns:
+        The slope posture.
 
     Raises:
-        InputError: naming ``slope`` (the nominal stance is out of the leg workspace: too steep
-            for this body angle) or ``step`` (the step ends are out of reach), with the largest
-            feasible value in the message.
+        InputError: naming ``slope`` when the neutral stance is out of the leg workspace (too
+            steep for this body angle), with the steepest feasible slope in the message.
     """
     h = params.height if params.height is not None else robot.stance_height
     post = SlopePosture(params.slope, params.body_pitch, h, params.posture)
-    if not _nominal_ok(robot, params.slope, params.body_pitch, params, h, 0.0):
-        lo, hi = 0.0, params.slope
-        if not _nominal_ok(robot, 0.0, 0.0, params, h, 0.0):
-            raise InputError("height", h, "a body height the legs reach on flat ground")
-        for _ in range(_BISECT_STEPS):
-            mid = 0.5 * (lo + hi)
-            lo, hi = (
-                (mid, hi)
-                if _nominal_ok(robot, mid, params.body_pitch, params, h, 0.0)
-                else (
-                    lo,
-                    mid,
-                )
-            )
-        raise InputError(
-            "slope",
-            f"{math.degrees(params.slope):.2f} deg",
-            f"at most {math.degrees(lo):.2f} deg with body angle "
-            f"{math.degrees(params.body_pitch):.2f} deg (leg workspace: usable length "
-            f"{robot.min_leg_length:.3f}-{robot.max_leg_length:.3f} m and joint limits)",
-        )
-    if not _nominal_ok(robot, params.slope, params.body_pitch, params, h, params.step):
-        lo, hi = 0.0, params.step
-        for _ in range(_BISECT_STEPS):
-            mid = 0.5 * (lo + hi)
-            ok = _nominal_ok(robot, params.slope, params.body_pitch, params, h, mid)
-            lo, hi = (mid, hi) if ok else (lo, mid)
-        raise InputError(
-            "step",
-            f"{params.step:.3f} m",
-            f"at most {lo:.3f} m on a {math.degrees(params.slope):.2f} deg slope with body angle "
-            f"{math.degrees(params.body_pitch):.2f} deg (reachable leg workspace)",
-        )
-    return post
+    if _neutral_ok(robot, post):
+        return post
+    if not _neutral_ok(robot, SlopePosture(0.0, 0.0, h, params.posture)):
+        raise InputError("height", h, "a body height the legs reach on flat ground")
+    lo, hi = 0.0, params.slope
+    for _ in range(_BISECT_STEPS):
+        mid = 0.5 * (lo + hi)
+        trial = SlopePosture(mid, min(params.body_pitch, mid), h, params.posture)
+        lo, hi = (mid, hi) if _neutral_ok(robot, trial) else (lo, mid)
+    raise InputError(
+        "slope",
+        f"{math.degrees(params.slope):.2f} deg",
+        f"at most {math.degrees(lo):.2f} deg with body angle "
+        f"{math.degrees(params.body_pitch):.2f} deg (leg workspace: usable length "
+        f"{robot.min_leg_length:.3f}-{robot.max_leg_length:.3f} m and joint limits)",
+    )
 
 
 def _body_for_com(
@@ -307,17 +283,45 @@ def _body_for_com(
 def plan_gait(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
     """Plan a walk gait up a slope.
 
-    Steps: check reachability; place the feet in the staggered stance of the swing order (each leg
-    a quarter step apart, centred on the posture's neutral footholds); for every group of swings
-    (pairs for the OSP method) compute the support triangles, the ZMP target (OSP or incentre,
-    sec. 1.3), the body position whose CoM projects on it, a body shift to it and the swings
-    (eq. 10-13), each foot landing one step S further up the slope. A final shift centres the CoM
-    in the four-foot support polygon.
+    Steps: check the posture fits the leg workspace; place the feet in the staggered stance of
+    the swing order (each leg a quarter step apart, centred on the posture's neutral footholds);
+    for every group of swings (pairs for the OSP method) compute the support triangles, the ZMP
+    target (OSP or incentre, sec. 1.3), the body position whose CoM projects on it, a body shift
+    to it and the swings (eq. 10-13), each foot landing one step S further up the slope. A final
+    shift centres the CoM in the four-foot support polygon.
 
     Raises:
-        InputError: the slope, step or body angle exceed a limit (see :func:`check_reachability`),
-            or a body shift of the plan leaves the leg workspace (named ``step``).
+        InputError: naming ``slope`` when the posture is out of the leg workspace, ``step`` when
+            the steps or the body shifts they need are out of reach (with the largest feasible
+            step in the message), ``body_pitch`` when the body angle is outside [0, slope].
     """
+    check_reachability(robot, params)
+    try:
+        return _plan(robot, params)
+    except InputError as exc:
+        if exc.field != "step":
+            raise
+        reason = exc.expected
+    # largest feasible step, by bisection on short plans (the gait repeats every cycle)
+    lo, hi = 0.0, params.step
+    for _ in range(_BISECT_STEPS // 2):
+        mid = 0.5 * (lo + hi)
+        try:
+            _plan(robot, replace(params, step=mid, cycles=min(params.cycles, 2)))
+            lo = mid
+        except InputError:
+            hi = mid
+    raise InputError(
+        "step",
+        f"{params.step:.3f} m",
+        f"at most {lo:.3f} m on a {math.degrees(params.slope):.2f} deg slope with body angle "
+        f"{math.degrees(params.body_pitch):.2f} deg and strategy {params.strategy.value} "
+        f"(leg workspace; {reason})",
+    )
+
+
+def _plan(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
+    """:func:`plan_gait` without the search for the largest feasible step."""
     post = check_reachability(robot, params)
     u = post.slope_direction
     order = swing_order(params.strategy)

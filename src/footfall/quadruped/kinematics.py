@@ -71,7 +71,8 @@ def leg_ik(robot: QuadrupedRobot, foot: ArrayLike, leg: Leg | None = None) -> Fl
     """Closed-form inverse kinematics of one leg (knee-forward branch), vectorised.
 
     Inverts :func:`leg_fk`: ``q1 = atan2(y, -z)``, the sagittal length ``r = sqrt(y^2 + z^2)``, the
-    knee from the law of cosines and the hip pitch from the triangle hip-knee-foot.
+    knee from the law of cosines and the hip pitch from the triangle hip-knee-foot. The foot is
+    taken to be below the hip in the leg's plane (``r > 0``), as it is in every stance and swing.
 
     Args:
         robot: robot parameters.
