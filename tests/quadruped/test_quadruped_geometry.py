@@ -55,7 +55,7 @@ def _line_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
 @given(
     q1=st.floats(-0.5, 0.5),
     q2=st.floats(-1.2, 1.2),
-    q3=st.floats(0.3, 2.5),
+    q3=st.floats(0.55, 2.65),
 )
 def test_ik_inverts_fk(q1: float, q2: float, q3: float) -> None:
     q = np.array([q1, q2, q3])

@@ -65,10 +65,12 @@ N_LEG_JOINTS = 3
 class JointLimits:
     """Lower and upper angle of the three leg joints [rad], in ``JOINT_NAMES`` order.
 
-    The knee angle is positive when the knee points forward (see :mod:`kinematics`).
+    The knee angle is positive when the knee points forward (see :mod:`kinematics`). The knee's
+    lower limit keeps the leg from straightening into the singular (locked-knee) pose; it sets
+    the usable leg length :attr:`QuadrupedRobot.max_leg_length`.
     """
 
-    lower: tuple[float, float, float] = (-0.6, -1.8, 0.15)
+    lower: tuple[float, float, float] = (-0.6, -1.8, 0.5)
     upper: tuple[float, float, float] = (0.6, 1.8, 2.7)
 
     def __post_init__(self) -> None:
@@ -103,8 +105,7 @@ class QuadrupedRobot:
         shank_mass: mass of one shank including the foot [kg].
         hip_mass: mass of one hip ab/ad housing, lumped at the hip [kg].
         stance_height: initial leg length / body-centre height above the ground ``h_B`` [m].
-        joint_limits: limits of the three leg joints.
-        reach_margin: fraction of ``thigh + shank`` kept in reserve so the knee never locks.
+        joint_limits: limits of the three leg joints (the knee's bound the usable leg length).
     """
 
     body_length: float = 1.0
@@ -121,7 +122,6 @@ class QuadrupedRobot:
     hip_mass: float = 1.0
     stance_height: float = 0.6
     joint_limits: JointLimits = field(default_factory=JointLimits)
-    reach_margin: float = 0.03
 
     def __post_init__(self) -> None:
         for name in (
@@ -140,8 +140,6 @@ class QuadrupedRobot:
             "stance_height",
         ):
             object.__setattr__(self, name, positive(f"robot.{name}", getattr(self, name)))
-        if not 0.0 <= self.reach_margin < 0.5:
-            raise InputError("robot.reach_margin", self.reach_margin, "a fraction in [0, 0.5)")
         if self.stance_height >= self.max_leg_length:
             raise InputError(
                 "robot.stance_height",
@@ -165,17 +163,19 @@ class QuadrupedRobot:
         """Whole-robot mass M [kg]."""
         return self.body_mass + 4.0 * self.leg_mass
 
+    def _leg_length(self, knee: float) -> float:
+        l1, l2 = self.thigh_length, self.shank_length
+        return math.sqrt(l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * math.cos(knee))
+
     @property
     def max_leg_length(self) -> float:
-        """Largest usable hip-to-foot distance [m] (reach margin applied)."""
-        return (self.thigh_length + self.shank_length) * (1.0 - self.reach_margin)
+        """Longest hip-to-foot distance, set by the knee's lower limit [m]."""
+        return self._leg_length(max(0.0, self.joint_limits.lower[2]))
 
     @property
     def min_leg_length(self) -> float:
-        """Shortest hip-to-foot distance allowed by the knee's upper limit [m]."""
-        q3 = self.joint_limits.upper[2]
-        l1, l2 = self.thigh_length, self.shank_length
-        return math.sqrt(l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * math.cos(q3))
+        """Shortest hip-to-foot distance, set by the knee's upper limit [m]."""
+        return self._leg_length(self.joint_limits.upper[2])
 
     def hip_offset(self, leg: Leg) -> FloatArray:
         """Position of the leg frame origin in ``{B}``, shape (3,) [m]."""
