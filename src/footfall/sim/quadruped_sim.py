@@ -91,7 +91,12 @@ class QuadrupedSim:
     def __init__(
         self, robot: QuadrupedRobot, slope: float, settings: SimSettings | None = None
     ) -> None:
-        import mujoco  # optional dependency: footfall[sim]
+        try:
+            import mujoco  # optional dependency: footfall[sim]
+        except ImportError as exc:
+            raise FootfallError(
+                f"MuJoCo is required: pip install 'footfall[sim]' ({exc})"
+            ) from None
 
         self.mujoco = mujoco
         self.robot = robot
@@ -435,11 +440,7 @@ def run_slope_walk(
 ) -> tuple[GaitPlan, SimResult]:
     """Plan (raising InputError before any simulation on bad input) and simulate a slope walk."""
     plan = plan_gait(robot, params)
-    try:
-        result = simulate(plan, settings, video_path=video_path)
-    except ImportError as exc:  # pragma: no cover - depends on the installed extras
-        raise FootfallError(f"MuJoCo is required: pip install 'footfall[sim]' ({exc})") from None
-    return plan, result
+    return plan, simulate(plan, settings, video_path=video_path)
 
 
 def benchmark_quadruped(

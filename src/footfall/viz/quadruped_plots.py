@@ -203,7 +203,7 @@ def plot_stability(plan: GaitPlan, res: SimResult | None, path: Path) -> Path:
     ax0.set_title(f"cycle 1, strategy {plan.params.strategy.value}: targets ★", fontsize=9)
     ax0.set_xlabel("x [m]")
     ax0.set_ylabel("y [m]")
-    ax0.legend(fontsize=6, loc="lower right")
+    ax0.legend(fontsize=6, loc="upper left", bbox_to_anchor=(0.0, -0.18), ncol=2)
     ax1.plot(ref.t, ref.margin, "b-", lw=1, label="planned")
     if res is not None:
         ax1.plot(res.t, res.margin, "r-", lw=0.8, label="measured (CoP vs contact polygon)")
