@@ -1,0 +1,1 @@
+"""Simulation: reduced-order closed loops and MuJoCo models."""

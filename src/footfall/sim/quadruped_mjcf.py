@@ -1,0 +1,243 @@
+"""MJCF of the document-001 quadruped, generated from :class:`QuadrupedRobot` (no downloads).
+
+The model mirrors the planner's assumptions: hip ab/ad and hip pitch axes meet at the hip, thigh
+and shank are straight links of the robot's lengths, masses sit at the hip and at the link
+midpoints (explicit ``<inertial>``), the foot is a sphere whose centre is the planner's foot point.
+Joints are driven by position actuators.
+
+Scenes: a plane sloped by ``slope`` rising along +x (``slope_scene``) or a flight of stairs
+(``stairs_scene``). The foot-centre plane of the planner passes through the world origin, so the
+ground plane is placed one foot radius below it along its normal.
+
+MuJoCo notes (measured for this issue): angles are in radians only with
+``<compiler angle="radian"/>``; robot geoms would collide with each other without the
+contype/conaffinity bits of :mod:`quadruped_names`; feet creep down a 15 degree slope with the
+default pyramidal cone, which ``cone="elliptic" impratio="10"`` stops.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from footfall._validate import non_negative, positive
+from footfall.errors import InputError
+from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
+from footfall.sim import quadruped_names as nm
+
+#: joint axes in the parent body frame, in ``JOINT_NAMES`` order (ab/ad about x, pitch/knee about y)
+_JOINT_AXES = ("1 0 0", "0 1 0", "0 1 0")
+
+
+@dataclass(frozen=True)
+class SimSettings:
+    """Physics and actuator settings of the generated model.
+
+    Attributes:
+        timestep: physics step [s].
+        kp: position gain of every joint actuator [N m / rad].
+        kv: velocity gain (damping) of every joint actuator [N m s / rad].
+        torque_limit: actuator torque limit [N m].
+        friction: sliding friction coefficient between feet and ground.
+        impratio: ratio of frictional to normal constraint impedance (elliptic cone).
+        armature: rotor inertia added to each joint [kg m^2] (stabilises stiff position control).
+    """
+
+    timestep: float = 0.002
+    kp: float = 6000.0
+    kv: float = 120.0
+    torque_limit: float = 1500.0
+    friction: float = 1.0
+    impratio: float = 10.0
+    armature: float = 0.05
+
+    def __post_init__(self) -> None:
+        for name in ("timestep", "kp", "kv", "torque_limit", "friction", "impratio"):
+            object.__setattr__(self, name, positive(f"sim.{name}", getattr(self, name)))
+        object.__setattr__(self, "armature", non_negative("sim.armature", self.armature))
+
+
+def _f(*values: float) -> str:
+    return " ".join(f"{v:.6g}" for v in values)
+
+
+def _box_inertia(mass: float, sx: float, sy: float, sz: float) -> tuple[float, float, float]:
+    return (
+        mass * (sy * sy + sz * sz) / 12.0,
+        mass * (sx * sx + sz * sz) / 12.0,
+        mass * (sx * sx + sy * sy) / 12.0,
+    )
+
+
+def _rod_inertia(mass: float, length: float, radius: float) -> tuple[float, float, float]:
+    """Slender rod along z: inertia about its centre [kg m^2]."""
+    transverse = mass * (3.0 * radius * radius + length * length) / 12.0
+    return transverse, transverse, 0.5 * mass * radius * radius
+
+
+def _quat_about_y(angle: float) -> tuple[float, float, float, float]:
+    return math.cos(angle / 2.0), 0.0, math.sin(angle / 2.0), 0.0
+
+
+def slope_floor_xml(slope: float, foot_radius: float) -> str:
+    """Sloped ground plane rising along +x by ``slope`` [rad]."""
+    # the plane's normal n = (-sin b, 0, cos b); place it r below the foot-centre plane
+    n = np.array([-math.sin(slope), 0.0, math.cos(slope)])
+    pos = -foot_radius * n
+    return (
+        f'<geom name="{nm.FLOOR_GEOM}" type="plane" size="40 8 0.1" pos="{_f(*pos)}" '
+        f'quat="{_f(*_quat_about_y(-slope))}" material="ground" '
+        f'contype="{nm.GROUND_CONTYPE}" conaffinity="{nm.GROUND_CONAFFINITY}"/>'
+    )
+
+
+def stairs_xml(
+    rise: float, run: float, steps: int, width: float, start_x: float, foot_radius: float
+) -> str:
+    """A flat floor and ``steps`` boxes rising by ``rise`` every ``run`` metres from ``start_x``."""
+    rise = positive("stairs.rise", rise)
+    run = positive("stairs.run", run)
+    if steps < 1:
+        raise InputError("stairs.steps", steps, "an integer >= 1")
+    parts = [
+        f'<geom name="{nm.FLOOR_GEOM}" type="plane" size="40 8 0.1" pos="0 0 {-foot_radius:.6g}" '
+        f'material="ground" contype="{nm.GROUND_CONTYPE}" '
+        f'conaffinity="{nm.GROUND_CONAFFINITY}"/>'
+    ]
+    for k in range(steps):
+        top = (k + 1) * rise - foot_radius
+        x0 = start_x + k * run
+        # each box reaches from the floor to its tread and to the end of the flight
+        length = (steps - k) * run
+        parts.append(
+            f'<geom name="{nm.STAIR_GEOM_PREFIX}{k}" type="box" '
+            f'size="{_f(length / 2, width / 2, (top + foot_radius) / 2)}" '
+            f'pos="{_f(x0 + length / 2, 0.0, (top - foot_radius) / 2)}" material="stairs" '
+            f'contype="{nm.GROUND_CONTYPE}" conaffinity="{nm.GROUND_CONAFFINITY}"/>'
+        )
+    return "\n    ".join(parts)
+
+
+def _leg_xml(robot: QuadrupedRobot, settings: SimSettings, leg_index: int) -> str:
+    leg = LEGS[leg_index]
+    lo, hi = robot.joint_limits.lower, robot.joint_limits.upper
+    l1, l2, r = robot.thigh_length, robot.shank_length, robot.foot_radius
+    hip = robot.hip_offset(leg)
+    thigh_r, shank_r = 0.035, 0.028
+    ti = _rod_inertia(robot.thigh_mass, l1, thigh_r)
+    si = _rod_inertia(robot.shank_mass, l2, shank_r)
+    hi_i = 0.4 * robot.hip_mass * 0.06**2  # solid sphere of radius 6 cm
+    nocol = 'contype="0" conaffinity="0"'
+    j = [nm.joint(leg, name) for name in JOINT_NAMES]
+    return f"""
+      <body name="{nm.hip_body(leg)}" pos="{_f(*hip)}">
+        <joint name="{j[0]}" axis="{_JOINT_AXES[0]}" range="{_f(lo[0], hi[0])}"/>
+        <inertial pos="0 0 0" mass="{robot.hip_mass:.6g}" diaginertia="{_f(hi_i, hi_i, hi_i)}"/>
+        <geom type="sphere" size="0.06" material="joint" {nocol}/>
+        <body name="{nm.thigh_body(leg)}">
+          <joint name="{j[1]}" axis="{_JOINT_AXES[1]}" range="{_f(lo[1], hi[1])}"/>
+          <inertial pos="0 0 {-l1 / 2:.6g}" mass="{robot.thigh_mass:.6g}"
+                    diaginertia="{_f(*ti)}"/>
+          <geom type="capsule" fromto="0 0 0 0 0 {-l1:.6g}" size="{thigh_r}" material="leg"
+                {nocol}/>
+          <body name="{nm.shank_body(leg)}" pos="0 0 {-l1:.6g}">
+            <joint name="{j[2]}" axis="{_JOINT_AXES[2]}" range="{_f(lo[2], hi[2])}"/>
+            <inertial pos="0 0 {-l2 / 2:.6g}" mass="{robot.shank_mass:.6g}"
+                      diaginertia="{_f(*si)}"/>
+            <geom type="capsule" fromto="0 0 0 0 0 {-l2:.6g}" size="{shank_r}" material="leg"
+                  {nocol}/>
+            <geom name="{nm.foot_geom(leg)}" type="sphere" size="{r:.6g}" pos="0 0 {-l2:.6g}"
+                  material="foot" friction="{settings.friction:.6g} 0.02 0.002"
+                  contype="{nm.ROBOT_CONTYPE}" conaffinity="{nm.ROBOT_CONAFFINITY}"/>
+            <site name="{nm.foot_site(leg)}" pos="0 0 {-l2:.6g}" size="0.01"/>
+          </body>
+        </body>
+      </body>"""
+
+
+def quadruped_mjcf(
+    robot: QuadrupedRobot,
+    ground_xml: str,
+    settings: SimSettings | None = None,
+) -> str:
+    """MJCF text of the robot on the ground described by ``ground_xml``.
+
+    Args:
+        robot: robot parameters.
+        ground_xml: worldbody geoms of the terrain (see :func:`slope_floor_xml`,
+            :func:`stairs_xml`).
+        settings: physics and actuator settings.
+
+    Returns:
+        The MJCF document as a string.
+    """
+    s = settings if settings is not None else SimSettings()
+    bi = _box_inertia(robot.body_mass, robot.body_length, robot.body_width, robot.body_height)
+    legs = "".join(_leg_xml(robot, s, i) for i in range(len(LEGS)))
+    actuators = "\n    ".join(
+        f'<position name="{nm.actuator(leg, jn)}" joint={quoteattr(nm.joint(leg, jn))} '
+        f'kp="{s.kp:.6g}" kv="{s.kv:.6g}" forcerange="{_f(-s.torque_limit, s.torque_limit)}"/>'
+        for leg in LEGS
+        for jn in JOINT_NAMES
+    )
+    half = (robot.body_length / 2, robot.body_width / 2, robot.body_height / 2)
+    return f"""<mujoco model="{nm.MODEL_NAME}">
+  <compiler angle="radian" autolimits="true"/>
+  <option timestep="{s.timestep:.6g}" integrator="implicitfast" cone="elliptic"
+          impratio="{s.impratio:.6g}"/>
+  <visual>
+    <global offwidth="1280" offheight="720"/>
+    <quality shadowsize="0"/>
+  </visual>
+  <default>
+    <joint damping="2" armature="{s.armature:.6g}"/>
+    <geom solref="0.005 1"/>
+  </default>
+  <asset>
+    <texture name="grid" type="2d" builtin="checker" rgb1="0.55 0.6 0.55" rgb2="0.45 0.5 0.45"
+             width="512" height="512"/>
+    <material name="ground" texture="grid" texrepeat="8 8" texuniform="true"/>
+    <material name="stairs" rgba="0.6 0.55 0.5 1"/>
+    <material name="body" rgba="0.25 0.35 0.6 1"/>
+    <material name="leg" rgba="0.7 0.7 0.72 1"/>
+    <material name="joint" rgba="0.3 0.3 0.3 1"/>
+    <material name="foot" rgba="0.15 0.15 0.15 1"/>
+  </asset>
+  <worldbody>
+    <light pos="0 -3 6" dir="0 0.4 -1" directional="true"/>
+    {ground_xml}
+    <body name="{nm.TRUNK_BODY}" pos="0 0 1">
+      <freejoint name="{nm.ROOT_JOINT}"/>
+      <camera name="{nm.TRACK_CAMERA}" mode="trackcom" pos="0.6 -3.2 0.9"
+              xyaxes="1 0 0 0 0.25 1"/>
+      <inertial pos="0 0 0" mass="{robot.body_mass:.6g}" diaginertia="{_f(*bi)}"/>
+      <geom name="{nm.TRUNK_GEOM}" type="box" size="{_f(*half)}" material="body"
+            contype="{nm.ROBOT_CONTYPE}" conaffinity="{nm.ROBOT_CONAFFINITY}"/>{legs}
+    </body>
+  </worldbody>
+  <actuator>
+    {actuators}
+  </actuator>
+</mujoco>
+"""
+
+
+def slope_scene(robot: QuadrupedRobot, slope: float, settings: SimSettings | None = None) -> str:
+    """MJCF of the robot on a plane sloped by ``slope`` [rad] rising along +x."""
+    return quadruped_mjcf(robot, slope_floor_xml(slope, robot.foot_radius), settings)
+
+
+def stairs_scene(
+    robot: QuadrupedRobot,
+    rise: float = 0.1,
+    run: float = 0.4,
+    steps: int = 6,
+    start_x: float = 0.8,
+    settings: SimSettings | None = None,
+) -> str:
+    """MJCF of the robot in front of a flight of ``steps`` stairs (rise/run in metres)."""
+    ground = stairs_xml(rise, run, steps, 3.0 * robot.body_width, start_x, robot.foot_radius)
+    return quadruped_mjcf(robot, ground, settings)
