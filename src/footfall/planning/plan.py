@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 from footfall._validate import non_negative, positive
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
+from footfall.solvers import KNOWN_BACKENDS
 from footfall.solvers.base import SolveStatus
 
 FloatArray = NDArray[np.float64]
@@ -84,6 +85,8 @@ class PlannerOptions:
             raise InputError("heading_segments", self.heading_segments, "an integer >= 4")
         object.__setattr__(self, "time_limit", positive("time_limit", self.time_limit))
         object.__setattr__(self, "gap", non_negative("gap", self.gap))
+        if self.solver not in KNOWN_BACKENDS:
+            raise InputError("solver", self.solver, f"one of {', '.join(KNOWN_BACKENDS)}")
         object.__setattr__(self, "momentum_bound", positive("momentum_bound", self.momentum_bound))
 
 

@@ -52,6 +52,7 @@ def solve(
 
 __all__ = [
     "DEFAULT_SOLVER",
+    "KNOWN_BACKENDS",
     "MIQCQP",
     "ProblemBuilder",
     "SolveStatus",

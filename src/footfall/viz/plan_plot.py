@@ -52,6 +52,14 @@ def plot_plan(plan: FootstepPlan, scene: Scene, path: Path, title: str | None = 
         )
     g = scene.goal
     ax.plot(g.position[0], g.position[1], "*", color="gold", mec="k", ms=14, label="goal")
+    # Frame the walk, not the whole terrain: footsteps and goal plus a margin.
+    pts = np.vstack([plan.footsteps[:, :2], g.position[None, :2]]) if plan.has_solution else None
+    if pts is not None:
+        margin = 0.5
+        lo, hi = pts.min(axis=0) - margin, pts.max(axis=0) + margin
+        ax.set_xlim(lo[0], hi[0])
+        ax.set_ylim(lo[1], hi[1])
+        side.set_xlim(lo[0], hi[0])
     for sd in (Side.LEFT, Side.RIGHT):
         ax.plot([], [], "s", mfc="none", color=SIDE_COLOUR[sd], label=f"{sd.value} foot")
     ax.legend(loc="upper left", fontsize=7)

@@ -1,0 +1,244 @@
+"""Full-horizon MIQCQP planner (document 000 eq. 5.11-5.18): model structure, solutions checked by
+the independent checker, infeasibility diagnosis, the checker's own ability to fail."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from footfall.errors import InputError
+from footfall.models.biped import Side
+from footfall.planning import (
+    PlannerOptions,
+    build_footstep_problem,
+    check_plan,
+    make_plan,
+    plan_footsteps,
+    plan_kinematic,
+    plan_reactive,
+)
+from footfall.solvers import SolveStatus
+from tests.planning.scenes import SHORT_FLAT, SHORT_TURN, TWO_STONES, scene
+
+#: the solver's relative gap in these tests
+GAP = 1e-6
+OPTS = PlannerOptions(time_limit=120.0, gap=GAP)
+
+
+@pytest.fixture(scope="module")
+def stones_plan():
+    sc = scene(TWO_STONES)
+    return sc, plan_footsteps(sc, n_steps=5, options=OPTS)
+
+
+def test_dynamics_and_reset_rows_are_the_alip_matrices() -> None:
+    sc = scene(SHORT_FLAT)
+    fp = build_footstep_problem(sc, n_steps=3)
+    alip = sc.robot.alip()
+    ad, bd = alip.discretize(sc.robot.node_dt)
+    a_r, b_r = alip.reset_map(sc.robot.t_ds)
+    a_eq = fp.problem.a_eq.toarray()
+    labels = fp.problem.eq_labels
+    row = labels.index("5.12a dynamics step 1 node 2 row 3")
+    np.testing.assert_allclose(a_eq[row, fp.x[1, 3]], [0, 0, 0, 1])
+    np.testing.assert_allclose(-a_eq[row, fp.x[1, 2]], ad[3])
+    np.testing.assert_allclose(-a_eq[row, fp.u[1, 2]], bd[3])
+    row = labels.index("5.12b reset 1->2 row 2")
+    np.testing.assert_allclose(-a_eq[row, fp.x[1, -1]], a_r[2])
+    np.testing.assert_allclose(-a_eq[row, fp.p[2]], b_r[2])
+    np.testing.assert_allclose(a_eq[row, fp.p[1]], b_r[2])
+    # every torque node has exactly one cone of radius U_max
+    assert len(fp.problem.cones) == 3 * (sc.robot.n_nodes - 1)
+    assert {r for _, r in fp.problem.cones} == {sc.robot.u_max}
+
+
+def test_plan_is_optimal_and_passes_the_independent_checker(stones_plan) -> None:
+    sc, plan = stones_plan
+    assert plan.status is SolveStatus.OPTIMAL
+    report = check_plan(plan, sc)
+    assert report.ok, report.summary()
+    assert report.dynamics_error < 1e-6
+    assert plan.regions[1:] == ("stone_a", "stone_b", "slope", "slope", "slope")
+    # footsteps on the slope follow its plane: z = 0.1 (x - 0.85) / 0.65
+    for i in (3, 4, 5):
+        assert plan.footsteps[i, 2] == pytest.approx(
+            0.1 * (plan.footsteps[i, 0] - 0.85) / 0.65, abs=1e-6
+        )
+    assert plan.gap <= GAP + 1e-12
+    assert plan.bound <= plan.objective * (1 + 1e-9)
+
+
+def test_objective_recomputed_from_the_plan(stones_plan) -> None:
+    """Eq. (5.11) evaluated directly on the plan's arrays equals the solver's objective."""
+    sc, plan = stones_plan
+    w = OPTS.weights
+    torque = w.torque * float(np.sum(plan.torques**2))
+    th = plan.headings
+    heading = w.heading * float(np.sum((th[2:] - 2 * th[1:-1] + th[:-2]) ** 2))
+    steps = np.diff(plan.footsteps, axis=0)
+    step = w.step * float(np.sum(steps**2 * np.array(w.step_matrix)))
+    # x_goal: at rest between the final feet, relative to the last footstep
+    x_goal = np.zeros(4)
+    x_goal[:2] = sc.goal.position[:2] - plan.footsteps[-1, :2]
+    q = w.terminal_diag(sc.robot)
+    terminal = w.terminal * float(np.sum(q * (plan.final_state - x_goal) ** 2))
+    assert torque + heading + step + terminal == pytest.approx(plan.objective, rel=1e-6)
+
+
+def test_torque_bound_is_a_disc_not_a_box() -> None:
+    """With U_max small enough to bind, both torque axes are used and the 2-norm stays <= U_max."""
+    sc = scene(SHORT_TURN)
+    robot = replace(sc.robot, u_max=8.0)
+    plan = plan_footsteps(sc, robot, n_steps=4, options=OPTS)
+    assert plan.has_solution
+    norms = np.linalg.norm(plan.torques, axis=-1)
+    assert norms.max() <= robot.u_max * (1 + 1e-6)
+    assert check_plan(plan, sc, robot).ok
+    # a box of the same size would allow |u| up to sqrt(2) U_max; the cone must bind somewhere
+    assert norms.max() > 0.99 * robot.u_max
+
+
+def test_turning_plan_changes_heading_within_the_rate_bound() -> None:
+    sc = scene(SHORT_TURN)
+    plan = plan_footsteps(sc, n_steps=4, options=OPTS)
+    assert plan.status is SolveStatus.OPTIMAL
+    assert np.all(np.abs(np.diff(plan.headings)) <= sc.robot.theta_max + 1e-9)
+    assert plan.headings[-1] == pytest.approx(math.radians(60))
+    assert check_plan(plan, sc).ok
+    # reported sin/cos approximations are within the chord error of the true values
+    half = math.pi / OPTS.heading_segments
+    chord = 1 - math.cos(half)
+    np.testing.assert_allclose(plan.sin_cos[:, 0], np.sin(plan.headings), atol=chord + 1e-9)
+    np.testing.assert_allclose(plan.sin_cos[:, 1], np.cos(plan.headings), atol=chord + 1e-9)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    segment=st.integers(0, 15),
+    frac=st.floats(0.0, 1.0),
+    q=st.tuples(st.floats(-0.4, 0.5), st.floats(-0.5, 0.5)),
+    side=st.sampled_from([Side.LEFT, Side.RIGHT]),
+)
+def test_segment_reach_rows_are_conservative(
+    segment: int, frac: float, q: tuple, side: Side
+) -> None:
+    """Any step that satisfies the per-segment rows is reachable at every heading of the segment."""
+    from footfall.models.biped import BipedParams
+
+    robot = BipedParams()
+    n_seg = 16
+    width = 2 * math.pi / n_seg
+    phi_a = -math.pi + segment * width
+    g_rows, h_rows = robot.reach.halfspaces(side)
+    d = np.array(q)
+    ok_rows = True
+    for g, h in zip(g_rows, h_rows, strict=True):
+        h_eff = h * math.cos(width / 2) if h > 0 else h
+        for phi in (phi_a, phi_a + width):
+            rot = np.array([[math.cos(phi), -math.sin(phi)], [math.sin(phi), math.cos(phi)]])
+            ok_rows &= bool((rot @ g) @ d <= h_eff)
+    if not ok_rows:
+        return
+    theta = phi_a + frac * width
+    local = np.array(
+        [
+            math.cos(theta) * d[0] + math.sin(theta) * d[1],
+            -math.sin(theta) * d[0] + math.cos(theta) * d[1],
+        ]
+    )
+    assert robot.reach.contains(local, side, tol=1e-9)
+
+
+def test_too_few_steps_is_infeasible_with_a_diagnosis() -> None:
+    sc = scene(TWO_STONES)
+    plan = plan_footsteps(sc, n_steps=2, options=OPTS)
+    assert plan.status is SolveStatus.INFEASIBLE
+    assert not plan.has_solution
+    assert "at least" in plan.message
+
+
+def test_unreachable_goal_region_is_diagnosed() -> None:
+    text = TWO_STONES.replace(
+        "[[0.85, -0.4, 0.0], [1.5, -0.4, 0.1], [1.5, 0.4, 0.1], [0.85, 0.4, 0.0]]",
+        "[[1.85, -0.4, 0.0], [2.5, -0.4, 0.1], [2.5, 0.4, 0.1], [1.85, 0.4, 0.0]]",
+    ).replace("[1.1, 0, 0.038462]", "[2.1, 0, 0.038462]")
+    sc = scene(text)
+    plan = plan_footsteps(sc, n_steps=8, options=OPTS)
+    assert plan.status is SolveStatus.INFEASIBLE
+    assert "cannot be reached" in plan.message or "no goal region" in plan.message
+
+
+def test_checker_reports_each_kind_of_violation(stones_plan) -> None:
+    sc, plan = stones_plan
+    bad_region = plan.footsteps.copy()
+    bad_region[2, :2] += [0.0, 0.5]  # off stone_b
+    report = check_plan(replace(plan, footsteps=bad_region), sc)
+    assert {"region", "reach", "dynamics"} <= report.kinds()
+
+    bad_torque = plan.torques.copy()
+    bad_torque[1, 0] = [sc.robot.u_max, sc.robot.u_max]
+    assert "torque" in check_plan(replace(plan, torques=bad_torque), sc).kinds()
+
+    bad_heading = plan.headings.copy()
+    bad_heading[2] += 1.0
+    assert "heading_rate" in check_plan(replace(plan, headings=bad_heading), sc).kinds()
+
+    bad_state = plan.states.copy()
+    bad_state[2, 1, 3] += 0.5
+    assert "dynamics" in check_plan(replace(plan, states=bad_state), sc).kinds()
+
+    short = replace(plan, footsteps=plan.footsteps.copy())
+    short.footsteps[-1, 0] += 0.05
+    assert "goal" in check_plan(short, sc).kinds()
+
+
+def test_time_limit_is_honest() -> None:
+    sc = scene(TWO_STONES)
+    plan = plan_footsteps(sc, n_steps=6, options=PlannerOptions(time_limit=0.05, gap=GAP))
+    assert plan.status in (SolveStatus.TIME_LIMIT, SolveStatus.OPTIMAL)
+    if plan.status is SolveStatus.TIME_LIMIT and plan.has_solution:
+        assert plan.gap > GAP
+        assert check_plan(plan, sc).ok
+
+
+def test_kinematic_baseline_meets_geometry_and_needs_more_torque(stones_plan) -> None:
+    sc, full = stones_plan
+    kin = plan_kinematic(sc, n_steps=5, options=OPTS)
+    assert kin.has_solution
+    report = check_plan(kin, sc)
+    assert report.kinds() <= {"torque"}, report.summary()
+    # Same footstep count; the full-horizon plan needs no more torque effort (it optimises it).
+    assert np.sum(full.torques**2) <= np.sum(kin.torques**2) * (1 + 1e-6)
+
+
+def test_reactive_baseline_reaches_goal_and_passes_checker() -> None:
+    sc = scene(SHORT_FLAT)
+    plan = plan_reactive(sc)
+    assert plan.status is SolveStatus.FEASIBLE, plan.message
+    assert check_plan(plan, sc).ok
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [({"n_steps": 0}, "n_steps"), ({"n_steps": 2.5}, "n_steps"), ({"planner": "astar"}, "planner")],
+)
+def test_bad_arguments(kwargs: dict, field: str) -> None:
+    sc = scene(SHORT_FLAT)
+    args = {"planner": "miqcqp", "n_steps": 3} | kwargs
+    with pytest.raises(InputError) as err:
+        make_plan(sc, **args)
+    assert err.value.field == field
+
+
+def test_bad_options() -> None:
+    with pytest.raises(InputError, match="time_limit"):
+        PlannerOptions(time_limit=-1)
+    with pytest.raises(InputError, match="heading_segments"):
+        PlannerOptions(heading_segments=2)
+    with pytest.raises(InputError, match="solver"):
+        PlannerOptions(solver="cplex")
