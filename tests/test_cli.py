@@ -69,4 +69,7 @@ def test_demo_writes_summary(tmp_path: Path) -> None:
     assert res.returncode == 0, res.stderr
     summary = json.loads((tmp_path / "demo.json").read_text())
     assert summary["lip"]["turn"]["final_speed_mps"] < 0.01
+    assert summary["plans"]["miqcqp"]["status"] == "optimal"
+    assert all(p["check_ok"] for p in summary["plans"].values())
+    assert summary["quadruped"]["fell"] is False
     assert (tmp_path / "lip" / "circle" / "lip_walk.png").exists()

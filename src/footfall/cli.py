@@ -111,7 +111,13 @@ def demo(out: Path = typer.Option(Path("out/demo"), help="Output folder.")) -> N
     """Run the main demo on built-in defaults and write figures and JSON into OUT."""
     from footfall.demo import run_demo
 
-    summary = run_demo(out)
+    labels = {
+        "lip": "LIP walks (document 004)",
+        "plans": "footstep plans (document 000)",
+        "quadruped": "quadruped on a slope in MuJoCo (document 001)",
+    }
+    with console.status("footfall demo") as status:
+        summary = run_demo(out, progress=lambda key: status.update(f"demo: {labels[key]} ..."))
     for line in summary["lines"]:
         typer.echo(line)
     typer.echo(f"wrote {out / 'demo.json'}")
