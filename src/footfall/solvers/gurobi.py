@@ -41,7 +41,20 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
     m.setObjective(r @ (problem.cost_weight * r), GRB.MINIMIZE)
     if options.initial_solution is not None:
         x.Start = options.initial_solution
-    m.optimize()
+    try:
+        m.optimize()
+    except gp.GurobiError as exc:
+        # e.g. "Model too large for size-limited license": an outcome to report, not a crash
+        return SolverResult(
+            status=SolveStatus.ERROR,
+            x=None,
+            objective=math.nan,
+            bound=math.nan,
+            gap=math.inf,
+            solve_time=time.perf_counter() - start,
+            solver=NAME,
+            stats={"raw_status": f"GurobiError: {exc}"},
+        )
     n_sols = m.SolCount
     xs = np.array(x.X) if n_sols > 0 else None
     objective = problem.objective(xs) if xs is not None else math.nan
