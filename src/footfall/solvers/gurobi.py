@@ -34,13 +34,14 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
     if problem.a_le.shape[0]:
         m.addMConstr(problem.a_le, x, "<", problem.b_le)
     for idx, radius in problem.cones:
-        m.addConstr(x[idx] @ x[idx] <= radius * radius)
+        sel = x[idx.tolist()]
+        m.addConstr(sel @ sel <= radius * radius)
     # Residuals r = F x - f as variables keep the objective a diagonal quadratic: sum w r^2.
     r = m.addMVar(problem.cost_matrix.shape[0], lb=-GRB.INFINITY)
     m.addConstr(r == problem.cost_matrix @ x - problem.cost_target)
     m.setObjective(r @ (problem.cost_weight * r), GRB.MINIMIZE)
     if options.initial_solution is not None:
-        x.Start = options.initial_solution
+        x.setAttr("Start", options.initial_solution)
     try:
         m.optimize()
     except gp.GurobiError as exc:
