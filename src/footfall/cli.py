@@ -217,6 +217,9 @@ def plan(
     time_limit: float = typer.Option(60.0, help="Solver time limit per solve [s]."),
     gap: float = typer.Option(1e-4, help="Relative optimality gap at which to stop."),
     solver: str = typer.Option("scip", help="Optimisation backend: scip or gurobi."),
+    region_margin: float = typer.Option(
+        0.0, help="Keep footsteps this far inside their region [m] (0: point footholds)."
+    ),
     out: Path = typer.Option(Path("out/plan"), help="Output folder for plan.json and plan.png."),
 ) -> None:
     """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists."""
@@ -229,7 +232,9 @@ def plan(
     sc = resolve_scene(scene_file, scene)
     if steps is not None and (steps < 1):
         raise InputError("steps", steps, "an integer >= 1")
-    options = PlannerOptions(time_limit=time_limit, gap=gap, solver=solver)
+    options = PlannerOptions(
+        time_limit=time_limit, gap=gap, solver=solver, region_margin=region_margin
+    )
     with console.status(f"planning {sc.name} with {planner} ...") as status:
 
         def progress(n: int, result: Any) -> None:

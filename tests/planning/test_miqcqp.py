@@ -242,3 +242,19 @@ def test_bad_options() -> None:
         PlannerOptions(heading_segments=2)
     with pytest.raises(InputError, match="solver"):
         PlannerOptions(solver="cplex")
+
+
+def test_region_margin_keeps_footsteps_inside() -> None:
+    sc = scene(TWO_STONES)
+    margin = 0.05
+    opts = PlannerOptions(time_limit=120.0, gap=GAP, region_margin=margin)
+    plan = plan_footsteps(sc, n_steps=5, options=opts)
+    assert plan.status is SolveStatus.OPTIMAL
+    assert check_plan(plan, sc).ok
+    for i in range(1, plan.n_steps + 1):
+        a, b = sc.terrain[plan.regions[i]].halfspaces()
+        assert np.max(a @ plan.footsteps[i, :2] - b) <= -margin + 1e-6
+    # the same footsteps claimed with a larger margin are flagged by the checker
+    assert "region" in check_plan(replace(plan, region_margin=0.2), sc).kinds()
+    reactive = plan_reactive(sc, region_margin=margin)
+    assert reactive.status is SolveStatus.FEASIBLE and check_plan(reactive, sc).ok

@@ -120,14 +120,8 @@ def test_stairs_scene_compiles_with_steps() -> None:
 
 
 def _cli_app():
-    import typer
+    from footfall.cli import app
 
-    from footfall.cli import quadruped_cmd
-
-    # a two-command app so that "quadruped" is a sub-command whatever else cli.py holds
-    app = typer.Typer()
-    app.callback()(lambda: None)
-    app.command("quadruped")(quadruped_cmd)
     return app
 
 

@@ -176,9 +176,17 @@ def check_plan(plan: FootstepPlan, scene: Scene, robot: BipedParams | None = Non
             out.append(Violation("region", i, math.inf, f"unknown region {plan.regions[i]!r}"))
             continue
         corners = region.vertices3d
-        outside = _inside_polygon(feet[i, :2], corners[:, :2], GEOM_TOL)
+        # distance outside the polygon, plus the margin the plan promised to keep
+        outside = _inside_polygon(feet[i, :2], corners[:, :2], GEOM_TOL) + plan.region_margin
         if outside > GEOM_TOL:
-            out.append(Violation("region", i, outside, f"{outside:.2e} m outside {region.name}"))
+            out.append(
+                Violation(
+                    "region",
+                    i,
+                    outside,
+                    f"{outside:.2e} m outside {region.name} (margin {plan.region_margin:g} m)",
+                )
+            )
         dz = abs(feet[i, 2] - _plane_height(corners, feet[i, :2]))
         if dz > GEOM_TOL:
             out.append(Violation("region", i, dz, f"{dz:.2e} m off the plane of {region.name}"))

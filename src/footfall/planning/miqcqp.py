@@ -307,7 +307,8 @@ def build_footstep_problem(
                     dict(zip(pv, map(float, row_a), strict=True)), float(row_b), z,
                     f"5.17 plane {region.name} step {i}",
                 )  # fmt: skip
-            a_poly, b_poly = region.halfspaces()  # eq. 5.18
+            a_poly, b_poly = region.halfspaces()  # eq. 5.18, unit outward normals
+            b_poly = b_poly - options.region_margin
             for row_a, row_b in zip(a_poly, b_poly, strict=True):
                 b.add_le_big_m(
                     dict(zip(pv[:2], map(float, row_a), strict=True)), float(row_b), z,
@@ -390,6 +391,7 @@ def extract_plan(fp: FootstepProblem, x: FloatArray, **meta: Any) -> FootstepPla
         torques=x[fp.u],
         final_state=x[fp.x_final],
         sin_cos=np.stack([x[fp.s], x[fp.c]], axis=1),
+        region_margin=fp.options.region_margin,
         **meta,
     )
 

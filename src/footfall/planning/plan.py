@@ -69,6 +69,9 @@ class PlannerOptions:
         verbose: print the solver log.
         momentum_bound: bound on |L| as a CoM speed [m/s] (|L| <= m z_H * bound); a physical limit
             that also gives the solver finite bounds.
+        region_margin: keep every footstep at least this far inside its region's polygon [m]
+            (eq. 5.18 with each edge moved inward). 0 is the document's point foothold; half the
+            sole width (0.05 m) keeps the sole on narrow stones at any heading.
     """
 
     weights: PlannerWeights = field(default_factory=PlannerWeights)
@@ -79,6 +82,7 @@ class PlannerOptions:
     threads: int = 1
     verbose: bool = False
     momentum_bound: float = 3.0
+    region_margin: float = 0.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.heading_segments, int) or self.heading_segments < 4:
@@ -88,6 +92,7 @@ class PlannerOptions:
         if self.solver not in KNOWN_BACKENDS:
             raise InputError("solver", self.solver, f"one of {', '.join(KNOWN_BACKENDS)}")
         object.__setattr__(self, "momentum_bound", positive("momentum_bound", self.momentum_bound))
+        object.__setattr__(self, "region_margin", non_negative("region_margin", self.region_margin))
 
 
 @dataclass(frozen=True)
@@ -139,6 +144,7 @@ class FootstepPlan:
     stats: dict[str, Any] = field(default_factory=dict)
     message: str = ""
     sin_cos: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
+    region_margin: float = 0.0
 
     @property
     def n_steps(self) -> int:

@@ -38,6 +38,7 @@ def _one_step(
     side: Side,
     l_des: FloatArray | None,
     target: FloatArray | None,
+    region_margin: float = 0.0,
 ) -> tuple[FloatArray, str, FloatArray, FloatArray] | None:
     """One-step-ahead choice of the next footstep and the current phase's ankle torques.
 
@@ -82,7 +83,8 @@ def _one_step(
     h_vars = [int(b.add_binaries(f"H[{r.name}]", ())[()]) for r in scene.terrain]
     b.add_eq(dict.fromkeys(h_vars, 1.0), 1.0, "one region")
     for z, region in zip(h_vars, scene.terrain, strict=True):
-        for rows, rhs, dim in ((*region.plane_rows(), 3), (*region.halfspaces(), 2)):
+        a_poly, b_poly = region.halfspaces()
+        for rows, rhs, dim in ((*region.plane_rows(), 3), (a_poly, b_poly - region_margin, 2)):
             for ra, rb in zip(rows, rhs, strict=True):
                 b.add_le_big_m(
                     {int(p[j]): float(ra[j]) for j in range(dim)}, float(rb), z, region.name
@@ -116,6 +118,7 @@ def plan_reactive(
     scene: Scene,
     robot: BipedParams | None = None,
     max_steps: int = 40,
+    region_margin: float = 0.0,
 ) -> FootstepPlan:
     """Walk toward the goal one step at a time (see the module docstring).
 
@@ -123,6 +126,7 @@ def plan_reactive(
         scene: terrain, start and goal.
         robot: robot parameters (default ``scene.robot``).
         max_steps: give up after this many footsteps.
+        region_margin: keep footsteps this far inside their region's polygon [m].
 
     Returns:
         A plan with status ``feasible`` when the goal was reached, ``infeasible`` otherwise (the
@@ -187,7 +191,7 @@ def plan_reactive(
             # At the end of a left stance the CoM moves right (v_y < 0), so L_x = -m z_H v_y > 0;
             # (L_x, L_y) rotates with the heading like a vector.
             l_des = rot2(new_th) @ np.array([nxt_side.sign * lx_mag, mzh * speed])
-        step = _one_step(scene, robot, x, stance, th, side, l_des, target)
+        step = _one_step(scene, robot, x, stance, th, side, l_des, target, region_margin)
         if step is None:
             message = f"no reachable region from footstep {len(feet) - 1}"
             break
@@ -222,4 +226,5 @@ def plan_reactive(
         solve_time=time.perf_counter() - t0,
         solver="scip",
         message=message,
+        region_margin=region_margin,
     )

@@ -38,7 +38,9 @@ def make_plan(
     if planner == "reactive":
         from footfall.planning.reactive import plan_reactive
 
-        return plan_reactive(scene, robot, max_steps=n_steps or 40)
+        return plan_reactive(
+            scene, robot, max_steps=n_steps or 40, region_margin=options.region_margin
+        )
     if n_steps is None:
         return plan_min_steps(scene, planner, options, robot)
     if planner == "kinematic":
