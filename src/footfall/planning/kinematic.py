@@ -10,14 +10,12 @@ reports the torque violation).
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from footfall.models.biped import BipedParams
 from footfall.planning.miqcqp import build_footstep_problem, extract_plan
-from footfall.planning.plan import FootstepPlan, PlannerOptions
-from footfall.solvers import SolverOptions, SolveStatus, solve
+from footfall.planning.plan import FootstepPlan, PlannerOptions, result_meta
+from footfall.solvers import SolveStatus, solve
 from footfall.solvers.problem import fix_variables
 from footfall.terrain.scene import Scene
 
@@ -34,23 +32,10 @@ def plan_kinematic(
     from footfall.planning.diagnose import diagnose_infeasible
 
     options = options or PlannerOptions()
-    solver_opts = SolverOptions(
-        time_limit=options.time_limit,
-        gap=options.gap,
-        threads=options.threads,
-        verbose=options.verbose,
-    )
+    solver_opts = options.solver_options()
     kin = build_footstep_problem(scene, robot, n_steps, options, dynamics=False)
     res = solve(kin.problem, options.solver, solver_opts)
-    meta: dict[str, Any] = dict(
-        status=res.status,
-        objective=res.objective,
-        bound=res.bound,
-        gap=res.gap,
-        solve_time=res.solve_time,
-        solver=res.solver,
-        stats=dict(res.stats),
-    )
+    meta = result_meta(res)
     if res.x is None:
         msg = (
             diagnose_infeasible(scene, kin.robot, n_steps)

@@ -49,10 +49,11 @@ from footfall.planning.plan import (
     FootstepPlan,
     PlannerOptions,
     goal_feet,
+    result_meta,
     rot2,
     wrap_near,
 )
-from footfall.solvers import ProblemBuilder, SolverOptions, SolveStatus, solve
+from footfall.solvers import ProblemBuilder, SolveStatus, solve
 from footfall.solvers.problem import MIQCQP
 from footfall.terrain.scene import Scene
 
@@ -421,25 +422,8 @@ def plan_footsteps(
             diagnose_infeasible(scene, fp.robot, n_steps),
             solver=options.solver,
         )
-    result = solve(
-        fp.problem,
-        options.solver,
-        SolverOptions(
-            time_limit=options.time_limit,
-            gap=options.gap,
-            threads=options.threads,
-            verbose=options.verbose,
-        ),
-    )
-    meta: dict[str, Any] = dict(
-        status=result.status,
-        objective=result.objective,
-        bound=result.bound,
-        gap=result.gap,
-        solve_time=result.solve_time,
-        solver=result.solver,
-        stats=result.stats,
-    )
+    result = solve(fp.problem, options.solver, options.solver_options())
+    meta = result_meta(result)
     if result.x is None:
         if result.status is SolveStatus.INFEASIBLE:
             message = diagnose_infeasible(scene, fp.robot, n_steps)

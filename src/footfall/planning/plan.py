@@ -13,7 +13,7 @@ from footfall._validate import non_negative, positive
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.solvers import KNOWN_BACKENDS
-from footfall.solvers.base import SolveStatus
+from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
 
 FloatArray = NDArray[np.float64]
 
@@ -93,6 +93,25 @@ class PlannerOptions:
             raise InputError("solver", self.solver, f"one of {', '.join(KNOWN_BACKENDS)}")
         object.__setattr__(self, "momentum_bound", positive("momentum_bound", self.momentum_bound))
         object.__setattr__(self, "region_margin", non_negative("region_margin", self.region_margin))
+
+    def solver_options(self) -> SolverOptions:
+        """The backend options these planner options imply."""
+        return SolverOptions(
+            time_limit=self.time_limit, gap=self.gap, threads=self.threads, verbose=self.verbose
+        )
+
+
+def result_meta(result: SolverResult) -> dict[str, Any]:
+    """The :class:`FootstepPlan` fields that come from a solver result."""
+    return {
+        "status": result.status,
+        "objective": result.objective,
+        "bound": result.bound,
+        "gap": result.gap,
+        "solve_time": result.solve_time,
+        "solver": result.solver,
+        "stats": dict(result.stats),
+    }
 
 
 @dataclass(frozen=True)
