@@ -29,6 +29,8 @@ class SolverOptions:
     Attributes:
         time_limit: wall-clock limit [s].
         gap: relative optimality gap at which to stop (|primal - dual| / |primal|).
+        abs_gap: absolute gap at which to stop (needed when the optimum is near zero, where a
+            relative gap cannot close).
         threads: number of threads the backend may use.
         verbose: print the backend's log.
         seed: random seed of the backend.
@@ -37,6 +39,7 @@ class SolverOptions:
 
     time_limit: float = 60.0
     gap: float = 1e-4
+    abs_gap: float = 1e-9
     threads: int = 1
     verbose: bool = False
     seed: int = 0
@@ -45,6 +48,7 @@ class SolverOptions:
     def __post_init__(self) -> None:
         object.__setattr__(self, "time_limit", positive("time_limit", self.time_limit))
         object.__setattr__(self, "gap", non_negative("gap", self.gap))
+        object.__setattr__(self, "abs_gap", non_negative("abs_gap", self.abs_gap))
         if not isinstance(self.threads, int) or self.threads < 1:
             from footfall.errors import InputError
 

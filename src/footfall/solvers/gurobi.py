@@ -25,6 +25,7 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
     m = gp.Model("footfall", env=env)
     m.Params.TimeLimit = options.time_limit
     m.Params.MIPGap = options.gap
+    m.Params.MIPGapAbs = options.abs_gap
     m.Params.Threads = options.threads
     m.Params.Seed = options.seed
     vtype = np.where(problem.integer, GRB.INTEGER, GRB.CONTINUOUS)

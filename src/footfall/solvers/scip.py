@@ -29,6 +29,7 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
         m.hideOutput()
     m.setParam("limits/time", options.time_limit)
     m.setParam("limits/gap", options.gap)
+    m.setParam("limits/absgap", options.abs_gap)
     m.setParam("randomization/randomseedshift", options.seed)
     m.setParam("parallel/maxnthreads", options.threads)
 
