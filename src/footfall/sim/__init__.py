@@ -1,0 +1,10 @@
+"""Simulation of footstep plans.
+
+``reduced``: the closed loop of document 000 section 5.4-5.5 on the reduced-order (ALIP) plant:
+plan -> MPC footstep / ankle-torque adjuster (eq. 5.19) -> ALIP with a rectangular sole, pushes,
+noise and model mismatch -> metrics (single-support ZMP offset, falls, goal error).
+"""
+
+from footfall.sim.reduced import Push, SimMetrics, SimOptions, SimResult, simulate
+
+__all__ = ["Push", "SimMetrics", "SimOptions", "SimResult", "simulate"]
