@@ -297,8 +297,10 @@ def compare_command(
     planners: str = typer.Option("miqcqp,kinematic,reactive", help="Comma-separated planners."),
     trials: int = typer.Option(50, help="Seeded trials per scene and planner."),
     workers: int = typer.Option(2, help="Worker processes."),
-    steps: int | None = typer.Option(
-        None, help="Footsteps N of miqcqp/kinematic (default: geometric lower bound + 2)."
+    steps: str | None = typer.Option(
+        None,
+        help="Footsteps N of miqcqp/kinematic: one number, or per scene 'name=N,name=N' "
+        "(default: geometric lower bound + 2).",
     ),
     time_limit: float = typer.Option(60.0, "--time-limit", help="Planner time limit [s]."),
     push_max: float = typer.Option(15.0, help="Push impulses uniform in [0, push_max] [N s]."),
@@ -320,6 +322,15 @@ def compare_command(
 
     _positive_int("trials", trials)
     _positive_int("workers", workers)
+    n_steps: int | dict[str, int] | None = None
+    if steps is not None:
+        try:
+            if "=" in steps:
+                n_steps = {k.strip(): int(v) for k, v in (kv.split("=") for kv in steps.split(","))}
+            else:
+                n_steps = int(steps)
+        except ValueError:
+            raise InputError("steps", steps, "an integer or 'scene=N,scene=N'") from None
     names = check_names("planners", planners.split(","), PLANNERS)
     spec = TrialSpec(
         push_max=push_max,
@@ -351,7 +362,7 @@ def compare_command(
             bar.update(task, description=what, completed=done, total=total or None)
 
         rows, table, plans = run_compare(
-            scene_objs, names, trials, out, spec, workers, steps, time_limit, progress
+            scene_objs, names, trials, out, spec, workers, n_steps, time_limit, progress
         )
     header = (
         f"{trials} trials per scene and planner; pushes uniform in [0, {push_max:g}] N s "

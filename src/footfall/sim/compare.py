@@ -266,11 +266,14 @@ def run_compare(
     out: Path,
     spec: TrialSpec,
     workers: int = 1,
-    n_steps: int | None = None,
+    n_steps: int | dict[str, int] | None = None,
     time_limit: float = 60.0,
     progress: Callable[[str, int, int], None] | None = None,
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]], dict[tuple[str, str], FootstepPlan]]:
     """Plan (cached), then run ``trials`` seeded trials per (scene, planner) over ``workers``.
+
+    ``n_steps``: footsteps of the horizon planners, for all scenes or per scene name (missing
+    scenes use the default of :func:`make_plan`).
 
     Returns:
         ``(rows, table, plans)``.
@@ -283,9 +286,8 @@ def run_compare(
         for planner in planners:
             if progress:
                 progress(f"planning {s_name} / {planner}", 0, 0)
-            plans[(s_name, planner)] = cached_plan(
-                out / "plans", scene, planner, n_steps, time_limit
-            )
+            n: int | None = n_steps.get(s_name) if isinstance(n_steps, dict) else n_steps
+            plans[(s_name, planner)] = cached_plan(out / "plans", scene, planner, n, time_limit)
     jobs = [
         (s, p, plan, seed)
         for (s, p), plan in plans.items()
