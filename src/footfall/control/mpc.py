@@ -47,6 +47,7 @@ Clarabel (interior-point SOCP) backend solves the same condensed problem for cro
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from enum import Enum
@@ -582,11 +583,34 @@ class MPC:
         ):
             if arr.shape != (n,):
                 raise InputError(name, arr.tolist(), f"shape ({n},)")
+        theta = np.concatenate([x, pr[:2] - ps[:2], xr])
+        return self.solve_theta(k_s, theta, ps, pr, t0)
+
+    def solve_theta(
+        self,
+        k_s: int,
+        theta: FloatArray,
+        p_stance: FloatArray,
+        p_next_ref: FloatArray,
+        t0: float | None = None,
+    ) -> MPCSolution:
+        """:meth:`solve` without input checks, from the parameter vector (for simulation loops).
+
+        Args:
+            k_s: control tick, 0 <= k_s < M (not checked).
+            theta: ``[x_measured (4), (p_next_ref - p_stance)[:2], x_next_ref (4)]``, shape (10,).
+            p_stance: (3,) [m].
+            p_next_ref: (3,) [m].
+            t0: ``time.perf_counter()`` at the start of the caller's solve (for solve_time).
+        """
+        t0 = time.perf_counter() if t0 is None else t0
+        mdl = self.model
+        ps, pr = p_stance, p_next_ref
         if self._last is not None and k_s <= self._last.k_s:
             self._last = None  # a new single support: nothing to shift
         self.n_solves += 1
-        theta = np.concatenate([x, pr[:2] - ps[:2], xr])
-        if not np.all(np.isfinite(theta)):
+        # one reduction instead of isfinite().all(): a NaN or inf anywhere makes the sum non-finite
+        if not math.isfinite(float(theta.sum())):
             return self._fallback(k_s, ps, pr, t0, "non-finite measurement or reference")
         lam0 = None
         if self._last is not None:
@@ -599,7 +623,7 @@ class MPC:
                 u, lam, iters, ok = self._solve_clarabel(k_s, theta)
         except (np.linalg.LinAlgError, ValueError) as exc:
             return self._fallback(k_s, ps, pr, t0, f"solver error: {exc}")
-        if not ok or not np.all(np.isfinite(u)):
+        if not ok or not math.isfinite(float(u.sum())):
             return self._fallback(k_s, ps, pr, t0, "solver did not converge")
         d = mdl._d_theta[k_s] @ theta + mdl._d_u[k_s] @ u
         sol = MPCSolution(

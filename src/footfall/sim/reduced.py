@@ -364,16 +364,23 @@ def simulate(
     ad_dss, bd_dss = zoh(a_aug, b_aug, dt_ds / n_sub)
     d0, d_span = viability_bounds(robot, omega, f_len, f_wid)
 
-    def push_torque(t0: float, h: float, k: int) -> FloatArray:
-        """Equivalent push torque z_H (-F_y, F_x) on each of k sub-steps of length h from t0."""
-        out = np.zeros((k, 2))
-        mids = t0 + (np.arange(k) + 0.5) * h
-        for p in opts.pushes:
-            on = (mids >= p.time) & (mids < p.time + p.duration)
-            if on.any():
-                f = p.force
-                out[on] += zh * np.array([-f[1], f[0]])
-        return out
+    # Push torque z_H (-F_y, F_x) on every plant sub-step of the walk, tabulated once: row
+    # i (M + n_ds) + k is tick k of phase i (k >= M: double support), columns the sub-steps.
+    starts = np.concatenate(
+        [np.arange(m_ticks) * dt, robot.t_ss + np.arange(n_ds) * dt_ds]
+    )  # tick start within a step
+    lengths = np.concatenate([np.full(m_ticks, dt), np.full(n_ds, dt_ds)])
+    step_period = robot.t_ss + robot.t_ds
+    t_start = (np.arange(n)[:, None] * step_period + starts[None]).ravel()
+    h_sub = np.tile(lengths, n) / n_sub
+    mids = t_start[:, None] + (np.arange(n_sub)[None] + 0.5) * h_sub[:, None]
+    push_tab = np.zeros((t_start.shape[0], n_sub, 2))
+    for p in opts.pushes:
+        on = (mids >= p.time) & (mids < p.time + p.duration)
+        f = p.force
+        push_tab[on] += zh * np.array([-f[1], f[0]])
+    push_any = push_tab.any(axis=(1, 2))
+    push_const = np.all(push_tab == push_tab[:, :1], axis=(1, 2))
 
     rng = np.random.default_rng(opts.seed)
     noise = rng.standard_normal((n * m_ticks, 4)) * np.array(
@@ -403,41 +410,57 @@ def simulate(
     for i in range(n):
         stance = feet[-1]
         heading = float(plan.headings[i])
-        rot = _rot(heading)
         p_ref = plan.footsteps[i + 1]
         x_ref = plan.states[i + 1, 0] if i + 1 < n else plan.final_state
         sol = None
+        cth, sth = math.cos(heading), math.sin(heading)
+        hx, hy = float(half[0]), float(half[1])
+        theta = np.empty(10)
+        theta[4:6] = p_ref[:2] - stance[:2]
+        theta[6:] = x_ref
+        # exp(-omega T_r) of the fall bound for every tick (T_r = time to touchdown)
+        decay = np.exp(-omega * (m_ticks - 1 - np.arange(m_ticks)) * dt)
+        kxi = 1.0 / (mzh * omega)
         for k in range(m_ticks):
-            sol = mpc.solve(k, x + noise[i * m_ticks + k], stance, p_ref, x_ref)
+            theta[:4] = x
+            theta[:4] += noise[i * m_ticks + k]
+            sol = mpc.solve_theta(k, theta, stance, p_ref)
             solve_times.append(sol.solve_time)
             u_cmd = sol.torques[0]
-            # CoP of the command, in the foot frame, clipped to the sole (foot rolls otherwise).
-            off = rot.T @ np.array([-u_cmd[1], u_cmd[0]]) / mg
-            off_c = np.clip(off, -half, half)
-            clipped = bool(np.any(off_c != off))
-            off_w = rot @ off_c
-            u = np.array([mg * off_w[1], -mg * off_w[0]])
+            # CoP of the command in the foot frame, clipped to the sole (the foot rolls otherwise).
+            cwx, cwy = -float(u_cmd[1]) / mg, float(u_cmd[0]) / mg
+            ox, oy = cth * cwx + sth * cwy, -sth * cwx + cth * cwy
+            cx, cy = min(max(ox, -hx), hx), min(max(oy, -hy), hy)
+            wx, wy = cth * cx - sth * cy, sth * cx + cth * cy
+            u = np.array([mg * wy, -mg * wx])
             t_arr[j], stance_arr[j], single[j] = t, i, True
             com[j] = stance[:2] + x[:2]
-            cop[j] = stance[:2] + off_w
-            cop_off[j], tau_cmd[j], tau[j], sat[j] = off_c, u_cmd, u, clipped
+            cop[j] = (stance[0] + wx, stance[1] + wy)
+            cop_off[j], tau_cmd[j], tau[j] = (cx, cy), u_cmd, u
+            sat[j] = cx != ox or cy != oy
             j += 1
-            pt = push_torque(t, dt / n_sub, n_sub) if opts.pushes else None
-            if pt is None or not pt.any():
+            jt = i * (m_ticks + n_ds) + k
+            if not push_any[jt]:
                 x = ad_t @ x + bd_t @ u
-            elif np.all(pt == pt[0]):
-                x = ad_t @ x + bd_t @ (u + pt[0])
+            elif push_const[jt]:
+                x = ad_t @ x + bd_t @ (u + push_tab[jt, 0])
             else:
-                for s in range(n_sub):
-                    x = ad_s @ x + bd_s @ (u + pt[s])
+                for q in range(n_sub):
+                    x = ad_s @ x + bd_s @ (u + push_tab[jt, q])
             t += dt
             # Fall test on the true state (module docstring).
-            if not np.all(np.isfinite(x)):
+            if not np.isfinite(x).all():
                 fell, fall_time = True, t
                 break
-            xi = rot.T @ (x[:2] + np.array([x[3], -x[2]]) / (mzh * omega))
-            bound = d0 + d_span * math.exp(-omega * (m_ticks - k - 1) * dt)
-            if xi[0] > bound[0] or -xi[0] > bound[1] or xi[1] > bound[2] or -xi[1] > bound[3]:
+            gx, gy = float(x[0] + kxi * x[3]), float(x[1] - kxi * x[2])
+            fx, fy = cth * gx + sth * gy, -sth * gx + cth * gy
+            e = decay[k]
+            if (
+                fx > d0[0] + d_span[0] * e
+                or -fx > d0[1] + d_span[1] * e
+                or fy > d0[2] + d_span[2] * e
+                or -fy > d0[3] + d_span[3] * e
+            ):
                 fell, fall_time = True, t
                 break
         if fell:
@@ -448,17 +471,17 @@ def simulate(
         delta = p_next[:2] - stance[:2]
         # Double support: the contact point moves linearly to the new foot (eq. 5.8-5.10).
         s_aug = np.concatenate([x, np.zeros(2), delta / robot.t_ds])
-        for _ in range(n_ds):
+        for k in range(n_ds):
             t_arr[j], stance_arr[j] = t, i
             com[j] = stance[:2] + s_aug[:2]
             cop[j] = stance[:2] + s_aug[4:6]
             j += 1
-            pt = push_torque(t, dt_ds / n_sub, n_sub) if opts.pushes else None
-            if pt is None or not pt.any():
+            jt = i * (m_ticks + n_ds) + m_ticks + k
+            if not push_any[jt]:
                 s_aug = ad_ds @ s_aug
             else:
-                for s in range(n_sub):
-                    s_aug = ad_dss @ s_aug + bd_dss @ pt[s]
+                for q in range(n_sub):
+                    s_aug = ad_dss @ s_aug + bd_dss @ push_tab[jt, q]
             t += dt_ds
         x = s_aug[:4].copy()
         x[:2] -= delta
