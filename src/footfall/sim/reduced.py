@@ -39,7 +39,6 @@ at every control tick of every single support; mean, RMS and max over the walk a
 
 from __future__ import annotations
 
-import functools
 import math
 import time
 from dataclasses import asdict, dataclass, field
@@ -294,18 +293,21 @@ def _sole_corners(foot: FloatArray, heading: float, length: float, width: float)
     return np.asarray(foot[:2] + half @ _rot(heading).T)
 
 
-@functools.lru_cache(maxsize=8)
-def _cached_mpc(
-    key: str, robot: BipedParams, weights: MPCWeights, dt: float, k: int | None
-) -> CondensedMPC:
-    del key  # only part of the cache key
-    return build_mpc(robot, weights, dt, k)
+#: condensed MPCs by (robot, weights, rate, nodes) description: trials of one plan build it once
+_MPC_CACHE: dict[str, CondensedMPC] = {}
+_MPC_CACHE_SIZE = 8
 
 
 def _mpc_model(robot: BipedParams, opts: SimOptions) -> CondensedMPC:
-    # BipedParams compares by identity; its repr describes it fully (cache across equal robots).
-    key = f"{robot!r}|{opts.weights!r}|{opts.control_rate}|{opts.mpc_nodes}"
-    return _cached_mpc(key, robot, opts.weights, 1.0 / opts.control_rate, opts.mpc_nodes)
+    # BipedParams compares by identity (unpickled copies differ), but its repr describes it fully.
+    key = f"{robot!r}|{opts.weights!r}|{opts.control_rate!r}|{opts.mpc_nodes!r}"
+    mdl = _MPC_CACHE.get(key)
+    if mdl is None:
+        if len(_MPC_CACHE) >= _MPC_CACHE_SIZE:
+            _MPC_CACHE.pop(next(iter(_MPC_CACHE)))
+        mdl = build_mpc(robot, opts.weights, 1.0 / opts.control_rate, opts.mpc_nodes)
+        _MPC_CACHE[key] = mdl
+    return mdl
 
 
 def simulate(
@@ -379,8 +381,8 @@ def simulate(
         on = (mids >= p.time) & (mids < p.time + p.duration)
         f = p.force
         push_tab[on] += zh * np.array([-f[1], f[0]])
-    push_any = push_tab.any(axis=(1, 2))
-    push_const = np.all(push_tab == push_tab[:, :1], axis=(1, 2))
+    push_any = np.asarray(push_tab.any(axis=(1, 2)), dtype=bool)
+    push_const = np.asarray(np.all(push_tab == push_tab[:, :1], axis=(1, 2)), dtype=bool)
 
     rng = np.random.default_rng(opts.seed)
     noise = rng.standard_normal((n * m_ticks, 4)) * np.array(
