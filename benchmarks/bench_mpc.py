@@ -42,26 +42,20 @@ class RecordingMPC(MPC):
 
     calls: ClassVar[list[tuple]] = []
 
-    def solve(self, k_s, x_measured, p_stance, p_next_ref, x_next_ref):  # type: ignore[override]
-        RecordingMPC.calls.append(
-            (
-                k_s,
-                np.array(x_measured),
-                np.array(p_stance),
-                np.array(p_next_ref),
-                np.array(x_next_ref),
-            )
-        )
-        return super().solve(k_s, x_measured, p_stance, p_next_ref, x_next_ref)
+    def solve_theta(self, k_s, theta, p_stance, p_next_ref, t0=None):  # type: ignore[override]
+        RecordingMPC.calls.append((k_s, theta.copy(), np.array(p_stance), np.array(p_next_ref)))
+        return super().solve_theta(k_s, theta, p_stance, p_next_ref, t0)
 
 
 def percentile(v: list[float], q: float) -> float:
     return float(np.percentile(np.asarray(v), q))
 
 
-def naive_cvxpy(mdl: CondensedMPC, k_s: int, x0, ps, pr, xr) -> float:
+def naive_cvxpy(mdl: CondensedMPC, k_s: int, theta, ps, pr) -> float:
     """Build and solve eq. (5.19) from scratch in CVXPY; returns the wall time [s]."""
     import cvxpy as cp
+
+    x0, xr = theta[:4], theta[6:]
 
     t0 = time.perf_counter()
     n_b = mdl.n_blocks(k_s)
@@ -111,9 +105,11 @@ def main() -> None:
     for _ in range(3):
         mpc = MPC(mdl)
         times, iters = [], []
-        for c in calls:
+        for k_s, theta, ps, pr in calls:
+            # the public, validating entry point (what a user calls)
+            x, xr = theta[:4], theta[6:]
             t0 = time.perf_counter()
-            sol = mpc.solve(*c)
+            sol = mpc.solve(k_s, x, ps, pr, xr)
             times.append(time.perf_counter() - t0)
             iters.append(sol.iterations)
         passes.append(times)
