@@ -374,3 +374,207 @@ def quadruped_cmd(
         f"mean {m['stability_margin_mean_m']:.3f} m, {m['realtime_factor']:.0f}x real time"
     )
     console.print(f"wrote {out / 'quadruped.json'}")
+
+
+# --- simulate (issue 4) ---
+def _scene_arg(text: str) -> object:
+    """A built-in scene name or a YAML file path."""
+    from footfall.terrain import builtin_scene, load_scene
+
+    is_file = text.endswith((".yaml", ".yml")) or Path(text).is_file()
+    return load_scene(Path(text)) if is_file else builtin_scene(text)
+
+
+def _positive_int(field: str, value: int) -> int:
+    if value < 1:
+        raise InputError(field, value, "an integer >= 1")
+    return value
+
+
+@app.command("simulate")
+def simulate_command(
+    scene: str = typer.Option("flat", "--scene", help="Built-in scene name or YAML file."),
+    planner: str = typer.Option("reactive", help="Planner: miqcqp, kinematic or reactive."),
+    steps: int | None = typer.Option(
+        None, help="Footsteps N of miqcqp/kinematic (default: geometric lower bound + 2)."
+    ),
+    time_limit: float = typer.Option(60.0, "--time-limit", help="Planner time limit [s]."),
+    push: float = typer.Option(0.0, help="Push impulse [N s]; 0 for none."),
+    push_time: float = typer.Option(1.0, help="Push start time [s]."),
+    push_direction: float = typer.Option(90.0, help="Push direction [deg] (0 = +x, 90 = +y)."),
+    push_duration: float = typer.Option(0.1, help="Push pulse length [s]."),
+    noise_pos: float = typer.Option(0.0, help="CoM position estimate noise (std) [m]."),
+    noise_vel: float = typer.Option(0.0, help="CoM velocity estimate noise (std) [m/s]."),
+    placement_error: float = typer.Option(0.0, help="Landing error (std per axis) [m]."),
+    mass_scale: float = typer.Option(1.0, help="True mass / model mass."),
+    com_height_scale: float = typer.Option(1.0, help="True CoM height / model CoM height."),
+    rate: float = typer.Option(500.0, help="Control rate [Hz]."),
+    seed: int = typer.Option(0, help="Random seed."),
+    out: Path = typer.Option(Path("out/simulate"), help="Output folder."),
+) -> None:
+    """Plan a scene, walk it in closed loop (MPC eq. 5.19 on the ALIP plant), write sim.json + figures."""
+    import math
+
+    from footfall.planning.plan import check_planner_name
+    from footfall.sim import Push, SimOptions, simulate
+    from footfall.sim.compare import make_plan
+    from footfall.terrain.scene import Scene
+    from footfall.viz.sim_plots import save_sim_figures
+
+    check_planner_name(planner)
+    opts = SimOptions(
+        control_rate=rate,
+        noise_pos=noise_pos,
+        noise_vel=noise_vel,
+        mass_scale=mass_scale,
+        com_height_scale=com_height_scale,
+        pushes=(Push(push_time, push, math.radians(push_direction), push_duration),)
+        if push != 0
+        else (),
+        placement_error=placement_error,
+        seed=seed,
+    )
+    sc = _scene_arg(scene)
+    assert isinstance(sc, Scene)
+    plan = make_plan(sc, planner, steps, time_limit)
+    if not plan.has_solution:
+        from footfall.errors import InfeasibleError
+
+        raise InfeasibleError(f"{planner} found no plan for {sc.name}: {plan.message}")
+    res = simulate(plan, opts, goal=sc.goal.position)
+    m = res.metrics
+    write_json(
+        out / "sim.json",
+        {
+            "scene": sc.name,
+            "planner": planner,
+            "plan": {
+                "status": plan.status.value,
+                "steps": plan.n_steps,
+                "planning_time": plan.solve_time,
+                "message": plan.message,
+                "footsteps": plan.footsteps.tolist(),
+            },
+            "options": {
+                "control_rate": rate,
+                "push": {
+                    "impulse": push,
+                    "time": push_time,
+                    "direction_deg": push_direction,
+                    "duration": push_duration,
+                },
+                "noise_pos": noise_pos,
+                "noise_vel": noise_vel,
+                "placement_error": placement_error,
+                "mass_scale": mass_scale,
+                "com_height_scale": com_height_scale,
+                "seed": seed,
+            },
+            "metrics": m.to_dict(),
+            "footsteps": res.footsteps.tolist(),
+        },
+    )
+    figs = save_sim_figures(res, out, sc.terrain)
+    outcome = f"FELL at {m.fall_time:.2f} s" if m.fell else ("stopped" if m.stopped else "walked")
+    typer.echo(
+        f"{sc.name} / {planner}: {outcome}; single-support ZMP offset mean "
+        f"{1000 * m.zmp_offset_mean:.1f} mm, max {1000 * m.zmp_offset_max:.1f} mm; "
+        f"goal error {m.goal_error:.3f} m; wrote {out / 'sim.json'} and {len(figs)} figures"
+    )
+
+
+# --- compare (issue 4) ---
+@app.command("compare")
+def compare_command(
+    scenes: str = typer.Option(
+        "discrete_steps,stairs_slope_gap", help="Comma-separated scene names or YAML files."
+    ),
+    planners: str = typer.Option("miqcqp,kinematic,reactive", help="Comma-separated planners."),
+    trials: int = typer.Option(50, help="Seeded trials per scene and planner."),
+    workers: int = typer.Option(2, help="Worker processes."),
+    steps: str | None = typer.Option(
+        None,
+        help="Footsteps N of miqcqp/kinematic: one number, or per scene 'name=N,name=N' "
+        "(default: geometric lower bound + 2).",
+    ),
+    time_limit: float = typer.Option(60.0, "--time-limit", help="Planner time limit [s]."),
+    push_max: float = typer.Option(15.0, help="Push impulses uniform in [0, push_max] [N s]."),
+    noise_pos: float = typer.Option(0.002, help="CoM position estimate noise (std) [m]."),
+    noise_vel: float = typer.Option(0.02, help="CoM velocity estimate noise (std) [m/s]."),
+    placement_error: float = typer.Option(0.01, help="Landing error (std per axis) [m]."),
+    mismatch: float = typer.Option(0.0, help="Mass/CoM-height mismatch fraction (uniform +-)."),
+    rate: float = typer.Option(500.0, help="Control rate [Hz]."),
+    out: Path = typer.Option(Path("out/compare"), help="Output folder (plans cached in plans/)."),
+) -> None:
+    """Section 5.5: every planner through the same MPC and plant over seeded disturbed trials."""
+    import os
+
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from footfall.planning.plan import PLANNERS
+    from footfall.sim.compare import TrialSpec, check_names, run_compare, write_outputs
+    from footfall.terrain.scene import Scene
+
+    _positive_int("trials", trials)
+    _positive_int("workers", workers)
+    n_steps: int | dict[str, int] | None = None
+    if steps is not None:
+        try:
+            if "=" in steps:
+                n_steps = {k.strip(): int(v) for k, v in (kv.split("=") for kv in steps.split(","))}
+            else:
+                n_steps = int(steps)
+        except ValueError:
+            raise InputError("steps", steps, "an integer or 'scene=N,scene=N'") from None
+    names = check_names("planners", planners.split(","), PLANNERS)
+    spec = TrialSpec(
+        push_max=push_max,
+        noise_pos=noise_pos,
+        noise_vel=noise_vel,
+        placement_error=placement_error,
+        mismatch=mismatch,
+        control_rate=rate,
+    )
+    scene_objs: dict[str, Scene] = {}
+    for text in [s.strip() for s in scenes.split(",") if s.strip()]:
+        sc = _scene_arg(text)
+        assert isinstance(sc, Scene)
+        scene_objs[sc.name] = sc
+    if not scene_objs:
+        raise InputError("scenes", scenes, "one or more scene names or YAML files")
+    # The MPC's small matrices run fastest single-threaded; spawned workers read this.
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=console,
+    ) as bar:
+        task = bar.add_task("planning", total=None)
+
+        def progress(what: str, done: int, total: int) -> None:
+            bar.update(task, description=what, completed=done, total=total or None)
+
+        rows, table, plans = run_compare(
+            scene_objs, names, trials, out, spec, workers, n_steps, time_limit, progress
+        )
+    header = (
+        f"{trials} trials per scene and planner; pushes uniform in [0, {push_max:g}] N s "
+        f"({spec.push_duration:g} s pulse, random direction, at 10-80 % of the walk), estimate noise "
+        f"{noise_pos:g} m / {noise_vel:g} m/s, placement error {placement_error:g} m, mismatch "
+        f"{mismatch:g}, control rate {rate:g} Hz; planner time limit {time_limit:g} s. Plans: "
+        + "; ".join(
+            f"{s}/{p}: {pl.status.value}, N={pl.n_steps}, {pl.solve_time:.1f} s"
+            for (s, p), pl in plans.items()
+        )
+        + "."
+    )
+    paths = write_outputs(out, rows, table, header)
+    for r in table:
+        console.print(
+            f"{r['scene']:>18} {r['planner']:>9}: mean ZMP {1000 * r['zmp_mean']:.2f} mm, "
+            f"max {1000 * r['zmp_max']:.2f} mm, success {100 * r['success_rate']:.0f}% "
+            f"({r['trials']} trials)"
+        )
+    console.print(f"wrote {', '.join(str(p) for p in paths)}")

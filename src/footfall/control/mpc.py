@@ -1,0 +1,723 @@
+"""MPC footstep / ankle-torque adjuster of document 000, section 5.4 (eq. 5.19a-e).
+
+At every control tick ``k_s`` of single-support phase ``i`` (standing on footstep ``p_i``), from the
+measured ALIP state, the controller optimises the remaining ankle torques ``u_{i,k}``
+(``k = k_s .. M-1``) and the horizontal position of the next footstep ``p_{i+1}``:
+
+    minimise  sum_{k=k_s+1}^{M} dt (x_k - x_k^ref)^T Q (x_k - x_k^ref)
+            + sum_{k=k_s}^{M-1} dt u_k^T R u_k                                    (5.19a)
+            + (p_{i+1} - p_{i+1}^ref)^T W (p_{i+1} - p_{i+1}^ref)
+            + (x_{i+1,1} - x_{i+1,1}^ref)^T Q_f (x_{i+1,1} - x_{i+1,1}^ref)
+    s.t.      x_{k+1} = A_d x_k + B_d u_k                                         (5.19b)
+              x_{i+1,1} = A_r x_M + B_r (p_{i+1} - p_i)                            (5.19c)
+              x_{k_s} = x_measured                                                (5.19d)
+              ||u_k||_2 <= U_max                                                  (5.19e)
+
+``x_k^ref`` is the zero-torque ("natural") trajectory from the measured state, so
+``x_k - x_k^ref`` depends on the torques only: the tracking term is a torque-shaping term whose
+Hessian does not depend on the measurement.
+
+Discretisation (how the planner's K nodes meet the M control ticks). The MPC runs at the control
+rate: one single support has ``M = round(T_ss / dt_c)`` ticks and the dynamics (5.19b) use the exact
+ZOH matrices of one tick, so the prediction matches a plant that holds each torque for a tick. The
+torque is *blocked* on the planner's node grid: the M ticks are split into ``K - 1`` blocks of
+(almost) equal whole numbers of ticks, and the torque is constant within a block. At tick ``k_s``
+the decision variables are the torques of the blocks that are not over yet (the current block is
+partial) and the next footstep, so the horizon shrinks as ``k_s`` grows and the problem has at most
+``2 (K - 1) + 2`` variables. The stage terms are summed over every tick and scaled by ``dt_c``
+(``Q`` and ``R`` are weights per second), so the cost does not depend on the control rate.
+
+Condensed form. States are eliminated: with ``z = [u_blocks; d]``, ``d = p_{i+1} - p_i`` (x, y) and
+the parameter ``theta = [x_measured (4), d_ref (2), x_{i+1,1}^ref (4)]`` the cost is
+``1/2 z^T H z + z^T F theta + c(theta)`` with ``H``, ``F`` precomputed for every ``k_s`` by
+:func:`build_mpc`. ``B_r`` has a zero z column (eq. 5.10), so the footstep height does not enter the
+dynamics; it is kept at the reference height.
+
+Solver (an exact equivalent of the SOC constraint). The footstep is unconstrained, so it is
+eliminated in closed form; what is left is a strictly convex QP in the torque blocks with one 2-D
+Euclidean ball per block (eq. 5.19e as ``1/2 (||u_j||^2 - U_max^2) <= 0``, not a box). It is solved
+exactly through its dual: for multipliers ``lambda >= 0`` the minimiser is
+``u(lambda) = -(P + Lambda)^-1 q`` and the concave dual is maximised by a projected Newton method
+(Bertsekas 1982) with an Armijo search, warm-started from the previous tick's multipliers. Slater's
+condition holds (``u = 0`` is strictly feasible), so there is no duality gap, and the returned
+torques are projected onto the balls (a move of at most the tolerance) so (5.19e) holds exactly.
+When no ball is active the solution is one matrix-vector product with a precomputed gain. A
+Clarabel (interior-point SOCP) backend solves the same condensed problem for cross-checking.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.linalg.lapack import dposv, dpotrf, dtrtri
+
+from footfall._validate import finite, positive
+from footfall.errors import InputError
+from footfall.models.biped import BipedParams
+
+FloatArray = NDArray[np.float64]
+
+#: index slices into the parameter vector theta = [x_measured, d_ref, x_next_ref]
+THETA_X = slice(0, 4)
+THETA_D = slice(4, 6)
+THETA_XREF = slice(6, 10)
+N_THETA = 10
+
+#: MPC backends
+SOLVERS = ("newton", "clarabel")
+
+#: stop when the dual projected gradient 1/2 (1 - ||u_j / U_max||^2) is below this (a relative
+#: error of 1e-9 in the torque norms; the dual objective is only known to ~1e-13 relative, so much
+#: tighter tolerances would stall the line search)
+DUAL_TOL = 1e-9
+#: projected Newton iteration limit (a well-posed instance takes fewer than 15)
+MAX_NEWTON_ITER = 50
+
+
+class MPCStatus(str, Enum):
+    """Outcome of one MPC solve."""
+
+    OPTIMAL = "optimal"  # solved to tolerance
+    FALLBACK = "fallback"  # the solve failed; the last good solution, shifted, is returned
+
+
+@dataclass(frozen=True)
+class MPCWeights:
+    """Weights of the MPC cost (eq. 5.19a), given in physical units so that defaults transfer.
+
+    The velocity weights act on the angular momentum through ``v = L / (m z_H)``, i.e. the
+    momentum entries of ``Q`` and ``Q_f`` are ``q_vel / (m z_H)^2``.
+
+    Attributes:
+        q_pos: Q on the CoM position deviation from the natural trajectory [1/(m^2 s)].
+        q_vel: Q on the CoM velocity deviation from the natural trajectory [1/((m/s)^2 s)].
+        r: R on the ankle torque [1/((N m)^2 s)]; 1e-3 makes 15 N m held for a 0.4 s step cost 0.09.
+        w: W on the next-footstep deviation from the plan [1/m^2]; 10 makes 10 cm cost 0.1.
+        qf_pos: Q_f on the CoM position (relative to the new foot) at the start of the next step
+            [1/m^2].
+        qf_vel: Q_f on the CoM velocity at the start of the next step [1/(m/s)^2].
+        qf_dcm: Q_f on the divergent component (capture point) ``xi = c + v / omega`` at the start
+            of the next step [1/m^2]. Only the divergent component needs correcting: the
+            convergent one decays by itself, so a Q_f that weighs it (a rank-2 term
+            ``C_xi^T C_xi``) lets the footstep absorb pushes instead of the ankle (capture-point
+            stepping); diagonal position/velocity weights alone make the one-step horizon fight a
+            velocity error with torque and saturate. 1000 makes a 1 cm error cost 0.1.
+
+    The defaults were chosen in the reduced-order closed loop (``footfall.sim``): with
+    ``qf_dcm = 0`` and ``qf_pos = qf_vel = 100`` a 10 N s sideways push on the flat scene makes the
+    robot fall, with these it recovers.
+    """
+
+    q_pos: float = 1.0
+    q_vel: float = 0.1
+    r: float = 1e-3
+    w: float = 10.0
+    qf_pos: float = 1.0
+    qf_vel: float = 1.0
+    qf_dcm: float = 1000.0
+
+    def __post_init__(self) -> None:
+        for name in ("q_pos", "q_vel", "qf_pos", "qf_vel", "qf_dcm"):
+            v = finite(f"weights.{name}", getattr(self, name))
+            if v < 0.0:
+                raise InputError(f"weights.{name}", v, "a finite number >= 0")
+            object.__setattr__(self, name, v)
+        # R > 0 and W > 0 make the condensed Hessian positive definite (unique solution).
+        object.__setattr__(self, "r", positive("weights.r", self.r))
+        object.__setattr__(self, "w", positive("weights.w", self.w))
+
+    def matrices(self, robot: BipedParams) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """``(Q (4, 4), R (2, 2), W (2, 2), Q_f (4, 4))`` of eq. (5.19a) for ``robot``."""
+        mzh2 = (robot.mass * robot.com_height) ** 2
+        q = np.diag([self.q_pos, self.q_pos, self.q_vel / mzh2, self.q_vel / mzh2])
+        qf = np.diag([self.qf_pos, self.qf_pos, self.qf_vel / mzh2, self.qf_vel / mzh2])
+        # xi = c + v / omega with v = (L_y, -L_x) / (m z_H)
+        k = 1.0 / (robot.mass * robot.com_height * robot.alip().omega)
+        c_xi = np.array([[1.0, 0.0, 0.0, k], [0.0, 1.0, -k, 0.0]])
+        qf = qf + self.qf_dcm * c_xi.T @ c_xi
+        return q, self.r * np.eye(2), self.w * np.eye(2), qf
+
+
+@dataclass(frozen=True, eq=False)
+class CondensedMPC:
+    """The condensed MPC of eq. (5.19) for one gait, precomputed for every tick ``k_s``.
+
+    Built by :func:`build_mpc`. Per-tick entries are tuples indexed by ``k_s`` (0..M-1); ``n_b`` is
+    the number of remaining torque blocks at that tick and ``n_u = 2 n_b``.
+
+    Attributes:
+        robot: robot parameters (the controller's model).
+        weights: cost weights.
+        control_dt: control period dt_c = T_ss / M [s].
+        n_ticks: M, control ticks per single support.
+        n_nodes: K, planner nodes per single support (K - 1 torque blocks).
+        block_edges: tick index where each block starts, plus M at the end, shape (K,).
+        ad: one-tick ZOH state matrix (4, 4) (eq. 5.7a).
+        bd: one-tick ZOH input matrix (4, 2) (eq. 5.7b).
+        ar: reset map state matrix (4, 4) (eq. 5.9).
+        br: reset map input matrix (4, 3) (eq. 5.10, corrected).
+        Q, R, W, Qf: cost matrices (4, 4), (2, 2), (2, 2), (4, 4).
+        first_block: global index of the first remaining block at each ``k_s``.
+        block_ticks: remaining ticks of each remaining block, shape (n_b,) per ``k_s``.
+        a_end: end-of-single-support state from the measured state, ``x_M = a_end x + b_end u``,
+            (4, 4) per ``k_s``.
+        b_end: (4, n_u) per ``k_s``.
+        H: Hessian of the cost in ``z = [u; d]``, (n_u + 2, n_u + 2) per ``k_s``.
+        F: linear term ``z^T F theta``, (n_u + 2, 10) per ``k_s``.
+        c: constant term ``c(theta) = theta^T C theta``, (10, 10) per ``k_s``.
+    """
+
+    robot: BipedParams
+    weights: MPCWeights
+    control_dt: float
+    n_ticks: int
+    n_nodes: int
+    block_edges: NDArray[np.int64]
+    ad: FloatArray
+    bd: FloatArray
+    ar: FloatArray
+    br: FloatArray
+    Q: FloatArray
+    R: FloatArray
+    W: FloatArray
+    Qf: FloatArray
+    first_block: tuple[int, ...]
+    block_ticks: tuple[NDArray[np.int64], ...]
+    a_end: tuple[FloatArray, ...]
+    b_end: tuple[FloatArray, ...]
+    H: tuple[FloatArray, ...]
+    F: tuple[FloatArray, ...]
+    c: tuple[FloatArray, ...]
+    # Reduced problem in the scaled torques u / U_max with the footstep eliminated (see solve).
+    _p_scaled: tuple[FloatArray, ...] = field(repr=False, default=())
+    _q_map: tuple[FloatArray, ...] = field(repr=False, default=())
+    _gain: tuple[FloatArray, ...] = field(repr=False, default=())
+    _d_theta: tuple[FloatArray, ...] = field(repr=False, default=())
+    _d_u: tuple[FloatArray, ...] = field(repr=False, default=())
+    _powers: FloatArray = field(repr=False, default_factory=lambda: np.zeros((0, 4, 4)))
+    _sums: FloatArray = field(repr=False, default_factory=lambda: np.zeros((0, 4, 2)))
+
+    def n_blocks(self, k_s: int) -> int:
+        """Number of remaining torque blocks at tick ``k_s``."""
+        return int(self.block_ticks[k_s].shape[0])
+
+    def block_of_tick(self, k: int) -> int:
+        """Global block index (0..K-2) that holds tick ``k``."""
+        return int(np.searchsorted(self.block_edges, k, side="right") - 1)
+
+    def stacked(self, k_s: int) -> tuple[FloatArray, FloatArray]:
+        """Condensed prediction of the states at ticks ``k_s + 1 .. M`` (eq. 5.19b, d).
+
+        ``x_k = Phi[k - k_s - 1] x_{k_s} + Gamma[k - k_s - 1] u`` with ``u`` the remaining torque
+        blocks (n_u,), block ``j`` held over its ticks.
+
+        Returns:
+            ``(Phi (T, 4, 4), Gamma (T, 4, n_u))`` with ``T = M - k_s``.
+        """
+        m = self.n_ticks
+        k = np.arange(k_s + 1, m + 1)
+        phi = self._powers[k - k_s]
+        j0 = self.first_block[k_s]
+        n_b = self.n_blocks(k_s)
+        gamma = np.zeros((k.shape[0], 4, 2 * n_b))
+        for j in range(n_b):
+            a = max(int(self.block_edges[j0 + j]), k_s)
+            b = int(self.block_edges[j0 + j + 1])
+            # Block j acts on ticks a..b-1; the state at tick k has felt min(k, b) - a of them,
+            # the last one min(k, b) - 1 ticks ago: Ad^(k - min(k, b)) * sum_{i < n} Ad^i Bd.
+            last = np.clip(k, a, b)
+            gamma[:, :, 2 * j : 2 * j + 2] = self._powers[k - last] @ self._sums[last - a]
+        return phi, gamma
+
+    def cost(self, k_s: int, z: ArrayLike, theta: ArrayLike) -> float:
+        """Condensed cost ``1/2 z^T H z + z^T F theta + c(theta)`` of eq. (5.19a)."""
+        zz = np.asarray(z, dtype=float)
+        th = np.asarray(theta, dtype=float)
+        return float(0.5 * zz @ self.H[k_s] @ zz + zz @ self.F[k_s] @ th + th @ self.c[k_s] @ th)
+
+
+def _check_int(name: str, value: object, lo: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or int(value) < lo:
+        raise InputError(name, value, f"an integer >= {lo}")
+    return int(value)
+
+
+def build_mpc(
+    robot: BipedParams,
+    weights: MPCWeights | None = None,
+    control_dt: float = 0.002,
+    n_nodes: int | None = None,
+) -> CondensedMPC:
+    """Build the condensed MPC of eq. (5.19) for every tick of a single support.
+
+    Args:
+        robot: robot parameters (mass, CoM height, T_ss, T_ds, U_max) of the controller's model.
+        weights: cost weights (defaults: :class:`MPCWeights`).
+        control_dt: requested control period [s]; the used period is ``T_ss / M`` with
+            ``M = round(T_ss / control_dt)`` so that a single support is a whole number of ticks.
+        n_nodes: K, nodes of the torque blocking (default ``robot.n_nodes``); K - 1 blocks.
+
+    Returns:
+        The precomputed :class:`CondensedMPC`.
+    """
+    weights = weights or MPCWeights()
+    if not isinstance(weights, MPCWeights):
+        raise InputError("weights", weights, "an MPCWeights")
+    control_dt = positive("control_dt", control_dt)
+    k_nodes = _check_int("n_nodes", robot.n_nodes if n_nodes is None else n_nodes, 2)
+    m = round(robot.t_ss / control_dt)
+    if m < k_nodes - 1:
+        raise InputError(
+            "control_dt", control_dt, f"at most T_ss / (K - 1) = {robot.t_ss / (k_nodes - 1):g} s"
+        )
+    dt = robot.t_ss / m
+    alip = robot.alip()
+    ad, bd = alip.discretize(dt)
+    ar, br = alip.reset_map(robot.t_ds)
+    q, r, w, qf = weights.matrices(robot)
+    edges = np.round(np.linspace(0, m, k_nodes)).astype(np.int64)
+    powers = np.empty((m + 1, 4, 4))
+    sums = np.empty((m + 1, 4, 2))
+    powers[0], sums[0] = np.eye(4), 0.0
+    for n in range(1, m + 1):
+        powers[n] = ad @ powers[n - 1]
+        sums[n] = sums[n - 1] + powers[n - 1] @ bd
+    u_max = robot.u_max
+
+    proto = CondensedMPC(
+        robot=robot,
+        weights=weights,
+        control_dt=dt,
+        n_ticks=m,
+        n_nodes=k_nodes,
+        block_edges=edges,
+        ad=ad,
+        bd=bd,
+        ar=ar,
+        br=br,
+        Q=q,
+        R=r,
+        W=w,
+        Qf=qf,
+        first_block=(),
+        block_ticks=(),
+        a_end=(),
+        b_end=(),
+        H=(),
+        F=(),
+        c=(),
+        _powers=powers,
+        _sums=sums,
+    )
+    first: list[int] = []
+    ticks: list[NDArray[np.int64]] = []
+    for k_s in range(m):
+        j0 = int(np.searchsorted(edges, k_s, side="right") - 1)
+        first.append(j0)
+        t = edges[j0 + 1 :] - np.maximum(edges[j0:-1], k_s)
+        ticks.append(t.astype(np.int64))
+    object.__setattr__(proto, "first_block", tuple(first))
+    object.__setattr__(proto, "block_ticks", tuple(ticks))
+
+    a_end, b_end, hs, fs, cs = [], [], [], [], []
+    p_sc, q_map, gains, d_th, d_u = [], [], [], [], []
+    br2 = br[:, :2]
+    for k_s in range(m):
+        phi, gamma = proto.stacked(k_s)
+        n_u = gamma.shape[2]
+        n_z = n_u + 2
+        a_end.append(phi[-1])
+        b_end.append(gamma[-1])
+        h = np.zeros((n_z, n_z))
+        # Stage terms (5.19a), summed over ticks and scaled by dt (weights per second).
+        h[:n_u, :n_u] = 2.0 * dt * np.einsum("kai,ab,kbj->ij", gamma, q, gamma)
+        h[:n_u, :n_u] += np.kron(np.diag(2.0 * dt * ticks[k_s]), r)
+        # Footstep and next-step terms: residuals r_w = S_d z + D theta, r_f = C_z z + C_th theta.
+        s_d = np.zeros((2, n_z))
+        s_d[:, n_u:] = np.eye(2)
+        d_map = np.zeros((2, N_THETA))
+        d_map[:, THETA_D] = -np.eye(2)
+        c_z = np.hstack([ar @ gamma[-1], br2])  # (5.19c) with x_M from (5.19b)
+        c_th = np.zeros((4, N_THETA))
+        c_th[:, THETA_X] = ar @ phi[-1]
+        c_th[:, THETA_XREF] = -np.eye(4)
+        h += 2.0 * (s_d.T @ w @ s_d + c_z.T @ qf @ c_z)
+        f = 2.0 * (s_d.T @ w @ d_map + c_z.T @ qf @ c_th)
+        c = d_map.T @ w @ d_map + c_th.T @ qf @ c_th
+        hs.append(h)
+        fs.append(f)
+        cs.append(c)
+        # Eliminate d (unconstrained): d = -H_dd^-1 (F_d theta + H_du u).
+        h_uu, h_ud, h_dd = h[:n_u, :n_u], h[:n_u, n_u:], h[n_u:, n_u:]
+        h_dd_inv = np.linalg.inv(h_dd)
+        p_red = h_uu - h_ud @ h_dd_inv @ h_ud.T
+        p_red = 0.5 * (p_red + p_red.T)
+        f_red = f[:n_u] - h_ud @ h_dd_inv @ f[n_u:]
+        # Scaled torques v = u / U_max put the balls at radius 1 (better-conditioned multipliers).
+        p_sc.append(u_max**2 * p_red)
+        q_map.append(u_max * f_red)
+        gains.append(-np.linalg.solve(p_red, f_red))
+        d_th.append(-h_dd_inv @ f[n_u:])
+        d_u.append(-h_dd_inv @ h_ud.T)
+    for name, val in (
+        ("a_end", a_end),
+        ("b_end", b_end),
+        ("H", hs),
+        ("F", fs),
+        ("c", cs),
+        ("_p_scaled", p_sc),
+        ("_q_map", q_map),
+        ("_gain", gains),
+        ("_d_theta", d_th),
+        ("_d_u", d_u),
+    ):
+        object.__setattr__(proto, name, tuple(val))
+    return proto
+
+
+@dataclass(frozen=True)
+class MPCSolution:
+    """Result of one MPC solve (eq. 5.19).
+
+    Attributes:
+        k_s: control tick within the single support.
+        torques: remaining block torques ``u`` [N m], shape (n_b, 2); row 0 is applied now.
+        block_ticks: ticks each block lasts from now, shape (n_b,).
+        next_footstep: optimised ``p_{i+1}`` (3,) [m] (height = reference height).
+        status: :class:`MPCStatus`.
+        fallback: True when the solve failed and the last good solution (shifted) is returned.
+        solve_time: wall time of the solve [s].
+        iterations: projected Newton iterations (0 when no torque bound is active).
+        multipliers: dual variables of the torque balls (scaled problem), shape (n_b,).
+        message: why a fallback happened.
+    """
+
+    k_s: int
+    torques: FloatArray
+    block_ticks: NDArray[np.int64]
+    next_footstep: FloatArray
+    status: MPCStatus
+    fallback: bool
+    solve_time: float
+    iterations: int = 0
+    multipliers: FloatArray = field(default_factory=lambda: np.zeros(0))
+    message: str = ""
+
+    @property
+    def torque(self) -> FloatArray:
+        """The torque to apply at this tick (2,) [N m]."""
+        return self.torques[0]
+
+
+def solve_ball_qp(
+    p: FloatArray,
+    q: FloatArray,
+    lam0: FloatArray | None = None,
+    tol: float = DUAL_TOL,
+    max_iter: int = MAX_NEWTON_ITER,
+) -> tuple[FloatArray, FloatArray, int, bool]:
+    """Minimise ``1/2 v^T P v + q^T v`` s.t. ``||v_j||_2 <= 1`` for each 2-D block ``v_j``.
+
+    Projected Newton on the dual (see the module docstring). ``P`` must be positive definite.
+
+    Args:
+        p: (n, n) with n even.
+        q: (n,).
+        lam0: warm start for the multipliers (n / 2,), >= 0.
+        tol: tolerance on the dual projected gradient ``1/2 (1 - ||v_j||^2)``.
+        max_iter: iteration limit.
+
+    Returns:
+        ``(v (n,), lambda (n / 2,), iterations, converged)``; ``v`` is projected onto the balls.
+    """
+    n = q.shape[0]
+    n_b = n // 2
+    diag = np.arange(n)
+    if lam0 is None:
+        # Cold start from the exact multiplier of each block alone with P ~ P_jj I:
+        # ||q_j|| / (P_jj + lambda_j) = 1 at the unconstrained norm ||v_j|| = ||q_j|| / P_jj.
+        pjj = 0.5 * (p[diag[::2], diag[::2]] + p[diag[1::2], diag[1::2]])
+        v_unc = np.linalg.solve(p, -q).reshape(n_b, 2)
+        lam = pjj * np.maximum(np.linalg.norm(v_unc, axis=1) - 1.0, 0.0)
+    else:
+        lam = np.maximum(np.asarray(lam0, dtype=float), 0.0)
+
+    def evaluate(lam: FloatArray) -> tuple[FloatArray, FloatArray, float]:
+        mat = p.copy()
+        mat[diag, diag] += np.repeat(lam, 2)
+        # S = (P + Lambda)^-1 = L^-T L^-1 from the Cholesky factor (LAPACK directly: the numpy
+        # wrappers cost more than the arithmetic at this size).
+        chol, info = dpotrf(mat, lower=1, clean=1)
+        if info != 0:
+            raise np.linalg.LinAlgError(f"P + Lambda not positive definite (info {info})")
+        linv, info = dtrtri(chol, lower=1)
+        if info != 0:
+            raise np.linalg.LinAlgError(f"singular Cholesky factor (info {info})")
+        s = linv.T @ linv
+        v = -(s @ q)
+        # dual objective to minimise: phi = -g = 1/2 q^T S q + 1/2 sum(lambda)
+        return s, v, float(-0.5 * (q @ v) + 0.5 * lam.sum())
+
+    s, v, phi = evaluate(lam)
+    converged = False
+    it = 0
+    for it in range(max_iter + 1):
+        vb = v.reshape(n_b, 2)
+        grad = 0.5 * (1.0 - np.einsum("ij,ij->i", vb, vb))
+        viol = np.where(lam > 0.0, np.abs(grad), np.maximum(-grad, 0.0))
+        if viol.max() <= tol:
+            converged = True
+            break
+        if it == max_iter:
+            break
+        # Multipliers at (or within eps of) zero whose gradient pushes them down stay at zero.
+        eps = min(1e-3, float(np.sqrt(np.sum((lam - np.maximum(lam - grad, 0.0)) ** 2))))
+        bound = (lam <= eps) & (grad > 0.0)
+        free = ~bound
+        step = -grad
+        if free.any():
+            hess = np.einsum("ja,jalb,lb->jl", vb, s.reshape(n_b, 2, n_b, 2), vb)
+            hf = hess[free][:, free] if bound.any() else hess
+            hf.flat[:: hf.shape[0] + 1] += 1e-12 * (1.0 + np.trace(hf))
+            # Secular (More-Sorensen) Newton step: Newton on 1/||v_j|| - 1, which is close to
+            # linear in lambda (exactly so for P = p I), i.e. the dual Hessian system with the
+            # gradient rescaled per block by 2 ||v_j||^2 / (1 + ||v_j||). Far fewer iterations than
+            # Newton on the dual gradient; kept only while it is a descent direction of the dual.
+            nrm = np.sqrt(1.0 - 2.0 * grad[free])
+            rhs = np.stack([grad[free], grad[free] * 2.0 * nrm**2 / (1.0 + nrm)], axis=1)
+            _, sol, info = dposv(hf, rhs)
+            if info != 0:
+                raise np.linalg.LinAlgError(f"singular dual Hessian (info {info})")
+            step[free] = -sol[:, 1] if grad[free] @ sol[:, 1] > 0.0 else -sol[:, 0]
+        alpha = 1.0
+        while True:
+            lam_new = np.maximum(lam + alpha * step, 0.0)
+            s_new, v_new, phi_new = evaluate(lam_new)
+            decrease = float(grad @ (lam_new - lam))
+            # Accept on sufficient decrease, or when the predicted decrease is below the rounding
+            # error of phi (then only the gradient test above is meaningful).
+            if phi_new <= phi + 1e-4 * decrease or abs(decrease) <= 1e-13 * (1.0 + abs(phi)):
+                break
+            if alpha < 1e-10:
+                break
+            alpha *= 0.5
+        lam, s, v, phi = lam_new, s_new, v_new, phi_new
+    vb = v.reshape(n_b, 2)
+    norms = np.sqrt(np.einsum("ij,ij->i", vb, vb))
+    vb = vb / np.maximum(norms, 1.0)[:, None]
+    return vb.ravel(), lam, it, converged
+
+
+class MPC:
+    """The footstep / ankle-torque adjuster (eq. 5.19) running at the control rate.
+
+    Holds the condensed model, warm starts and failure counters for one walk. Call
+    :meth:`solve` at every tick of a single support with the measured state; ``k_s`` restarting
+    from a smaller value marks a new single support.
+
+    Args:
+        condensed: output of :func:`build_mpc`.
+        solver: ``newton`` (exact dual projected Newton, default) or ``clarabel`` (conic
+            interior point on the same condensed problem).
+    """
+
+    def __init__(self, condensed: CondensedMPC, solver: str = "newton") -> None:
+        if not isinstance(condensed, CondensedMPC):
+            raise InputError("condensed", condensed, "a CondensedMPC from build_mpc")
+        if solver not in SOLVERS:
+            raise InputError("solver", solver, f"one of {', '.join(SOLVERS)}")
+        self.model = condensed
+        self.solver = solver
+        self.n_solves = 0
+        self.n_fallbacks = 0
+        self._last: MPCSolution | None = None
+        self._clarabel: dict[int, Any] = {}
+
+    def reset(self) -> None:
+        """Forget warm starts and the last solution (counters are kept)."""
+        self._last = None
+
+    def solve(
+        self,
+        k_s: int,
+        x_measured: ArrayLike,
+        p_stance: ArrayLike,
+        p_next_ref: ArrayLike,
+        x_next_ref: ArrayLike,
+    ) -> MPCSolution:
+        """Solve eq. (5.19) at tick ``k_s``.
+
+        Args:
+            k_s: control tick in the single support, 0 <= k_s < M.
+            x_measured: measured ALIP state (4,) relative to the stance foot (eq. 5.19d).
+            p_stance: stance footstep p_i (3,) [m].
+            p_next_ref: planned next footstep p_{i+1}^ref (3,) [m].
+            x_next_ref: planned state after the next reset x_{i+1,1}^ref (4,).
+
+        Returns:
+            The :class:`MPCSolution`; a failed solve returns the last good solution shifted to
+            ``k_s`` (or zero torque and the reference footstep) with ``fallback=True``.
+        """
+        t0 = time.perf_counter()
+        mdl = self.model
+        if isinstance(k_s, bool) or not isinstance(k_s, int | np.integer):
+            raise InputError("k_s", k_s, f"an integer tick in [0, {mdl.n_ticks})")
+        k_s = int(k_s)
+        if not 0 <= k_s < mdl.n_ticks:
+            raise InputError("k_s", k_s, f"an integer tick in [0, {mdl.n_ticks})")
+        x = np.asarray(x_measured, dtype=float)
+        ps = np.asarray(p_stance, dtype=float)
+        pr = np.asarray(p_next_ref, dtype=float)
+        xr = np.asarray(x_next_ref, dtype=float)
+        for name, arr, n in (
+            ("x_measured", x, 4),
+            ("p_stance", ps, 3),
+            ("p_next_ref", pr, 3),
+            ("x_next_ref", xr, 4),
+        ):
+            if arr.shape != (n,):
+                raise InputError(name, arr.tolist(), f"shape ({n},)")
+        theta = np.concatenate([x, pr[:2] - ps[:2], xr])
+        return self.solve_theta(k_s, theta, ps, pr, t0)
+
+    def solve_theta(
+        self,
+        k_s: int,
+        theta: FloatArray,
+        p_stance: FloatArray,
+        p_next_ref: FloatArray,
+        t0: float | None = None,
+    ) -> MPCSolution:
+        """:meth:`solve` without input checks, from the parameter vector (for simulation loops).
+
+        Args:
+            k_s: control tick, 0 <= k_s < M (not checked).
+            theta: ``[x_measured (4), (p_next_ref - p_stance)[:2], x_next_ref (4)]``, shape (10,).
+            p_stance: (3,) [m].
+            p_next_ref: (3,) [m].
+            t0: ``time.perf_counter()`` at the start of the caller's solve (for solve_time).
+        """
+        t0 = time.perf_counter() if t0 is None else t0
+        mdl = self.model
+        ps, pr = p_stance, p_next_ref
+        if self._last is not None and k_s <= self._last.k_s:
+            self._last = None  # a new single support: nothing to shift
+        self.n_solves += 1
+        # one reduction instead of isfinite().all(): a NaN or inf anywhere makes the sum non-finite
+        if not math.isfinite(float(theta.sum())):
+            return self._fallback(k_s, ps, pr, t0, "non-finite measurement or reference")
+        lam0 = None
+        if self._last is not None:
+            shift = mdl.first_block[k_s] - mdl.first_block[self._last.k_s]
+            lam0 = self._last.multipliers[shift:]
+        try:
+            if self.solver == "newton":
+                u, lam, iters, ok = self._solve_newton(k_s, theta, lam0)
+            else:
+                u, lam, iters, ok = self._solve_clarabel(k_s, theta)
+        except (np.linalg.LinAlgError, ValueError) as exc:
+            return self._fallback(k_s, ps, pr, t0, f"solver error: {exc}")
+        if not ok or not math.isfinite(float(u.sum())):
+            return self._fallback(k_s, ps, pr, t0, "solver did not converge")
+        d = mdl._d_theta[k_s] @ theta + mdl._d_u[k_s] @ u
+        sol = MPCSolution(
+            k_s=k_s,
+            torques=u.reshape(-1, 2),
+            block_ticks=mdl.block_ticks[k_s],
+            next_footstep=np.array([ps[0] + d[0], ps[1] + d[1], pr[2]]),
+            status=MPCStatus.OPTIMAL,
+            fallback=False,
+            solve_time=time.perf_counter() - t0,
+            iterations=iters,
+            multipliers=lam,
+        )
+        self._last = sol
+        return sol
+
+    def _solve_newton(
+        self, k_s: int, theta: FloatArray, lam0: FloatArray | None
+    ) -> tuple[FloatArray, FloatArray, int, bool]:
+        mdl = self.model
+        u_max = mdl.robot.u_max
+        u = mdl._gain[k_s] @ theta
+        ub = u.reshape(-1, 2)
+        if np.einsum("ij,ij->i", ub, ub).max() <= u_max**2:
+            # No ball active: the unconstrained minimiser is optimal (all multipliers zero).
+            return u, np.zeros(ub.shape[0]), 0, True
+        q = mdl._q_map[k_s] @ theta
+        v, lam, iters, ok = solve_ball_qp(mdl._p_scaled[k_s], q, lam0)
+        return u_max * v, lam, iters, ok
+
+    def _solve_clarabel(
+        self, k_s: int, theta: FloatArray
+    ) -> tuple[FloatArray, FloatArray, int, bool]:
+        import clarabel
+        from scipy import sparse
+
+        mdl = self.model
+        p = mdl._p_scaled[k_s]
+        q = mdl._q_map[k_s] @ theta
+        n = q.shape[0]
+        n_b = n // 2
+        solver = self._clarabel.get(k_s)
+        if solver is None:
+            # s = b - A v in the product of second-order cones (1, v_j) for each block.
+            rows = []
+            for j in range(n_b):
+                rows.append(np.zeros(n))
+                e = np.zeros((2, n))
+                e[0, 2 * j] = e[1, 2 * j + 1] = -1.0
+                rows.extend(e)
+            a = sparse.csc_matrix(np.array(rows))
+            b = np.tile([1.0, 0.0, 0.0], n_b)
+            settings = clarabel.DefaultSettings()
+            settings.verbose = False
+            settings.presolve_enable = False
+            cones = [clarabel.SecondOrderConeT(3)] * n_b
+            solver = clarabel.DefaultSolver(sparse.triu(p, format="csc"), q, a, b, cones, settings)
+            self._clarabel[k_s] = solver
+        else:
+            solver.update(q=q)
+        res = solver.solve()
+        ok = str(res.status) in ("Solved", "AlmostSolved")
+        v = np.asarray(res.x, dtype=float)
+        vb = v.reshape(n_b, 2)
+        vb = vb / np.maximum(np.linalg.norm(vb, axis=1), 1.0)[:, None]
+        z = np.asarray(res.z, dtype=float).reshape(n_b, 3)
+        # The SOC multiplier z_0 of block j equals lambda_j ||v_j|| = lambda_j on the sphere.
+        return mdl.robot.u_max * vb.ravel(), z[:, 0], int(res.iterations), ok
+
+    def _fallback(
+        self, k_s: int, ps: FloatArray, pr: FloatArray, t0: float, message: str
+    ) -> MPCSolution:
+        """The last good solution shifted to ``k_s``, or zero torque and the reference footstep."""
+        mdl = self.model
+        self.n_fallbacks += 1
+        n_b = mdl.n_blocks(k_s)
+        last = self._last
+        if last is not None:
+            shift = mdl.first_block[k_s] - mdl.first_block[last.k_s]
+            torques = last.torques[shift:]
+            lam = last.multipliers[shift:]
+            foot = last.next_footstep
+        else:
+            torques = np.zeros((n_b, 2))
+            lam = np.zeros(n_b)
+            foot = np.array(pr, dtype=float) if np.all(np.isfinite(pr)) else np.array(ps, float)
+        return MPCSolution(
+            k_s=k_s,
+            torques=np.array(torques),
+            block_ticks=mdl.block_ticks[k_s],
+            next_footstep=np.array(foot),
+            status=MPCStatus.FALLBACK,
+            fallback=True,
+            solve_time=time.perf_counter() - t0,
+            multipliers=np.array(lam),
+            message=message,
+        )

@@ -1,0 +1,559 @@
+"""Closed-loop reduced-order simulation: footstep plan -> MPC (eq. 5.19) -> ALIP plant with a real foot.
+
+Plant. The continuous ALIP dynamics (eq. 5.2-5.4) with the *true* mass and CoM height (model
+mismatch options), integrated exactly (matrix exponential) with the applied torque held constant
+over sub-steps of the control period; push forces switch on and off on the sub-step grid. When
+nothing switches inside a control tick the sub-steps compose into the exact one-tick matrices (the
+same numbers up to rounding), which keeps the loop fast. A horizontal push force ``F`` on the CoM
+at height ``z_H`` changes the angular momentum about the contact point like the torque
+``z_H (-F_y, F_x)``.
+
+Foot. Each sole is a ``foot_length x foot_width`` rectangle centred on the footstep and aligned with
+its planned heading. The MPC's torque command implies a centre of pressure (CoP)
+``stance + (-tau_y, tau_x) / (m g)``; the ground can only put the CoP inside the sole, so the CoP
+is clipped to the rectangle (in the foot frame) and the applied torque is the one of the clipped
+CoP, with the true weight.
+
+Double support. After each single support the swing foot lands at the MPC's footstep (plus the
+optional placement error) and the contact point moves linearly from the old to the new foot over
+``T_ds`` with no ankle torque: exactly the assumption of the reset map (eq. 5.8-5.10), integrated
+here with the true parameters; the state is then re-expressed relative to the new foot.
+
+Fall (precise definition). Let ``xi = c + v / omega`` be the ALIP's divergent component (capture
+point) relative to the stance foot, in the foot's heading frame, and ``T_r`` the time left until
+the next touchdown. The robot has *fallen* when, at any sample of a single support, along either
+axis ``|xi| > d_0 + (d_inf + l - d_0) exp(-omega T_r)``, where ``d_0`` is the sole half-size along
+that axis, ``l`` the reach of a step in that direction (bounding box of the reach trapezoid:
+forward ``max x``, backward ``-min x``, sideways ``max |y|``), and
+``d_inf = d_0 + l e / (1 - e)``, ``e = exp(-omega (T_ss + T_ds))``, the fixed point of the N-step
+capturability recursion ``d_n = d_0 + (d_{n-1} + l - d_0) e`` (Koolen et al. 2012). The bound is
+optimistic (CoP anywhere in the sole, the whole reach box, instantaneous transfer at touchdown), so
+outside it no footstep sequence with the robot's timing can stop the robot: a sure fall. The run
+stops at the fall. The state also counts as fallen when it becomes non-finite. Separately, the run
+*stops* (comes to rest without another step) when after the last footstep the capture point lies in
+the convex hull of the two final soles; ``success = not fell and stopped``.
+
+ZMP measure (document 000, section 5.5): the distance of the realised CoP from the stance foot centre
+at every control tick of every single support; mean, RMS and max over the walk and per phase.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from footfall._validate import finite, non_negative, positive
+from footfall.control.mpc import MPC, SOLVERS, CondensedMPC, MPCWeights, build_mpc
+from footfall.errors import InputError
+from footfall.models._linear import zoh
+from footfall.models.alip import ALIP
+from footfall.models.biped import BipedParams
+from footfall.planning.plan import FootstepPlan
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Push:
+    """A horizontal push on the CoM: a constant force pulse.
+
+    Attributes:
+        time: start time from the beginning of the walk [s], >= 0.
+        impulse: impulse magnitude [N s], >= 0 (force = impulse / duration).
+        direction: direction of the force in the world frame [rad] (0 = +x, forward at start).
+        duration: pulse length [s], > 0.
+    """
+
+    time: float
+    impulse: float
+    direction: float = 0.0
+    duration: float = 0.1
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "time", non_negative("push.time", self.time))
+        object.__setattr__(self, "impulse", non_negative("push.impulse", self.impulse))
+        object.__setattr__(self, "direction", finite("push.direction", self.direction))
+        object.__setattr__(self, "duration", positive("push.duration", self.duration))
+
+    @property
+    def force(self) -> FloatArray:
+        """Force vector (2,) [N] during the pulse."""
+        f = self.impulse / self.duration
+        return np.array([f * math.cos(self.direction), f * math.sin(self.direction)])
+
+
+@dataclass(frozen=True)
+class SimOptions:
+    """Options of :func:`simulate`.
+
+    Attributes:
+        control_rate: MPC rate [Hz] (the period is adjusted so T_ss is a whole number of ticks).
+        substeps: plant sub-steps per control tick (push switching resolution), >= 1.
+        noise_pos: standard deviation of the CoM position estimate [m].
+        noise_vel: standard deviation of the CoM velocity estimate [m/s] (momentum noise
+            ``m z_H noise_vel``).
+        mass_scale: true mass / model mass (model mismatch), > 0.
+        com_height_scale: true CoM height / model CoM height, > 0.
+        pushes: push disturbances.
+        placement_error: standard deviation of the landing position error, per axis [m].
+        seed: random seed of the noise and placement error.
+        foot_length: sole length [m] (default: the robot's).
+        foot_width: sole width [m] (default: the robot's).
+        weights: MPC weights (eq. 5.19a).
+        mpc_nodes: torque blocks + 1 of the MPC (default: the plan robot's K).
+        solver: MPC backend, ``newton`` or ``clarabel``.
+    """
+
+    control_rate: float = 500.0
+    substeps: int = 4
+    noise_pos: float = 0.0
+    noise_vel: float = 0.0
+    mass_scale: float = 1.0
+    com_height_scale: float = 1.0
+    pushes: tuple[Push, ...] = ()
+    placement_error: float = 0.0
+    seed: int = 0
+    foot_length: float | None = None
+    foot_width: float | None = None
+    weights: MPCWeights = field(default_factory=MPCWeights)
+    mpc_nodes: int | None = None
+    solver: str = "newton"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "control_rate", positive("control_rate", self.control_rate))
+        for name in ("noise_pos", "noise_vel", "placement_error"):
+            object.__setattr__(self, name, non_negative(name, getattr(self, name)))
+        for name in ("mass_scale", "com_height_scale"):
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        for name in ("foot_length", "foot_width"):
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, positive(name, getattr(self, name)))
+        for name, lo in (("substeps", 1), ("seed", 0)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < lo:
+                raise InputError(name, v, f"an integer >= {lo}")
+        if isinstance(self.pushes, Push):
+            object.__setattr__(self, "pushes", (self.pushes,))
+        pushes = tuple(self.pushes)
+        for p in pushes:
+            if not isinstance(p, Push):
+                raise InputError("pushes", p, "Push objects")
+        object.__setattr__(self, "pushes", pushes)
+        if not isinstance(self.weights, MPCWeights):
+            raise InputError("weights", self.weights, "an MPCWeights")
+        if self.solver not in SOLVERS:
+            raise InputError("solver", self.solver, f"one of {', '.join(SOLVERS)}")
+
+
+@dataclass(frozen=True)
+class SimMetrics:
+    """Outcome of one closed-loop run (see the module docstring for the definitions).
+
+    Attributes:
+        fell: the capture point left the viable region (or the state blew up).
+        fall_time: time of the fall [s] (nan if none).
+        stopped: after the last footstep the capture point is inside the two final soles.
+        success: ``not fell and stopped``.
+        zmp_offset_mean: mean single-support CoP distance from the stance foot centre [m].
+        zmp_offset_rms: its RMS [m].
+        zmp_offset_max: its maximum [m].
+        zmp_offset_phase_mean: per single-support phase [m].
+        zmp_offset_phase_max: per single-support phase [m].
+        saturated_time: single-support time with the CoP clipped at the sole edge [s].
+        saturated_fraction: that time over the simulated single-support time.
+        footstep_dev_mean: mean horizontal distance of the landed footsteps from the plan [m].
+        footstep_dev_max: maximum of it [m].
+        goal_error: horizontal distance of the final CoM from the goal [m] (nan after a fall).
+        steps_taken: footsteps landed.
+        mpc_solves: MPC solves.
+        mpc_fallbacks: failed MPC solves replaced by the last good solution.
+        mpc_time_median: median MPC solve time [s].
+        mpc_time_max: maximum MPC solve time [s].
+        sim_time: simulated time [s].
+        wall_time: wall time of the run [s].
+    """
+
+    fell: bool
+    fall_time: float
+    stopped: bool
+    success: bool
+    zmp_offset_mean: float
+    zmp_offset_rms: float
+    zmp_offset_max: float
+    zmp_offset_phase_mean: tuple[float, ...]
+    zmp_offset_phase_max: tuple[float, ...]
+    saturated_time: float
+    saturated_fraction: float
+    footstep_dev_mean: float
+    footstep_dev_max: float
+    goal_error: float
+    steps_taken: int
+    mpc_solves: int
+    mpc_fallbacks: int
+    mpc_time_median: float
+    mpc_time_max: float
+    sim_time: float
+    wall_time: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (NaN becomes None)."""
+        out: dict[str, Any] = {}
+        for k, v in asdict(self).items():
+            if isinstance(v, tuple):
+                out[k] = [None if not math.isfinite(x) else float(x) for x in v]
+            elif isinstance(v, float) and not math.isfinite(v):
+                out[k] = None
+            else:
+                out[k] = v
+        return out
+
+
+@dataclass(frozen=True, eq=False)
+class SimResult:
+    """Trajectories and metrics of one run; arrays have one row per plant sample (control tick).
+
+    Attributes:
+        metrics: :class:`SimMetrics`.
+        t: sample times [s], shape (T,).
+        stance: index of the stance footstep, shape (T,) (during double support: the old foot).
+        single: True in single support, shape (T,).
+        com: world CoM horizontal position [m], shape (T, 2).
+        cop: realised world CoP [m], shape (T, 2).
+        cop_offset: realised CoP minus the stance foot centre, in the foot frame [m], shape (T, 2).
+        torque_cmd: MPC torque command [N m], shape (T, 2) (zero in double support).
+        torque: applied (clipped) ankle torque [N m], shape (T, 2).
+        saturated: CoP clipped at the sole edge, shape (T,).
+        footsteps: landed footsteps [m], shape (n + 1, 3).
+        plan_footsteps: planned footsteps [m], shape (N + 1, 3).
+        headings: footstep headings [rad], shape (n + 1,).
+        goal: goal position (2,) [m].
+        u_max: torque bound U_max [N m].
+        foot_length: sole length [m].
+        foot_width: sole width [m].
+        planner: name of the planner of the plan.
+    """
+
+    metrics: SimMetrics
+    t: FloatArray
+    stance: NDArray[np.int64]
+    single: NDArray[np.bool_]
+    com: FloatArray
+    cop: FloatArray
+    cop_offset: FloatArray
+    torque_cmd: FloatArray
+    torque: FloatArray
+    saturated: NDArray[np.bool_]
+    footsteps: FloatArray
+    plan_footsteps: FloatArray
+    headings: FloatArray
+    goal: FloatArray
+    u_max: float
+    foot_length: float
+    foot_width: float
+    planner: str
+
+
+def _rot(theta: float) -> FloatArray:
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s], [s, c]])
+
+
+def viability_bounds(
+    robot: BipedParams, omega: float, foot_length: float, foot_width: float
+) -> tuple[FloatArray, FloatArray]:
+    """Per-direction constants of the fall test (module docstring).
+
+    Returns:
+        ``(d0, d_plus_l)``, each (4,) for the directions (+x, -x, +y, -y) of the foot frame:
+        the sole half-size ``d_0`` and ``d_inf + l - d_0`` [m].
+    """
+    v = robot.reach.vertices
+    reach = np.array([v[:, 0].max(), -v[:, 0].min(), np.abs(v[:, 1]).max(), np.abs(v[:, 1]).max()])
+    d0 = np.array([foot_length, foot_length, foot_width, foot_width]) / 2.0
+    e = math.exp(-omega * (robot.t_ss + robot.t_ds))
+    d_inf = d0 + reach * e / (1.0 - e)
+    return d0, d_inf + reach - d0
+
+
+def _in_hull(point: FloatArray, corners: FloatArray) -> bool:
+    """Whether ``point`` (2,) lies in the convex hull of ``corners`` (n, 2)."""
+    from scipy.spatial import ConvexHull
+
+    hull = ConvexHull(corners)
+    return bool(np.all(hull.equations[:, :2] @ point + hull.equations[:, 2] <= 1e-12))
+
+
+def _sole_corners(foot: FloatArray, heading: float, length: float, width: float) -> FloatArray:
+    half = np.array([[1, 1], [-1, 1], [-1, -1], [1, -1]]) * np.array([length, width]) / 2.0
+    return np.asarray(foot[:2] + half @ _rot(heading).T)
+
+
+#: condensed MPCs by (robot, weights, rate, nodes) description: trials of one plan build it once
+_MPC_CACHE: dict[str, CondensedMPC] = {}
+_MPC_CACHE_SIZE = 8
+
+
+def _mpc_model(robot: BipedParams, opts: SimOptions) -> CondensedMPC:
+    # BipedParams compares by identity (unpickled copies differ), but its repr describes it fully.
+    key = f"{robot!r}|{opts.weights!r}|{opts.control_rate!r}|{opts.mpc_nodes!r}"
+    mdl = _MPC_CACHE.get(key)
+    if mdl is None:
+        if len(_MPC_CACHE) >= _MPC_CACHE_SIZE:
+            _MPC_CACHE.pop(next(iter(_MPC_CACHE)))
+        mdl = build_mpc(robot, opts.weights, 1.0 / opts.control_rate, opts.mpc_nodes)
+        _MPC_CACHE[key] = mdl
+    return mdl
+
+
+def simulate(
+    plan: FootstepPlan,
+    options: SimOptions | None = None,
+    goal: FloatArray | None = None,
+) -> SimResult:
+    """Walk ``plan`` in closed loop: MPC (eq. 5.19) on the ALIP plant with a rectangular sole.
+
+    Args:
+        plan: a footstep plan with states (its robot is the controller's model).
+        options: simulation options.
+        goal: goal position (2,) or (3,) [m]; default the midpoint of the last two footsteps.
+
+    Returns:
+        A :class:`SimResult`. Falls are reported in the metrics, never raised.
+    """
+    wall0 = time.perf_counter()
+    opts = options or SimOptions()
+    if not isinstance(plan, FootstepPlan):
+        raise InputError("plan", type(plan).__name__, "a FootstepPlan")
+    if not isinstance(opts, SimOptions):
+        raise InputError("options", opts, "a SimOptions")
+    n = plan.n_steps
+    if n < 1 or plan.states.shape[0] != n:
+        raise InputError("plan", plan.message or plan.status, "a plan with at least one footstep")
+    robot = plan.robot
+    mdl = _mpc_model(robot, opts)
+    mpc = MPC(mdl, opts.solver)
+    dt, m_ticks = mdl.control_dt, mdl.n_ticks
+    n_ds = max(1, round(robot.t_ds / dt))
+    dt_ds = robot.t_ds / n_ds
+    n_sub = opts.substeps
+    f_len = opts.foot_length or robot.foot_length
+    f_wid = opts.foot_width or robot.foot_width
+    half = np.array([f_len, f_wid]) / 2.0
+    goal_xy = (
+        0.5 * (plan.footsteps[-1, :2] + plan.footsteps[-2, :2])
+        if goal is None
+        else np.asarray(goal, dtype=float)[:2]
+    )
+
+    # True plant (model mismatch) and its exact one-tick, sub-step and double-support matrices.
+    true = ALIP(robot.mass * opts.mass_scale, robot.com_height * opts.com_height_scale, robot.g)
+    mg, mzh, zh = true.mass * true.g, true.mass * true.com_height, true.com_height
+    omega = true.omega
+    ad_t, bd_t = true.discretize(dt)
+    ad_s, bd_s = true.discretize(dt / n_sub)
+    a_aug = np.zeros((8, 8))
+    a_aug[:4, :4] = true.A
+    a_aug[:4, 4:6] = true.E[:, :2]  # contact displacement acts like the torque E d (eq. 5.10)
+    a_aug[4:6, 6:8] = np.eye(2)
+    b_aug = np.zeros((8, 2))
+    b_aug[2:4] = np.eye(2)
+    ad_ds, _ = zoh(a_aug, b_aug, dt_ds)
+    ad_dss, bd_dss = zoh(a_aug, b_aug, dt_ds / n_sub)
+    d0, d_span = viability_bounds(robot, omega, f_len, f_wid)
+
+    # Push torque z_H (-F_y, F_x) on every plant sub-step of the walk, tabulated once: row
+    # i (M + n_ds) + k is tick k of phase i (k >= M: double support), columns the sub-steps.
+    starts = np.concatenate(
+        [np.arange(m_ticks) * dt, robot.t_ss + np.arange(n_ds) * dt_ds]
+    )  # tick start within a step
+    lengths = np.concatenate([np.full(m_ticks, dt), np.full(n_ds, dt_ds)])
+    step_period = robot.t_ss + robot.t_ds
+    t_start = (np.arange(n)[:, None] * step_period + starts[None]).ravel()
+    h_sub = np.tile(lengths, n) / n_sub
+    mids = t_start[:, None] + (np.arange(n_sub)[None] + 0.5) * h_sub[:, None]
+    push_tab = np.zeros((t_start.shape[0], n_sub, 2))
+    for p in opts.pushes:
+        on = (mids >= p.time) & (mids < p.time + p.duration)
+        f = p.force
+        push_tab[on] += zh * np.array([-f[1], f[0]])
+    push_any = np.asarray(push_tab.any(axis=(1, 2)), dtype=bool)
+    push_const = np.asarray(np.all(push_tab == push_tab[:, :1], axis=(1, 2)), dtype=bool)
+
+    rng = np.random.default_rng(opts.seed)
+    noise = rng.standard_normal((n * m_ticks, 4)) * np.array(
+        [opts.noise_pos, opts.noise_pos, mzh * opts.noise_vel, mzh * opts.noise_vel]
+    )
+    place_err = rng.standard_normal((n, 2)) * opts.placement_error
+
+    total = n * (m_ticks + n_ds)
+    t_arr = np.zeros(total)
+    stance_arr = np.zeros(total, dtype=np.int64)
+    single = np.zeros(total, dtype=bool)
+    com = np.zeros((total, 2))
+    cop = np.zeros((total, 2))
+    cop_off = np.zeros((total, 2))
+    tau_cmd = np.zeros((total, 2))
+    tau = np.zeros((total, 2))
+    sat = np.zeros(total, dtype=bool)
+    solve_times: list[float] = []
+
+    x = np.array(plan.states[0, 0], dtype=float)
+    feet = [np.array(plan.footsteps[0], dtype=float)]
+    headings = [float(plan.headings[0])]
+    fell = False
+    fall_time = math.nan
+    j = 0  # sample index
+    t = 0.0
+    for i in range(n):
+        stance = feet[-1]
+        heading = float(plan.headings[i])
+        p_ref = plan.footsteps[i + 1]
+        x_ref = plan.states[i + 1, 0] if i + 1 < n else plan.final_state
+        sol = None
+        cth, sth = math.cos(heading), math.sin(heading)
+        hx, hy = float(half[0]), float(half[1])
+        theta = np.empty(10)
+        theta[4:6] = p_ref[:2] - stance[:2]
+        theta[6:] = x_ref
+        # exp(-omega T_r) of the fall bound for every tick (T_r = time to touchdown)
+        decay = np.exp(-omega * (m_ticks - 1 - np.arange(m_ticks)) * dt)
+        kxi = 1.0 / (mzh * omega)
+        for k in range(m_ticks):
+            theta[:4] = x
+            theta[:4] += noise[i * m_ticks + k]
+            sol = mpc.solve_theta(k, theta, stance, p_ref)
+            solve_times.append(sol.solve_time)
+            u_cmd = sol.torques[0]
+            # CoP of the command in the foot frame, clipped to the sole (the foot rolls otherwise).
+            cwx, cwy = -float(u_cmd[1]) / mg, float(u_cmd[0]) / mg
+            ox, oy = cth * cwx + sth * cwy, -sth * cwx + cth * cwy
+            cx, cy = min(max(ox, -hx), hx), min(max(oy, -hy), hy)
+            wx, wy = cth * cx - sth * cy, sth * cx + cth * cy
+            u = np.array([mg * wy, -mg * wx])
+            t_arr[j], stance_arr[j], single[j] = t, i, True
+            com[j] = stance[:2] + x[:2]
+            cop[j] = (stance[0] + wx, stance[1] + wy)
+            cop_off[j], tau_cmd[j], tau[j] = (cx, cy), u_cmd, u
+            sat[j] = cx != ox or cy != oy
+            j += 1
+            jt = i * (m_ticks + n_ds) + k
+            if not push_any[jt]:
+                x = ad_t @ x + bd_t @ u
+            elif push_const[jt]:
+                x = ad_t @ x + bd_t @ (u + push_tab[jt, 0])
+            else:
+                for q in range(n_sub):
+                    x = ad_s @ x + bd_s @ (u + push_tab[jt, q])
+            t += dt
+            # Fall test on the true state (module docstring).
+            if not np.isfinite(x).all():
+                fell, fall_time = True, t
+                break
+            gx, gy = float(x[0] + kxi * x[3]), float(x[1] - kxi * x[2])
+            fx, fy = cth * gx + sth * gy, -sth * gx + cth * gy
+            e = decay[k]
+            if (
+                fx > d0[0] + d_span[0] * e
+                or -fx > d0[1] + d_span[1] * e
+                or fy > d0[2] + d_span[2] * e
+                or -fy > d0[3] + d_span[3] * e
+            ):
+                fell, fall_time = True, t
+                break
+        if fell:
+            break
+        assert sol is not None
+        p_next = np.array(sol.next_footstep, dtype=float)
+        p_next[:2] += place_err[i]
+        delta = p_next[:2] - stance[:2]
+        # Double support: the contact point moves linearly to the new foot (eq. 5.8-5.10).
+        s_aug = np.concatenate([x, np.zeros(2), delta / robot.t_ds])
+        for k in range(n_ds):
+            t_arr[j], stance_arr[j] = t, i
+            com[j] = stance[:2] + s_aug[:2]
+            cop[j] = stance[:2] + s_aug[4:6]
+            j += 1
+            jt = i * (m_ticks + n_ds) + m_ticks + k
+            if not push_any[jt]:
+                s_aug = ad_ds @ s_aug
+            else:
+                for q in range(n_sub):
+                    s_aug = ad_dss @ s_aug + bd_dss @ push_tab[jt, q]
+            t += dt_ds
+        x = s_aug[:4].copy()
+        x[:2] -= delta
+        feet.append(p_next)
+        headings.append(float(plan.headings[i + 1]))
+        if not np.all(np.isfinite(x)):
+            fell, fall_time = True, t
+            break
+
+    sl = slice(0, j)
+    ss = single[sl]
+    offs = np.linalg.norm(cop_off[sl][ss], axis=1)
+    phase_idx = stance_arr[sl][ss]
+    n_phases = int(phase_idx.max()) + 1 if offs.size else 0
+    ph_mean = tuple(float(offs[phase_idx == p].mean()) for p in range(n_phases))
+    ph_max = tuple(float(offs[phase_idx == p].max()) for p in range(n_phases))
+    feet_arr = np.array(feet)
+    n_landed = feet_arr.shape[0] - 1
+    dev = np.linalg.norm(feet_arr[1:, :2] - plan.footsteps[1 : n_landed + 1, :2], axis=1)
+    stopped = False
+    goal_error = math.nan
+    if not fell:
+        com_final = feet_arr[-1, :2] + x[:2]
+        goal_error = float(np.linalg.norm(com_final - goal_xy))
+        xi_final = com_final + np.array([x[3], -x[2]]) / (mzh * omega)
+        corners = np.vstack(
+            [_sole_corners(feet_arr[q], headings[q], f_len, f_wid) for q in (-1, -2)]
+        )
+        stopped = _in_hull(xi_final, corners)
+    st = np.array(solve_times) if solve_times else np.zeros(1)
+    metrics = SimMetrics(
+        fell=fell,
+        fall_time=fall_time,
+        stopped=stopped,
+        success=(not fell) and stopped,
+        zmp_offset_mean=float(offs.mean()) if offs.size else math.nan,
+        zmp_offset_rms=float(np.sqrt(np.mean(offs**2))) if offs.size else math.nan,
+        zmp_offset_max=float(offs.max()) if offs.size else math.nan,
+        zmp_offset_phase_mean=ph_mean,
+        zmp_offset_phase_max=ph_max,
+        saturated_time=float(sat[sl][ss].sum() * dt),
+        saturated_fraction=float(sat[sl][ss].mean()) if ss.any() else 0.0,
+        footstep_dev_mean=float(dev.mean()) if dev.size else 0.0,
+        footstep_dev_max=float(dev.max()) if dev.size else 0.0,
+        goal_error=goal_error,
+        steps_taken=n_landed,
+        mpc_solves=mpc.n_solves,
+        mpc_fallbacks=mpc.n_fallbacks,
+        mpc_time_median=float(np.median(st)),
+        mpc_time_max=float(st.max()),
+        sim_time=float(t),
+        wall_time=time.perf_counter() - wall0,
+    )
+    return SimResult(
+        metrics=metrics,
+        t=t_arr[sl],
+        stance=stance_arr[sl],
+        single=single[sl],
+        com=com[sl],
+        cop=cop[sl],
+        cop_offset=cop_off[sl],
+        torque_cmd=tau_cmd[sl],
+        torque=tau[sl],
+        saturated=sat[sl],
+        footsteps=feet_arr,
+        plan_footsteps=np.array(plan.footsteps),
+        headings=np.array(headings),
+        goal=goal_xy,
+        u_max=robot.u_max,
+        foot_length=f_len,
+        foot_width=f_wid,
+        planner=plan.planner,
+    )

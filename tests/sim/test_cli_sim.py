@@ -1,0 +1,78 @@
+"""`footfall simulate` and `footfall compare`: outputs and input errors (exit code 2)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+
+def run(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "footfall", *args], capture_output=True, text=True, timeout=300
+    )
+
+
+def test_simulate_writes_metrics_and_figures(tmp_path: Path) -> None:
+    r = run(
+        "simulate",
+        "--scene",
+        "flat",
+        "--planner",
+        "reactive",
+        "--push",
+        "5",
+        "--out",
+        str(tmp_path),
+    )
+    assert r.returncode == 0, r.stderr
+    data = json.loads((tmp_path / "sim.json").read_text())
+    m = data["metrics"]
+    assert m["fell"] is False and m["zmp_offset_max"] >= m["zmp_offset_mean"] > 0
+    for name in ("sim_top.png", "sim_zmp.png", "sim_torque.png"):
+        assert (tmp_path / name).stat().st_size > 0
+
+
+def test_compare_runs_trials_and_writes_the_table(tmp_path: Path) -> None:
+    r = run(
+        "compare",
+        "--scenes",
+        "flat",
+        "--planners",
+        "reactive",
+        "--trials",
+        "2",
+        "--workers",
+        "1",
+        "--out",
+        str(tmp_path),
+    )
+    assert r.returncode == 0, r.stderr
+    rows = (tmp_path / "compare.csv").read_text().strip().splitlines()
+    assert len(rows) == 3  # header + 2 trials
+    assert "| flat | reactive |" in (tmp_path / "compare.md").read_text()
+    assert (tmp_path / "compare_zmp_mean.png").is_file()
+    assert list((tmp_path / "plans").glob("flat_reactive_*.pkl"))
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (("simulate", "--scene", "moon"), "discrete_steps"),
+        (("simulate", "--planner", "astar"), "miqcqp, kinematic, reactive"),
+        (("simulate", "--rate", "-500"), "control_rate"),
+        (("simulate", "--push", "-3"), "push.impulse"),
+        (("compare", "--planners", "reactive,dijkstra"), "miqcqp, kinematic, reactive"),
+        (("compare", "--trials", "0"), "trials"),
+        (("compare", "--scenes", "flat", "--workers", "0"), "workers"),
+    ],
+)
+def test_bad_input_exits_2_with_the_valid_choices(
+    tmp_path: Path, args: tuple[str, ...], needle: str
+) -> None:
+    r = run(*args, "--out", str(tmp_path))
+    assert r.returncode == 2
+    assert needle in " ".join((r.stderr + r.stdout).split())
