@@ -23,6 +23,7 @@ from footfall.planning import (
     plan_reactive,
 )
 from footfall.solvers import SolveStatus
+from footfall.terrain import builtin_scene
 from tests.planning.scenes import SHORT_FLAT, SHORT_TURN, TWO_STONES, scene
 
 #: the solver's relative gap in these tests
@@ -221,6 +222,19 @@ def test_reactive_baseline_reaches_goal_and_passes_checker() -> None:
     plan = plan_reactive(sc)
     assert plan.status is SolveStatus.FEASIBLE, plan.message
     assert check_plan(plan, sc).ok
+
+
+def test_reactive_baseline_comes_nearly_to_rest_on_the_goal() -> None:
+    """The last step spends the stance's ankle torque on stopping: CoM speed after the final reset
+    well below walking speed, CoM near the goal midpoint."""
+    sc = builtin_scene("flat")
+    plan = plan_reactive(sc)
+    assert plan.status is SolveStatus.FEASIBLE
+    mzh = sc.robot.mass * sc.robot.com_height
+    speed = float(np.hypot(plan.final_state[2], plan.final_state[3])) / mzh
+    com = plan.footsteps[-1, :2] + plan.final_state[:2]
+    assert speed < 0.2
+    assert np.linalg.norm(com - sc.goal.position[:2]) < 0.1
 
 
 @pytest.mark.parametrize(

@@ -39,13 +39,16 @@ def _one_step(
     l_des: FloatArray | None,
     target: FloatArray | None,
     region_margin: float = 0.0,
+    rest_at: FloatArray | None = None,
 ) -> tuple[FloatArray, str, FloatArray, FloatArray] | None:
     """One-step-ahead choice of the next footstep and the current phase's ankle torques.
 
     Minimises the error of the ALIP angular momentum at the end of the *next* single support
     (assuming zero torque there) against ``l_des`` (or, when ``target`` is given, the distance of
     the footstep to ``target``), plus the torque effort, over footsteps that are reachable from the
-    ``side`` stance foot (true rotation: the heading is known) and lie on a region.
+    ``side`` stance foot (true rotation: the heading is known) and lie on a region. With
+    ``rest_at`` (a horizontal point [m], used for the steps onto the goal feet) the state right
+    after the reset onto the new foot is also pulled toward rest with the CoM at that point.
 
     Returns:
         ``(footstep (3,), region, states (K, 4), torques (K-1, 2))`` or None when nothing is
@@ -104,6 +107,16 @@ def _one_step(
                     row[int(p[jj])] = row.get(int(p[jj]), 0.0) + float(m_p[j, jj])
             offset = float(m_p[j] @ stance)
             b.add_square(row, float(l_des[j]) + offset, 1.0 / mzh**2, "momentum")
+    if rest_at is not None:
+        # x+ = A_r x_K + B_r (p - stance) toward [rest_at - p, 0, 0] (both relative to p).
+        for j in range(4):
+            row = {int(x[k_nodes - 1, jj]): float(a_r[j, jj]) for jj in range(4)}
+            for jj in range(3):
+                coef = float(b_r[j, jj]) + (1.0 if j == jj and j < 2 else 0.0)
+                if coef != 0.0:
+                    row[int(p[jj])] = row.get(int(p[jj]), 0.0) + coef
+            target_j = float(b_r[j] @ stance) + (float(rest_at[j]) if j < 2 else 0.0)
+            b.add_square(row, target_j, 1.0 if j < 2 else 1.0 / mzh**2, "rest")
     for k in range(k_nodes - 1):
         for j in range(2):
             b.add_square({int(u[k, j]): 1.0}, 0.0, 1e-4, "torque")
@@ -192,7 +205,10 @@ def plan_reactive(
             # At the end of a left stance the CoM moves right (v_y < 0), so L_x = -m z_H v_y > 0;
             # (L_x, L_y) rotates with the heading like a vector.
             l_des = rot2(new_th) @ np.array([nxt_side.sign * lx_mag, mzh * speed])
-        step = _one_step(scene, robot, x, stance, th, side, l_des, target, region_margin)
+        # The very last step (the stance foot already stands on its goal spot) ends at rest.
+        last = target is not None and bool(np.linalg.norm(stance[:2] - feet_goal[side]) < 1e-6)
+        rest = scene.goal.position[:2] if last else None
+        step = _one_step(scene, robot, x, stance, th, side, l_des, target, region_margin, rest)
         if step is None:
             message = f"no reachable region from footstep {len(feet) - 1}"
             break
