@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -61,6 +61,9 @@ EDGE_TOL = 0.005
 GOAL_TOL = 0.10
 #: video frame rate [1/s]
 VIDEO_FPS = 30
+#: extra footsteps after the plan's last one, taken where the feet already are and corrected by
+#: foot placement toward zero momentum: they absorb the momentum the walk ends with
+STOP_STEPS = 2
 #: sole-pose and CoM costs of the inverse kinematics: the feet must be where they are (the stance
 #: foot cannot move), the CoM is the ALIP's; torso and posture are secondary
 FOOT_POSITION_COST = 10.0
@@ -123,6 +126,8 @@ class WalkOptions:
         stop_time: time to bring the CoM to the middle of the final feet after the last step [s].
         hold_time: standing time at the end [s].
         pushes: external pushes.
+        stop_steps: stopping steps after the plan (:func:`extend_plan`); the adjuster must
+            answer for phases up to ``N + stop_steps - 1`` (:class:`PlanFollower` does).
         com_gain: gain of the CoM tracking feedback: the IK's CoM target is the reference plus
             ``com_gain`` times the horizontal tracking error. Without it the joint servos'
             compliance lets a robot standing on one foot roll slowly over it.
@@ -144,6 +149,7 @@ class WalkOptions:
     stop_time: float = 1.0
     hold_time: float = 0.5
     pushes: tuple[Push, ...] = ()
+    stop_steps: int = STOP_STEPS
     com_gain: float = 1.5
     ankle_torque: bool = True
     true_momentum: bool = False
@@ -196,6 +202,29 @@ class FootstepAdjuster(Protocol):
         ...
 
 
+def extend_plan(plan: FootstepPlan, extra: int = STOP_STEPS) -> FootstepPlan:
+    """``plan`` with ``extra`` stopping steps appended (in place: each foot steps where it stands).
+
+    Their ALIP states and torques are zero (the CoM at rest over the stance foot): as a foot
+    placement reference this asks to end the next phase with zero momentum, i.e. to capture the
+    remaining motion.
+    """
+    if extra <= 0:
+        return plan
+    n = plan.n_steps
+    idx = [n - 1 + (j % 2) for j in range(extra)]
+    k = plan.states.shape[1]
+    return replace(
+        plan,
+        footsteps=np.vstack([plan.footsteps, plan.footsteps[idx]]),
+        headings=np.concatenate([plan.headings, plan.headings[idx]]),
+        sides=plan.sides + tuple(plan.sides[i] for i in idx),
+        regions=plan.regions + tuple(plan.regions[i] for i in idx),
+        states=np.concatenate([plan.states, np.zeros((extra, k, 4))]),
+        torques=np.concatenate([plan.torques, np.zeros((extra, k - 1, 2))]),
+    )
+
+
 def _point_in_region(region: Region, xy: FloatArray, margin: float) -> bool:
     return float(region.signed_distance(xy)) <= -margin
 
@@ -221,6 +250,8 @@ class PlanFollower:
         region_margin: the corrected footstep stays this far inside its region [m].
         freeze_after: phase share after which the footstep is frozen.
         dcm_gain: gain of the capture-point feedback on the ZMP (0 = planned torque only).
+        stop_steps: stopping steps appended to the plan (:func:`extend_plan`); the walker asks
+            for phases up to ``N + stop_steps - 1``.
     """
 
     plan: FootstepPlan
@@ -229,10 +260,12 @@ class PlanFollower:
     max_correction: float = 0.12
     region_margin: float = 0.05
     freeze_after: float = 0.7
-    dcm_gain: float = 2.0
+    dcm_gain: float = 2.5
+    stop_steps: int = STOP_STEPS
     _frozen: dict[int, FloatArray] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
+        self.plan = extend_plan(self.plan, self.stop_steps)
         robot = self.plan.robot
         self._alip = robot.alip()
         self._dt = robot.node_dt
@@ -293,7 +326,7 @@ class PlanFollower:
             return self._frozen[phase], u
         # the plan's footstep relative to where the stance foot really is
         target = ref_next.copy()
-        if self.gain > 0.0 and phase + 1 < plan.n_steps:
+        if self.gain > 0.0:
             x_end = self.predict_end(t, state, phase)
             err = self._to_next_end @ (x_end - plan.states[phase, -1])
             # The reset acts on the step p_{i+1} - p_i: if the robot stands off its planned
@@ -569,6 +602,7 @@ class WalkResult:
             (NaN if never reached).
         targets: the commanded (corrected) footsteps 1..N, shape (N, 3) [m].
         planned: the plan's footsteps 1..N, shape (N, 3) [m].
+        n_planned: the plan's N; entries beyond it are stopping steps.
         fell: whether a fall was detected.
         fall_time: when [s] (NaN if none).
         metrics: summary numbers (:func:`summarise`).
@@ -588,6 +622,7 @@ class WalkResult:
     landed: FloatArray
     targets: FloatArray
     planned: FloatArray
+    n_planned: int
     fell: bool
     fall_time: float
     metrics: dict[str, Any]
@@ -724,6 +759,8 @@ def walk(
     dt = opts.control_dt
     regions = {r.name: r for r in scene.terrain.regions}
     src: FootstepAdjuster = adjuster if adjuster is not None else PlanFollower(plan, regions)
+    n_planned = plan.n_steps
+    plan = extend_plan(plan, opts.stop_steps)
     alip = robot.alip()
     ad_tick, bd_tick = alip.discretize(dt)
     ds_map = _ds_propagator(alip, dt)
@@ -942,7 +979,7 @@ def walk(
         ankle_cmd: dict[Side, FloatArray | None] = {sd: None for sd in sim.sides}
         if opts.ankle_torque and phase_log[k] >= 0:
             ankle_cmd[stance_side] = ankle_u
-        elif opts.ankle_torque and t_walk0 <= t < t_end_steps:
+        elif opts.ankle_torque and t >= t_walk0:
             # double support: both ankles passive, the legs form a closed chain whose joint
             # servos place the CoM; each foot's CoP stays at its centre and the total CoP lies
             # between the feet, where the contact-point ramp of eq. (5.8) puts it
@@ -999,6 +1036,7 @@ def walk(
         landed=landed,
         targets=targets,
         planned=np.array(plan.footsteps[1:]),
+        n_planned=n_planned,
         fell=fell,
         fall_time=fall_time,
         metrics={},
@@ -1007,7 +1045,8 @@ def walk(
         video=video_path if writer is not None else None,
         video_note=video_note,
     )
-    metrics = summarise(result, scene, plan, sim.params, t_end_steps)
+    t_goal = t_walk0 + n_planned * t_step
+    metrics = summarise(result, scene, plan, sim.params, t_goal)
     object.__setattr__(result, "metrics", metrics)
     return result
 
@@ -1056,8 +1095,8 @@ def summarise(
     ticks at a sole edge, share inside the sole), ``zmp_planned`` (same statistics of the planned
     torques' ZMP) and ``per_step`` (per phase: mean and max offset norm, at-edge share).
     """
-    n = plan.n_steps
-    ss = res.phase >= 0
+    n = res.n_planned
+    ss = (res.phase >= 0) & (res.phase < n)
     z = res.zmp_offset[ss]
     ok = ~np.isnan(z[:, 0])
     z = z[ok]
@@ -1099,10 +1138,12 @@ def summarise(
                 "at_edge_share": float(np.mean(np.any(np.abs(a) >= half - EDGE_TOL, axis=1))),
             }
         )
-    done = ~np.isnan(res.landed[:, 0])
-    err_plan = np.linalg.norm((res.landed - res.planned)[done, :2], axis=1)
-    err_tgt = np.linalg.norm((res.landed - res.targets)[done, :2], axis=1)
-    err_z = np.abs((res.landed - res.planned)[done, 2])
+    npl = res.n_planned
+    landed, planned, targets = res.landed[:npl], res.planned[:npl], res.targets[:npl]
+    done = ~np.isnan(landed[:, 0])
+    err_plan = np.linalg.norm((landed - planned)[done, :2], axis=1)
+    err_tgt = np.linalg.norm((landed - targets)[done, :2], axis=1)
+    err_z = np.abs((landed - planned)[done, 2])
 
     def mm(a: FloatArray) -> dict[str, float]:
         return {"mean": float(np.mean(a)) if a.size else math.nan, "max": float(np.max(a)) if a.size else math.nan}
@@ -1117,7 +1158,8 @@ def summarise(
         "reached_goal": reached,
         "goal_error_m": goal_err,
         "time_to_goal_s": t_steps_end if (all_landed and not res.fell) else None,
-        "steps_planned": n,
+        "steps_planned": npl,
+        "stop_steps": int(res.landed.shape[0] - npl),
         "steps_landed": int(np.sum(done)),
         "footstep_error_m": mm(err_plan),
         "footstep_height_error_m": mm(err_z),
