@@ -138,9 +138,7 @@ def compare_mujoco(
             plan = plan_for_walk(scene, planner, n, time_limit, cache_dir)
             plan_time = time.perf_counter() - t0
             if not plan.has_solution:
-                rows.append(
-                    {"scene": name, "planner": planner, "plan_status": plan.status.value}
-                )
+                rows.append({"scene": name, "planner": planner, "plan_status": plan.status.value})
                 continue
             for seed in seeds:
                 opts = WalkOptions()

@@ -153,9 +153,7 @@ class BipedModel:
             v = getattr(self, name)
             if len(v) != 3:
                 raise InputError(f"model.{name}", v, "3 box dimensions (x, y, z) [m]")
-            object.__setattr__(
-                self, name, tuple(positive(f"model.{name}", float(c)) for c in v)
-            )
+            object.__setattr__(self, name, tuple(positive(f"model.{name}", float(c)) for c in v))
         if len(self.joint_range) != len(nm.LEG_JOINTS):
             raise InputError("model.joint_range", self.joint_range, "6 (lower, upper) pairs")
         for name, (lo, hi) in zip(nm.LEG_JOINTS, self.joint_range, strict=True):

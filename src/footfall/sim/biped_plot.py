@@ -28,7 +28,9 @@ def plot_walk(
         ax.add_patch(Polygon(r.vertices, closed=True, fc="0.85", ec="0.5", lw=0.8))
     ax.plot(res.com[:, 0], res.com[:, 1], "k-", lw=1, label="CoM (measured)")
     npl = res.n_planned
-    ax.plot(res.planned[:npl, 0], res.planned[:npl, 1], "o", mfc="none", mec="tab:blue", label="plan")
+    ax.plot(
+        res.planned[:npl, 0], res.planned[:npl, 1], "o", mfc="none", mec="tab:blue", label="plan"
+    )
     ax.plot(res.targets[:, 0], res.targets[:, 1], "x", c="tab:orange", label="commanded")
     ax.plot(res.landed[:, 0], res.landed[:, 1], ".", c="tab:red", label="landed")
     ax.plot(*scene.goal.position[:2], "*", c="tab:green", ms=12, label="goal")

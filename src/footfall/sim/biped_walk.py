@@ -63,7 +63,7 @@ GOAL_TOL = 0.10
 VIDEO_FPS = 30
 #: extra footsteps after the plan's last one, taken where the feet already are and corrected by
 #: foot placement toward zero momentum: they absorb the momentum the walk ends with
-STOP_STEPS = 2
+STOP_STEPS = 0
 #: sole-pose and CoM costs of the inverse kinematics: the feet must be where they are (the stance
 #: foot cannot move), the CoM is the ALIP's; torso and posture are secondary
 FOOT_POSITION_COST = 10.0
@@ -463,13 +463,20 @@ class BipedSim:
             ]
         )
         self.actuators = np.array(
-            [ident(obj.mjOBJ_ACTUATOR, nm.actuator(s, j)) for s in self.sides for j in nm.LEG_JOINTS]
+            [
+                ident(obj.mjOBJ_ACTUATOR, nm.actuator(s, j))
+                for s in self.sides
+                for j in nm.LEG_JOINTS
+            ]
         )
         self.foot_of_geom: dict[int, Side] = {}
         for s in self.sides:
             for k in range(len(nm.FOOT_CORNERS)):
                 self.foot_of_geom[ident(obj.mjOBJ_GEOM, nm.corner_geom(s, k))] = s
-        self.body_geoms = {ident(obj.mjOBJ_GEOM, nm.PELVIS_GEOM), ident(obj.mjOBJ_GEOM, nm.TORSO_GEOM)}
+        self.body_geoms = {
+            ident(obj.mjOBJ_GEOM, nm.PELVIS_GEOM),
+            ident(obj.mjOBJ_GEOM, nm.TORSO_GEOM),
+        }
         self._kp = np.array(m.actuator_gainprm[self.actuators, 0])
         self._bias = np.array(m.actuator_biasprm[self.actuators, :3])
         self.mass = float(np.sum(m.body_mass))
@@ -482,7 +489,11 @@ class BipedSim:
         d.qpos[:] = 0.0
         d.qvel[:] = 0.0
         mid = 0.5 * (np.asarray(left) + np.asarray(right))
-        d.qpos[self.root_adr : self.root_adr + 3] = (mid[0], mid[1], mid[2] + self.params.pelvis_height)
+        d.qpos[self.root_adr : self.root_adr + 3] = (
+            mid[0],
+            mid[1],
+            mid[2] + self.params.pelvis_height,
+        )
         d.qpos[self.root_adr + 3 : self.root_adr + 7] = (
             math.cos(heading / 2),
             0.0,
@@ -524,7 +535,11 @@ class BipedSim:
         self.mujoco.mj_subtreeVel(self.model, self.data)
         b = self.pelvis
         d = self.data
-        return np.array(d.subtree_com[b]), np.array(d.subtree_linvel[b]), np.array(d.subtree_angmom[b])
+        return (
+            np.array(d.subtree_com[b]),
+            np.array(d.subtree_linvel[b]),
+            np.array(d.subtree_angmom[b]),
+        )
 
     def contacts(self) -> tuple[dict[Side, tuple[FloatArray, FloatArray]], bool]:
         """Per foot, contact points (n, 3) and forces on the robot (n, 3) [N]; body-hit flag."""
@@ -550,7 +565,8 @@ class BipedSim:
             pts[side].append(np.array(c.pos))
             frc[side].append(sign * (c.frame.reshape(3, 3).T @ self._f6[:3]))
         out = {
-            s: (np.array(pts[s]).reshape(-1, 3), np.array(frc[s]).reshape(-1, 3)) for s in self.sides
+            s: (np.array(pts[s]).reshape(-1, 3), np.array(frc[s]).reshape(-1, 3))
+            for s in self.sides
         }
         return out, body_hit
 
@@ -673,7 +689,9 @@ class _IK:
         """Joint set points (12,) [rad] for sole poses, CoM (3,) [m] and torso yaw [rad]."""
         mink = self.mink
         for s, (pos, rot) in feet.items():
-            self.feet[s].set_target(mink.SE3.from_rotation_and_translation(mink.SO3.from_matrix(rot), pos))
+            self.feet[s].set_target(
+                mink.SE3.from_rotation_and_translation(mink.SO3.from_matrix(rot), pos)
+            )
         self.com.set_target(com)
         c, s_ = math.cos(torso_yaw / 2), math.sin(torso_yaw / 2)
         self.torso.set_target(
@@ -749,13 +767,17 @@ def walk(
     start_stance = scene.start.stance_foot
     if np.linalg.norm(plan.footsteps[0] - start_stance) > 1e-6:
         raise InputError(
-            "plan.footsteps[0]", plan.footsteps[0].tolist(), f"the scene's start stance foot {start_stance.tolist()}"
+            "plan.footsteps[0]",
+            plan.footsteps[0].tolist(),
+            f"the scene's start stance foot {start_stance.tolist()}",
         )
     sim = BipedSim(scene, model_params, settings)
     mj, m, d = sim.mujoco, sim.model, sim.data
     substeps = round(opts.control_dt / m.opt.timestep)
     if substeps < 1 or abs(substeps * m.opt.timestep - opts.control_dt) > 1e-9:
-        raise InputError("control_dt", opts.control_dt, f"a multiple of the physics step {m.opt.timestep}")
+        raise InputError(
+            "control_dt", opts.control_dt, f"a multiple of the physics step {m.opt.timestep}"
+        )
     dt = opts.control_dt
     regions = {r.name: r for r in scene.terrain.regions}
     src: FootstepAdjuster = adjuster if adjuster is not None else PlanFollower(plan, regions)
@@ -785,9 +807,9 @@ def walk(
     t_walk0 = opts.settle_time + opts.shift_time
     t_end_steps = t_walk0 + n * t_step
     t_total = t_end_steps + opts.stop_time + opts.hold_time
-    n_ticks = int(round(t_total / dt))
+    n_ticks = round(t_total / dt)
 
-    ts = np.arange(n_ticks) * dt
+    ts = np.arange(n_ticks, dtype=np.float64) * dt
     phase_log = np.full(n_ticks, -1, dtype=int)
     com_log = np.full((n_ticks, 3), np.nan)
     ref_log = np.full((n_ticks, 3), np.nan)
@@ -805,7 +827,10 @@ def walk(
         try:
             renderer = mj.Renderer(m, height=video_size[1], width=video_size[0])
         except Exception as exc:  # any GL failure means "no video", never a crash
-            renderer, video_note = None, f"no offscreen GL ({type(exc).__name__}: {exc}); video skipped"
+            renderer, video_note = (
+                None,
+                f"no offscreen GL ({type(exc).__name__}: {exc}); video skipped",
+            )
         if renderer is not None:
             import imageio.v2 as imageio
 
@@ -815,12 +840,12 @@ def walk(
 
     stance_side = plan.sides[0]
     x_ref = np.zeros(4)  # ALIP reference relative to the current stance contact point
+    prev_stance = np.array(scene.start.stance_foot)
     ds_aug = np.zeros(10)
     swing_start = foot_pos[stance_side.other].copy()
     swing_rot0 = foot_rot[stance_side.other].copy()
     apex = 0.0
     cur_phase = -1
-    in_ds = False
     stop_from = np.zeros(2)
     stop_vel = np.zeros(2)
     fell, fall_time = False, math.nan
@@ -831,11 +856,18 @@ def walk(
         middle of one single support to the middle of the next."""
         zs = plan.footsteps[:, 2]
         if t < t_walk0 + 0.5 * t_ss:
-            return float(zs[0] if t >= opts.settle_time else 0.5 * (scene.start.left[2] + scene.start.right[2])) + z_h
+            return (
+                float(
+                    zs[0]
+                    if t >= opts.settle_time
+                    else 0.5 * (scene.start.left[2] + scene.start.right[2])
+                )
+                + z_h
+            )
         u = (t - t_walk0 - 0.5 * t_ss) / t_step
-        i = int(math.floor(u))
+        i = math.floor(u)
         if i >= n:
-            return float(zs[n] + 0.0) + z_h
+            return float(zs[n]) + z_h
         frac = smoothstep(u - i)
         return float(zs[i] + (zs[i + 1] - zs[i]) * frac) + z_h
 
@@ -876,14 +908,16 @@ def walk(
                     x_ref = ds_aug[:4].copy()
                     x_ref[:2] -= (foot_pos[sd_landed] - prev_stance)[:2]
                 cur_phase = i
-                in_ds = False
                 stance_side = plan.sides[i]
                 swing_side = stance_side.other
                 swing_start = sim.sole(swing_side)[0]
                 swing_rot0 = foot_rot[swing_side]
                 apex = (
                     terrain_height_along(
-                        scene.terrain.regions, swing_start, plan.footsteps[i + 1], robot.foot_length / 2
+                        scene.terrain.regions,
+                        swing_start,
+                        plan.footsteps[i + 1],
+                        robot.foot_length / 2,
                     )
                     + opts.swing_clearance
                 )
@@ -895,7 +929,12 @@ def walk(
             x_meas = np.array([r[0], r[1], l_c[0], l_c[1]])
             if tp < t_ss:
                 phase_log[k] = i
-                nxt, u = src.update(tp, x_meas if opts.true_momentum else alip.state_from_velocity(r[:2], vel[:2]), stance, i)
+                nxt, u = src.update(
+                    tp,
+                    x_meas if opts.true_momentum else alip.state_from_velocity(r[:2], vel[:2]),
+                    stance,
+                    i,
+                )
                 targets[i] = nxt
                 zmp_plan_log[k] = alip.zmp(np.zeros(2), u)
                 fb = 1.0 if opts.ankle_torque else opts.com_feedback
@@ -910,7 +949,9 @@ def walk(
                 rot1 = foot_rotation(normals[i + 1], plan.headings[i + 1])
                 rot = _blend_rot(swing_rot0, rot1, s_h)
                 targets_now = {stance_side: (stance, foot_rot[stance_side]), swing_side: (pos, rot)}
-                yaw = float(plan.headings[i] + (plan.headings[i + 1] - plan.headings[i]) * 0.5 * s_h)
+                yaw = float(
+                    plan.headings[i] + (plan.headings[i + 1] - plan.headings[i]) * 0.5 * s_h
+                )
                 if tp + dt >= t_ss - 1e-9:
                     foot_rot[swing_side] = rot1
                 ref_xy = stance[:2] + x_ref[:2]
@@ -918,7 +959,6 @@ def walk(
                 prev_stance = stance.copy()
                 ds_aug = np.concatenate([x_ref, np.zeros(3), (targets[i] - stance) / t_ds])
             else:
-                in_ds = True
                 ds_aug = ds_map @ ds_aug
                 x_ref = ds_aug[:4]
                 ref_xy = prev_stance[:2] + x_ref[:2]
@@ -959,7 +999,11 @@ def walk(
         ref_log[k] = com_ref
 
         # ---------------------------------------------------------------- fall detection
-        stance_z = max(foot_pos[Side.LEFT][2], foot_pos[Side.RIGHT][2]) if phase_log[k] < 0 else foot_pos[stance_side][2]
+        stance_z = (
+            max(foot_pos[Side.LEFT][2], foot_pos[Side.RIGHT][2])
+            if phase_log[k] < 0
+            else foot_pos[stance_side][2]
+        )
         pelvis_z = float(d.xpos[sim.pelvis][2]) - float(stance_z)
         up = d.xmat[sim.torso].reshape(3, 3)[:, 2]
         tilt = math.acos(max(-1.0, min(1.0, float(up[2]))))
@@ -979,7 +1023,7 @@ def walk(
         ankle_cmd: dict[Side, FloatArray | None] = {sd: None for sd in sim.sides}
         if opts.ankle_torque and phase_log[k] >= 0:
             ankle_cmd[stance_side] = ankle_u
-        elif opts.ankle_torque and t >= t_walk0:
+        elif opts.ankle_torque and t_walk0 <= t < t_end_steps:
             # double support: both ankles passive, the legs form a closed chain whose joint
             # servos place the CoM; each foot's CoP stays at its centre and the total CoP lies
             # between the feet, where the contact-point ramp of eq. (5.8) puts it
@@ -1021,7 +1065,6 @@ def walk(
         writer.close()
     if renderer is not None:
         renderer.close()
-    del in_ds
     k_end = k + 1
     timing["total"] = wall
     sim_time = k_end * dt
@@ -1100,12 +1143,22 @@ def summarise(
     z = res.zmp_offset[ss]
     ok = ~np.isnan(z[:, 0])
     z = z[ok]
-    half = np.array([params.foot_length / 2 - params.corner_radius, params.foot_width / 2 - params.corner_radius])
+    half = np.array(
+        [
+            params.foot_length / 2 - params.corner_radius,
+            params.foot_width / 2 - params.corner_radius,
+        ]
+    )
     sole_half = np.array([params.foot_length / 2, params.foot_width / 2])
 
     def stats(a: FloatArray) -> dict[str, float]:
         if a.shape[0] == 0:
-            return {"mean": math.nan, "max": math.nan, "mean_abs_x": math.nan, "mean_abs_y": math.nan}
+            return {
+                "mean": math.nan,
+                "max": math.nan,
+                "mean_abs_x": math.nan,
+                "mean_abs_y": math.nan,
+            }
         nrm = np.linalg.norm(a, axis=1)
         return {
             "mean": float(np.mean(nrm)),
@@ -1146,7 +1199,10 @@ def summarise(
     err_z = np.abs((landed - planned)[done, 2])
 
     def mm(a: FloatArray) -> dict[str, float]:
-        return {"mean": float(np.mean(a)) if a.size else math.nan, "max": float(np.max(a)) if a.size else math.nan}
+        return {
+            "mean": float(np.mean(a)) if a.size else math.nan,
+            "max": float(np.max(a)) if a.size else math.nan,
+        }
 
     final_mid = 0.5 * (res.feet[-1, 0] + res.feet[-1, 1])
     goal_err = float(np.linalg.norm(final_mid[:2] - scene.goal.position[:2]))

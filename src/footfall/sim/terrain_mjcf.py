@@ -30,7 +30,7 @@ RAMP_THICKNESS = 0.3
 SHAPE_TOL = 1e-9
 
 
-def _f(*values: float) -> str:
+def _f(*values: float | np.floating) -> str:
     return " ".join(f"{v:.9g}" for v in values)
 
 
@@ -100,9 +100,7 @@ def region_solid(region: Region, base: float) -> tuple[str, str]:
     verts = np.vstack([top, bottom])
     mesh = f"{nm.REGION_MESH_PREFIX}{region.name}"
     asset = f'<mesh name="{mesh}" vertex="{_f(*verts.ravel())}"/>'
-    return asset, (
-        f'<geom name="{name}" type="mesh" mesh="{mesh}" material="terrain" {bits}/>'
-    )
+    return asset, (f'<geom name="{name}" type="mesh" mesh="{mesh}" material="terrain" {bits}/>')
 
 
 def terrain_xml(terrain: Terrain) -> tuple[str, str]:
