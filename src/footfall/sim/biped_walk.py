@@ -3,8 +3,9 @@
 Control loop (every ``control_dt``):
 
 1. **Measure** the ALIP state (eq. 5.1) of the robot about the stance contact point: the CoM
-   relative to the stance sole centre and the true angular momentum about that point,
-   ``L = L_G + m (c - p) x v`` (MuJoCo's subtree CoM, velocity and angular momentum).
+   relative to the stance sole centre and either ``m z_H (-v_y, v_x)`` from the CoM velocity
+   (default) or the true angular momentum ``L = L_G + m (c - p) x v`` (MuJoCo's subtree CoM,
+   velocity and angular momentum; ``WalkOptions.true_momentum``).
 2. **Footstep / ankle-torque source** (:class:`FootstepAdjuster`): returns the next footstep and
    the ankle torque of this tick. The built-in :class:`PlanFollower` uses the plan's footsteps and
    ALIP torques, corrected by one-step ALIP foot placement; the MPC of eq. (5.19) plugs in here.
@@ -137,6 +138,10 @@ class WalkOptions:
             moves as the pendulum it is, with the reference following the measured state
             (``com_feedback`` = 1 and no ``com_gain`` in single support). False: every joint is
             position-servoed and the ankle torque is whatever tracking the CoM reference needs.
+        true_momentum: give the adjuster the true angular momentum about the stance point
+            (``L_G + m (c - p) x v``, Gong & Grizzle) instead of ``m z_H (-v_y, v_x)`` from the
+            CoM velocity. Default False: with this robot's fast swing legs the CoM-velocity state
+            walked further in our runs.
         stop_on_fall: end the simulation when a fall is detected.
     """
 
@@ -612,7 +617,7 @@ class WalkResult:
         com_ref: reference CoM sent to the IK, shape (T, 3) [m].
         zmp_offset: stance-foot CoP relative to the sole centre in the foot frame, shape (T, 2)
             [m] (NaN outside single support or without contact).
-        zmp_planned: the planned ZMP offset of the source's torque, shape (T, 2) [m].
+        zmp_planned: the ZMP offset of the adjuster's commanded torque, shape (T, 2) [m].
         feet: measured sole centres (left, right), shape (T, 2, 3) [m].
         landed: measured sole centre after each planned footstep 1..N landed, shape (N, 3) [m]
             (NaN if never reached).
@@ -1135,8 +1140,8 @@ def summarise(
     ``footstep_error_m`` / ``footstep_error_vs_target_m`` (mean and max horizontal distance of the
     landed sole centres from the plan / from the commanded footsteps), ``zmp`` (single-support
     stance-foot CoP offset from the sole centre: mean and max norm [m], mean |x| and |y|, share of
-    ticks at a sole edge, share inside the sole), ``zmp_planned`` (same statistics of the planned
-    torques' ZMP) and ``per_step`` (per phase: mean and max offset norm, at-edge share).
+    ticks at a sole edge, share inside the sole), ``zmp_commanded`` (the adjuster's torque as a
+    ZMP, before the sole clip), ``zmp_plan`` (the plan's own torques) and ``per_step`` (per phase: mean and max offset norm, at-edge share).
     """
     n = res.n_planned
     ss = (res.phase >= 0) & (res.phase < n)
@@ -1221,7 +1226,8 @@ def summarise(
         "footstep_height_error_m": mm(err_z),
         "footstep_error_vs_target_m": mm(err_tgt),
         "zmp": zs,
-        "zmp_planned": stats(zp),
+        "zmp_commanded": stats(zp),
+        "zmp_plan": stats(plan.zmp_offsets()[:n].reshape(-1, 2)),
         "per_step": per_step,
         "sim_time_s": res.sim_time,
         "wall_time_s": res.timing.get("total", math.nan),
