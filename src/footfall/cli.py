@@ -578,3 +578,109 @@ def compare_command(
             f"({r['trials']} trials)"
         )
     console.print(f"wrote {', '.join(str(p) for p in paths)}")
+
+
+# --- walk (issue 7) ---
+def _json_clean(value: Any) -> Any:
+    """JSON has no NaN/inf and no numpy types: convert recursively (unknown numbers -> null)."""
+    import math
+
+    import numpy as np
+
+    if isinstance(value, dict):
+        return {str(k): _json_clean(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_json_clean(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _json_clean(value.tolist())
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+@app.command("walk")
+def walk_cmd(
+    scene_file: Path | None = typer.Argument(None, help="Scene YAML file (or use --scene)."),
+    scene: str | None = typer.Option(None, help="Built-in scene name (see `footfall scenes`)."),
+    planner: str = typer.Option("miqcqp", help="miqcqp, kinematic or reactive."),
+    steps: int | None = typer.Option(
+        None, help="Footsteps N (optimising planners); omitted: the smallest N with a plan."
+    ),
+    time_limit: float = typer.Option(300.0, help="Planner time limit per solve [s]."),
+    push: float = typer.Option(0.0, help="Magnitude of one seeded horizontal push [N] (0: none)."),
+    seed: int = typer.Option(0, help="Seed of the push direction and timing."),
+    out: Path = typer.Option(Path("out/walk"), help="Output folder."),
+    video: bool = typer.Option(True, "--video/--no-video", help="Write walk.mp4 (offscreen GL)."),
+) -> None:
+    """Walk a footstep plan with the MuJoCo biped (document 000, section 5.5).
+
+    Writes walk.json (fell or not, time to goal, footstep tracking error, single-support ZMP
+    offset statistics per step), walk.png, walk.mp4 and the plan (cached as plan_<scene>_<planner>
+    .json in --out and reused on the next run). Exit 1 when the robot falls or misses the goal.
+    """
+    import os
+
+    if video:
+        # headless offscreen rendering; MuJoCo picks its GL backend when it is first imported
+        os.environ.setdefault("MUJOCO_GL", "egl")
+    from footfall.planning.plan import check_planner_name
+    from footfall.sim.biped_compare import plan_for_walk, random_push
+    from footfall.sim.biped_plot import plot_walk
+    from footfall.sim.biped_walk import WalkOptions, walk
+
+    check_planner_name(planner)
+    if steps is not None and steps < 1:
+        raise InputError("steps", steps, "an integer >= 1")
+    if push < 0:
+        raise InputError("push", push, "a force magnitude >= 0 [N]")
+    sc = resolve_scene(scene_file, scene)
+    with console.status(f"planning {sc.name} with {planner} ..."):
+        plan = plan_for_walk(sc, planner, steps, time_limit, out)
+    if not plan.has_solution:
+        console.print(f"{sc.name}: {planner} found no plan ({plan.status.value}). {plan.message}")
+        raise typer.Exit(1)
+    opts = WalkOptions()
+    pushes = (random_push(seed, push, plan, opts),) if push > 0 else ()
+    opts = WalkOptions(pushes=pushes)
+    with console.status(f"walking {plan.n_steps} steps in MuJoCo ..."):
+        res = walk(sc, plan, opts, video_path=out / "walk.mp4" if video else None)
+    payload = {
+        "scene": sc.name,
+        "planner": planner,
+        "plan": {
+            "status": plan.status.value,
+            "n_steps": plan.n_steps,
+            "solve_time_s": plan.solve_time,
+            "message": plan.message,
+        },
+        "push": [
+            {"start_s": p.start, "duration_s": p.duration, "force_N": p.force.tolist()}
+            for p in pushes
+        ],
+        "metrics": res.metrics,
+        "timing_s": res.timing,
+        "real_time_factor": res.sim_time / max(res.timing["total"] - res.timing["render"], 1e-9),
+        "footsteps": {
+            "planned": res.planned[: res.n_planned],
+            "commanded": res.targets,
+            "landed": res.landed,
+        },
+        "video": str(res.video) if res.video else None,
+        "video_note": res.video_note,
+    }
+    write_json(out / "walk.json", _json_clean(payload))
+    plot_walk(res, sc, out / "walk.png", title=f"{sc.name}, {planner}")
+    m = res.metrics
+    console.print(
+        f"{sc.name} / {planner}: {plan.n_steps} steps, fell={m['fell']}, "
+        f"reached goal={m['reached_goal']}, footstep error mean "
+        f"{m['footstep_error_m']['mean']:.3f} m, ZMP offset mean {m['zmp']['mean']:.3f} m "
+        f"max {m['zmp']['max']:.3f} m"
+    )
+    if res.video_note:
+        console.print(res.video_note)
+    console.print(f"wrote {out / 'walk.json'}, walk.png" + (", walk.mp4" if res.video else ""))
+    if m["fell"] or not m["reached_goal"]:
+        raise typer.Exit(1)

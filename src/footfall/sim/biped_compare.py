@@ -1,0 +1,182 @@
+"""Document 000 section 5.5 run in MuJoCo: planners x scenes x seeded pushes -> ZMP-offset table.
+
+:func:`plan_for_walk` makes (or loads from a JSON cache) the plan of a scene for the model-derived
+robot; :func:`random_push` draws a seeded push; :func:`compare_mujoco` walks every combination and
+returns one row per walk; :func:`compare_table` aggregates the rows per scene and planner (mean
+and max single-support ZMP offset, success rate), which is the table of section 5.5.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from footfall._validate import non_negative
+from footfall.errors import InputError
+from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
+from footfall.sim.biped_model import BipedModel, planner_params
+from footfall.sim.biped_walk import Push, WalkOptions, WalkResult, walk
+from footfall.sim.plan_cache import cache_key, load_plan, save_plan
+from footfall.terrain.scene import Scene, builtin_scene
+
+#: pushes last this long [s]
+PUSH_DURATION = 0.1
+#: a push starts at a random single support between these shares of the walk
+PUSH_WINDOW = (0.3, 0.7)
+
+
+def plan_for_walk(
+    scene: Scene,
+    planner: str,
+    n_steps: int | None = None,
+    time_limit: float = 300.0,
+    cache_dir: Path | None = None,
+    model: BipedModel | None = None,
+) -> FootstepPlan:
+    """The plan of ``scene`` for the MuJoCo biped (robot parameters from :func:`planner_params`).
+
+    With ``cache_dir`` the plan is stored as ``plan_<scene>_<planner>.json`` and reused while the
+    scene, planner, N and robot parameters are unchanged (MIQCQP plans take minutes).
+    """
+    from footfall.planning.run import make_plan
+
+    check_planner_name(planner)
+    robot = planner_params(model, base=scene.robot)
+    key = cache_key(scene.name, planner, n_steps, robot)
+    path = cache_dir / f"plan_{scene.name}_{planner}.json" if cache_dir is not None else None
+    if path is not None:
+        cached = load_plan(path, robot, key)
+        if cached is not None:
+            return cached
+    plan = make_plan(scene, planner, n_steps, PlannerOptions(time_limit=time_limit), robot)
+    if path is not None and plan.has_solution:
+        save_plan(path, plan, scene.name, key)
+    return plan
+
+
+def random_push(seed: int, magnitude: float, plan: FootstepPlan, options: WalkOptions) -> Push:
+    """A horizontal push of ``magnitude`` [N] in a seeded random direction, lasting
+    ``PUSH_DURATION``, starting mid single support of a seeded step in ``PUSH_WINDOW`` of the walk.
+    """
+    magnitude = non_negative("push", magnitude)
+    rng = np.random.default_rng(seed)
+    n = plan.n_steps
+    lo, hi = (max(0, int(f * n)) for f in PUSH_WINDOW)
+    step = int(rng.integers(lo, max(lo + 1, hi)))
+    robot = plan.robot
+    t0 = (
+        options.settle_time
+        + options.shift_time
+        + step * (robot.t_ss + robot.t_ds)
+        + 0.25 * robot.t_ss
+    )
+    angle = float(rng.uniform(0.0, 2.0 * math.pi))
+    force = magnitude * np.array([math.cos(angle), math.sin(angle), 0.0])
+    return Push(start=t0, duration=PUSH_DURATION, force=force)
+
+
+def walk_row(scene: Scene, planner: str, seed: int, push: float, res: WalkResult) -> dict[str, Any]:
+    """One row of the comparison for a finished walk."""
+    m = res.metrics
+    return {
+        "scene": scene.name,
+        "planner": planner,
+        "seed": seed,
+        "push_N": push,
+        "fell": m["fell"],
+        "reached_goal": m["reached_goal"],
+        "steps_landed": m["steps_landed"],
+        "steps_planned": m["steps_planned"],
+        "zmp_mean_m": m["zmp"]["mean"],
+        "zmp_max_m": m["zmp"]["max"],
+        "zmp_at_edge_share": m["zmp"].get("at_edge_share", math.nan),
+        "footstep_error_mean_m": m["footstep_error_m"]["mean"],
+        "time_to_goal_s": m["time_to_goal_s"],
+        "wall_time_s": m["wall_time_s"],
+    }
+
+
+def compare_mujoco(
+    scenes: Sequence[str] = ("discrete_steps", "stairs_slope_gap"),
+    planners: Sequence[str] = ("miqcqp", "kinematic", "reactive"),
+    seeds: Sequence[int] = (0, 1, 2),
+    push: float = 30.0,
+    n_steps: dict[tuple[str, str], int] | None = None,
+    time_limit: float = 300.0,
+    cache_dir: Path | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> list[dict[str, Any]]:
+    """Walk every scene x planner x seed in MuJoCo with a seeded push; one row per walk.
+
+    Args:
+        scenes: built-in scene names.
+        planners: planner names.
+        seeds: push seeds (each seed is one walk with its own push).
+        push: push magnitude [N] (0 = no push).
+        n_steps: N per (scene, planner) for the optimising planners; missing = smallest N.
+        time_limit: planner time limit [s].
+        cache_dir: folder for cached plans (strongly advised for miqcqp).
+        progress: called with a line of text after each walk.
+
+    Returns:
+        Rows of :func:`walk_row` plus ``plan_status`` and ``plan_time_s``; a scene/planner
+        without a plan gives one row with ``plan_status`` and no walk numbers.
+    """
+    if not seeds:
+        raise InputError("seeds", list(seeds), "at least one seed")
+    rows: list[dict[str, Any]] = []
+    for name in scenes:
+        scene = builtin_scene(name)
+        for planner in planners:
+            n = (n_steps or {}).get((name, planner))
+            t0 = time.perf_counter()
+            plan = plan_for_walk(scene, planner, n, time_limit, cache_dir)
+            plan_time = time.perf_counter() - t0
+            if not plan.has_solution:
+                rows.append({"scene": name, "planner": planner, "plan_status": plan.status.value})
+                continue
+            for seed in seeds:
+                opts = WalkOptions()
+                pushes = (random_push(seed, push, plan, opts),) if push > 0 else ()
+                res = walk(scene, plan, WalkOptions(pushes=pushes))
+                row = walk_row(scene, planner, seed, push, res)
+                row["plan_status"] = plan.status.value
+                row["plan_time_s"] = plan_time
+                rows.append(row)
+                if progress is not None:
+                    progress(
+                        f"{name} {planner} seed {seed}: fell={row['fell']} "
+                        f"zmp mean {row['zmp_mean_m']:.3f} m"
+                    )
+    return rows
+
+
+def compare_table(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per (scene, planner): walks, success rate (goal reached without a fall), mean of the
+    per-walk mean single-support ZMP offset and max over walks of the max offset [m]."""
+    out: list[dict[str, Any]] = []
+    keys = sorted({(r["scene"], r["planner"]) for r in rows})
+    for scene, planner in keys:
+        rs = [r for r in rows if r["scene"] == scene and r["planner"] == planner and "fell" in r]
+        if not rs:
+            out.append({"scene": scene, "planner": planner, "walks": 0})
+            continue
+        mean = [r["zmp_mean_m"] for r in rs if not math.isnan(r["zmp_mean_m"])]
+        mx = [r["zmp_max_m"] for r in rs if not math.isnan(r["zmp_max_m"])]
+        out.append(
+            {
+                "scene": scene,
+                "planner": planner,
+                "walks": len(rs),
+                "success_rate": float(np.mean([r["reached_goal"] for r in rs])),
+                "fall_rate": float(np.mean([r["fell"] for r in rs])),
+                "zmp_mean_m": float(np.mean(mean)) if mean else math.nan,
+                "zmp_max_m": float(np.max(mx)) if mx else math.nan,
+            }
+        )
+    return out

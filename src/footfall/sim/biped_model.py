@@ -1,0 +1,440 @@
+"""MJCF of the footfall biped, generated from :class:`BipedModel` (no downloads).
+
+A ~30 kg humanoid lower body for document 000's validation (section 5.5): a pelvis carrying a torso
+box, two 6-DoF legs (hip yaw / roll / pitch, knee, ankle pitch / roll, axes as in
+:data:`biped_names.LEG_JOINT_AXES`) and flat rectangular feet. The ankle axes sit straight above the
+sole centre, which is the footstep point of the planner and the ALIP contact point. Each foot
+touches the ground through four small spheres at the sole corners; the foot box is visual only.
+Joints are driven by position actuators (PD servos).
+
+The planner's :class:`~footfall.models.biped.BipedParams` are *derived* from this model
+(:func:`planner_params`): mass and CoM height come from MuJoCo at the nominal walking posture.
+
+MuJoCo notes (as for the quadruped): angles in radians need ``<compiler angle="radian"/>``; robot
+geoms collide only with terrain through the contype/conaffinity bits of :mod:`biped_names`;
+``cone="elliptic"`` with a high ``impratio`` keeps the feet from creeping on the slope.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from footfall._validate import non_negative, positive
+from footfall.errors import FootfallError, InputError
+from footfall.models.biped import BipedParams, Side
+from footfall.sim import biped_names as nm
+
+FloatArray = NDArray[np.float64]
+
+#: share of the half foot width the planner's ankle-torque bound may use: U_max = share * m g * w/2
+#: keeps the planned ZMP (eq. 5.12d) inside the sole in every direction, with a margin
+U_MAX_FOOT_SHARE = 0.8
+
+
+def require_mujoco() -> Any:
+    """Import MuJoCo or raise a FootfallError saying how to install it."""
+    try:
+        import mujoco
+    except ImportError as exc:  # optional dependency: footfall[sim]
+        raise FootfallError(f"MuJoCo is required: pip install 'footfall[sim]' ({exc})") from None
+    return mujoco
+
+
+@dataclass(frozen=True)
+class BipedSimSettings:
+    """Physics and actuator settings of the generated model.
+
+    Attributes:
+        timestep: physics step [s].
+        kp: position gain of every joint servo [N m / rad].
+        kv: velocity gain (damping) of every joint servo [N m s / rad].
+        torque_limit: actuator torque limit [N m].
+        friction: sliding friction coefficient between the feet and the terrain.
+        impratio: frictional to normal constraint impedance ratio (elliptic cone).
+        armature: rotor inertia added to each leg joint [kg m^2] (stabilises stiff servos).
+    """
+
+    timestep: float = 0.002
+    kp: float = 5000.0
+    kv: float = 100.0
+    torque_limit: float = 300.0
+    friction: float = 1.0
+    impratio: float = 10.0
+    armature: float = 0.02
+
+    def __post_init__(self) -> None:
+        for name in ("timestep", "kp", "kv", "torque_limit", "friction", "impratio"):
+            object.__setattr__(self, name, positive(f"sim.{name}", getattr(self, name)))
+        object.__setattr__(self, "armature", non_negative("sim.armature", self.armature))
+
+
+@dataclass(frozen=True)
+class BipedModel:
+    """Link dimensions, masses and joint limits of the biped (SI units, radians).
+
+    Attributes:
+        pelvis_mass: pelvis mass [kg]; the pelvis is the floating base.
+        pelvis_size: pelvis box full size (x, y, z) [m].
+        torso_mass: torso mass [kg].
+        torso_size: torso box full size (x, y, z) [m].
+        torso_offset: height of the torso centre above the pelvis centre [m].
+        hip_width: lateral distance between the two hip joints [m]; also the planner's nominal
+            stance width.
+        hip_drop: depth of the hip joints below the pelvis centre [m].
+        hip_link_mass: mass of each of the two small hip links (yaw, roll) of a leg [kg].
+        thigh_length: hip pitch axis to knee axis [m].
+        thigh_mass: [kg].
+        shank_length: knee axis to ankle axis [m].
+        shank_mass: [kg].
+        ankle_height: ankle axes above the sole [m].
+        foot_mass: [kg].
+        foot_length: sole length (x) [m].
+        foot_width: sole width (y) [m].
+        corner_radius: radius of the contact spheres at the sole corners [m].
+        nominal_hip_height: height of the hip joints above the soles in the walking posture [m]
+            (knees bent, so the legs can lengthen when stepping up).
+        joint_range: (lower, upper) limits per joint of ``LEG_JOINTS`` [rad], same for both legs
+            (roll and yaw limits are mirrored for the right leg).
+    """
+
+    pelvis_mass: float = 8.0
+    pelvis_size: tuple[float, float, float] = (0.12, 0.22, 0.08)
+    torso_mass: float = 14.0
+    torso_size: tuple[float, float, float] = (0.14, 0.24, 0.30)
+    torso_offset: float = 0.22
+    hip_width: float = 0.20
+    hip_drop: float = 0.05
+    hip_link_mass: float = 0.4
+    thigh_length: float = 0.34
+    thigh_mass: float = 1.6
+    shank_length: float = 0.34
+    shank_mass: float = 1.0
+    ankle_height: float = 0.06
+    foot_mass: float = 0.6
+    foot_length: float = 0.20
+    foot_width: float = 0.10
+    corner_radius: float = 0.008
+    nominal_hip_height: float = 0.60
+    joint_range: tuple[tuple[float, float], ...] = (
+        (-0.6, 0.6),
+        (-0.4, 0.6),
+        (-1.9, 0.9),
+        (0.05, 2.4),
+        (-1.0, 1.0),
+        (-0.5, 0.5),
+    )
+
+    def __post_init__(self) -> None:
+        for name in (
+            "pelvis_mass",
+            "torso_mass",
+            "torso_offset",
+            "hip_width",
+            "hip_link_mass",
+            "thigh_length",
+            "thigh_mass",
+            "shank_length",
+            "shank_mass",
+            "ankle_height",
+            "foot_mass",
+            "foot_length",
+            "foot_width",
+            "corner_radius",
+            "nominal_hip_height",
+        ):
+            object.__setattr__(self, name, positive(f"model.{name}", getattr(self, name)))
+        object.__setattr__(self, "hip_drop", non_negative("model.hip_drop", self.hip_drop))
+        for name in ("pelvis_size", "torso_size"):
+            v = getattr(self, name)
+            if len(v) != 3:
+                raise InputError(f"model.{name}", v, "3 box dimensions (x, y, z) [m]")
+            object.__setattr__(self, name, tuple(positive(f"model.{name}", float(c)) for c in v))
+        if len(self.joint_range) != len(nm.LEG_JOINTS):
+            raise InputError("model.joint_range", self.joint_range, "6 (lower, upper) pairs")
+        for name, (lo, hi) in zip(nm.LEG_JOINTS, self.joint_range, strict=True):
+            if not lo < hi:
+                raise InputError(f"model.joint_range[{name}]", (lo, hi), "lower < upper [rad]")
+        if 2.0 * self.corner_radius >= min(self.foot_length, self.foot_width):
+            raise InputError("model.corner_radius", self.corner_radius, "< half the foot width")
+        if self.corner_radius >= self.ankle_height:
+            raise InputError("model.corner_radius", self.corner_radius, "< ankle_height")
+        leg = self.thigh_length + self.shank_length
+        if not self.ankle_height < self.nominal_hip_height < self.ankle_height + leg:
+            raise InputError(
+                "model.nominal_hip_height",
+                self.nominal_hip_height,
+                f"between ankle_height and ankle_height + thigh + shank ({self.ankle_height + leg})",
+            )
+
+    @property
+    def total_mass(self) -> float:
+        """Sum of all link masses [kg]."""
+        leg = 2 * self.hip_link_mass + self.thigh_mass + self.shank_mass + self.foot_mass
+        return self.pelvis_mass + self.torso_mass + 2.0 * leg
+
+    def leg_angles(self, hip_height: float) -> tuple[float, float, float]:
+        """(hip pitch, knee, ankle pitch) [rad] of a leg with the hip ``hip_height`` [m] straight
+        above a flat foot, torso upright (law of cosines in the sagittal plane).
+
+        Raises:
+            InputError: when the height is out of the leg's reach.
+        """
+        d = hip_height - self.ankle_height
+        l1, l2 = self.thigh_length, self.shank_length
+        if not abs(l1 - l2) < d < l1 + l2:
+            raise InputError("hip_height", hip_height, f"in ({abs(l1 - l2)}, {l1 + l2}) + ankle")
+        knee = math.pi - math.acos((l1 * l1 + l2 * l2 - d * d) / (2.0 * l1 * l2))
+        # the thigh leans forward by a, the shank back so that the ankle ends below the hip
+        a = math.acos((l1 * l1 + d * d - l2 * l2) / (2.0 * l1 * d))
+        return -a, knee, knee - a
+
+    def nominal_joints(self) -> FloatArray:
+        """Joint angles (12,) of the nominal posture, left leg then right leg in LEG_JOINTS order."""
+        hp, kn, ap = self.leg_angles(self.nominal_hip_height)
+        leg = np.array([0.0, 0.0, hp, kn, -ap, 0.0])
+        return np.concatenate([leg, leg])
+
+    @property
+    def pelvis_height(self) -> float:
+        """Pelvis centre above the soles in the nominal posture [m]."""
+        return self.nominal_hip_height + self.hip_drop
+
+
+def _f(*values: float) -> str:
+    return " ".join(f"{v:.6g}" for v in values)
+
+
+def _box_inertia(mass: float, sx: float, sy: float, sz: float) -> tuple[float, float, float]:
+    return (
+        mass * (sy * sy + sz * sz) / 12.0,
+        mass * (sx * sx + sz * sz) / 12.0,
+        mass * (sx * sx + sy * sy) / 12.0,
+    )
+
+
+def _rod_inertia(mass: float, length: float, radius: float) -> tuple[float, float, float]:
+    """Slender rod along z: inertia about its centre [kg m^2]."""
+    transverse = mass * (3.0 * radius * radius + length * length) / 12.0
+    return transverse, transverse, 0.5 * mass * radius * radius
+
+
+def _joint_range(p: BipedModel, side: Side, index: int) -> tuple[float, float]:
+    lo, hi = p.joint_range[index]
+    # roll and yaw limits are given for the left leg; the right leg is its mirror image
+    if side is Side.RIGHT and nm.LEG_JOINTS[index] in ("hip_yaw", "hip_roll", "ankle_roll"):
+        return -hi, -lo
+    return lo, hi
+
+
+def _leg_xml(p: BipedModel, s: BipedSimSettings, side: Side) -> str:
+    y = side.sign * p.hip_width / 2.0
+    r = p.corner_radius
+    hl = _f(*_box_inertia(p.hip_link_mass, 0.06, 0.06, 0.06))
+    ti = _f(*_rod_inertia(p.thigh_mass, p.thigh_length, 0.04))
+    si = _f(*_rod_inertia(p.shank_mass, p.shank_length, 0.035))
+    foot_h = 0.03
+    fi = _f(*_box_inertia(p.foot_mass, p.foot_length, p.foot_width, foot_h))
+    nocol = 'contype="0" conaffinity="0"'
+    col = f'contype="{nm.ROBOT_CONTYPE}" conaffinity="{nm.ROBOT_CONAFFINITY}"'
+
+    def jnt(i: int) -> str:
+        lo, hi = _joint_range(p, side, i)
+        return (
+            f'<joint name="{nm.joint(side, nm.LEG_JOINTS[i])}" axis="{nm.LEG_JOINT_AXES[i]}" '
+            f'range="{_f(lo, hi)}"/>'
+        )
+
+    corners = "\n".join(
+        f'              <geom name="{nm.corner_geom(side, k)}" type="sphere" size="{r:.6g}" '
+        f'pos="{_f(cx * (p.foot_length / 2 - r), cy * (p.foot_width / 2 - r), -p.ankle_height + r)}" '
+        f'material="foot" friction="{s.friction:.6g} 0.02 0.002" {col}/>'
+        for k, (cx, cy) in enumerate(nm.FOOT_CORNERS)
+    )
+    link = nm.link_body
+    return f"""
+      <body name="{link(side, "hip_yaw")}" pos="{_f(0.0, y, -p.hip_drop)}">
+        {jnt(0)}
+        <inertial pos="0 0 0" mass="{p.hip_link_mass:.6g}" diaginertia="{hl}"/>
+        <body name="{link(side, "hip_roll")}">
+          {jnt(1)}
+          <inertial pos="0 0 0" mass="{p.hip_link_mass:.6g}" diaginertia="{hl}"/>
+          <geom type="sphere" size="0.045" material="joint" {nocol}/>
+          <body name="{link(side, "hip_pitch")}">
+            {jnt(2)}
+            <inertial pos="0 0 {-p.thigh_length / 2:.6g}" mass="{p.thigh_mass:.6g}"
+                      diaginertia="{ti}"/>
+            <geom type="capsule" fromto="0 0 0 0 0 {-p.thigh_length:.6g}" size="0.04"
+                  material="leg" {nocol}/>
+            <body name="{link(side, "knee")}" pos="0 0 {-p.thigh_length:.6g}">
+              {jnt(3)}
+              <inertial pos="0 0 {-p.shank_length / 2:.6g}" mass="{p.shank_mass:.6g}"
+                        diaginertia="{si}"/>
+              <geom type="capsule" fromto="0 0 0 0 0 {-p.shank_length:.6g}" size="0.035"
+                    material="leg" {nocol}/>
+              <body name="{link(side, "ankle_pitch")}" pos="0 0 {-p.shank_length:.6g}">
+                {jnt(4)}
+                <inertial pos="0 0 0" mass="0.05" diaginertia="1e-5 1e-5 1e-5"/>
+                <body name="{nm.foot_body(side)}">
+                  {jnt(5)}
+                  <inertial pos="0 0 {-p.ankle_height + foot_h / 2:.6g}"
+                            mass="{p.foot_mass:.6g}" diaginertia="{fi}"/>
+                  <geom name="{nm.foot_geom(side)}" type="box"
+                        size="{_f(p.foot_length / 2, p.foot_width / 2, foot_h / 2)}"
+                        pos="0 0 {-p.ankle_height + foot_h / 2:.6g}" material="foot" {nocol}/>
+{corners}
+                  <site name="{nm.sole_site(side)}" pos="0 0 {-p.ankle_height:.6g}" size="0.01"/>
+                </body>
+              </body>
+            </body>
+          </body>
+        </body>
+      </body>"""
+
+
+def biped_mjcf(
+    params: BipedModel | None = None,
+    terrain: tuple[str, str] = ("", ""),
+    settings: BipedSimSettings | None = None,
+) -> str:
+    """MJCF text of the biped on a terrain.
+
+    Args:
+        params: link parameters (default :class:`BipedModel`).
+        terrain: ``(asset_xml, worldbody_xml)`` of the terrain (see
+            :func:`footfall.sim.terrain_mjcf.terrain_xml`); empty = no ground at all.
+        settings: physics and actuator settings.
+
+    Returns:
+        The MJCF document. The robot's ankle-pitch joint carries 0.05 kg (axis hub), which is
+        why the ``total_mass`` of the model exceeds :attr:`BipedModel.total_mass` by 0.1 kg.
+    """
+    p = params if params is not None else BipedModel()
+    s = settings if settings is not None else BipedSimSettings()
+    asset_xml, world_xml = terrain
+    pi = _f(*_box_inertia(p.pelvis_mass, *p.pelvis_size))
+    ti = _f(*_box_inertia(p.torso_mass, *p.torso_size))
+    legs = "".join(_leg_xml(p, s, side) for side in (Side.LEFT, Side.RIGHT))
+    actuators = "\n    ".join(
+        f'<position name="{nm.actuator(side, j)}" joint="{nm.joint(side, j)}" '
+        f'kp="{s.kp:.6g}" kv="{s.kv:.6g}" forcerange="{_f(-s.torque_limit, s.torque_limit)}"/>'
+        for side in (Side.LEFT, Side.RIGHT)
+        for j in nm.LEG_JOINTS
+    )
+    col = f'contype="{nm.ROBOT_CONTYPE}" conaffinity="{nm.ROBOT_CONAFFINITY}"'
+    return f"""<mujoco model="{nm.MODEL_NAME}">
+  <compiler angle="radian" autolimits="true"/>
+  <option timestep="{s.timestep:.6g}" integrator="implicitfast" cone="elliptic"
+          impratio="{s.impratio:.6g}"/>
+  <visual>
+    <global offwidth="1280" offheight="720"/>
+    <quality shadowsize="2048"/>
+  </visual>
+  <default>
+    <joint damping="0.5" armature="{s.armature:.6g}"/>
+    <geom solref="0.004 1" group="{nm.ROBOT_GROUP}"/>
+  </default>
+  <asset>
+    <texture name="grid" type="2d" builtin="checker" rgb1="0.55 0.6 0.55" rgb2="0.45 0.5 0.45"
+             width="512" height="512"/>
+    <material name="terrain" texture="grid" texrepeat="4 4" texuniform="true"/>
+    <material name="body" rgba="0.25 0.35 0.6 1"/>
+    <material name="leg" rgba="0.7 0.7 0.72 1"/>
+    <material name="joint" rgba="0.3 0.3 0.3 1"/>
+    <material name="foot" rgba="0.15 0.15 0.15 1"/>
+    {asset_xml}
+  </asset>
+  <worldbody>
+    <light pos="0 -3 6" dir="0 0.4 -1" directional="true"/>
+    {world_xml}
+    <body name="{nm.PELVIS_BODY}" pos="0 0 {p.pelvis_height:.6g}">
+      <freejoint name="{nm.ROOT_JOINT}"/>
+      <camera name="{nm.TRACK_CAMERA}" mode="trackcom" pos="0.3 -2.6 0.6"
+              xyaxes="1 0 0 0 0.2 1"/>
+      <inertial pos="0 0 0" mass="{p.pelvis_mass:.6g}" diaginertia="{pi}"/>
+      <geom name="{nm.PELVIS_GEOM}" type="box" size="{_f(*(c / 2 for c in p.pelvis_size))}"
+            material="body" {col}/>
+      <body name="{nm.TORSO_BODY}" pos="0 0 {p.torso_offset:.6g}">
+        <inertial pos="0 0 0" mass="{p.torso_mass:.6g}" diaginertia="{ti}"/>
+        <geom name="{nm.TORSO_GEOM}" type="box" size="{_f(*(c / 2 for c in p.torso_size))}"
+              material="body" {col}/>
+      </body>{legs}
+    </body>
+  </worldbody>
+  <actuator>
+    {actuators}
+  </actuator>
+</mujoco>
+"""
+
+
+@dataclass(frozen=True)
+class ModelInfo:
+    """Quantities of the compiled model at the nominal posture, measured by MuJoCo.
+
+    Attributes:
+        mass: total mass [kg].
+        com_height: CoM height above the soles, feet flat side by side [m].
+        com_offset: horizontal CoM offset from the midpoint of the soles, (2,) [m].
+    """
+
+    mass: float
+    com_height: float
+    com_offset: tuple[float, float]
+
+
+def measure_model(params: BipedModel | None = None) -> ModelInfo:
+    """Compile the model without terrain and measure its mass and nominal CoM height."""
+    mujoco = require_mujoco()
+    p = params if params is not None else BipedModel()
+    model = mujoco.MjModel.from_xml_string(biped_mjcf(p))
+    data = mujoco.MjData(model)
+    root = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, nm.ROOT_JOINT)]
+    data.qpos[root : root + 3] = (0.0, 0.0, p.pelvis_height)
+    data.qpos[root + 3 : root + 7] = (1.0, 0.0, 0.0, 0.0)
+    for i, side in enumerate((Side.LEFT, Side.RIGHT)):
+        for j, name in enumerate(nm.LEG_JOINTS):
+            jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, nm.joint(side, name))
+            data.qpos[model.jnt_qposadr[jid]] = p.nominal_joints()[6 * i + j]
+    mujoco.mj_forward(model, data)
+    pelvis = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, nm.PELVIS_BODY)
+    com = np.array(data.subtree_com[pelvis])
+    soles = [
+        data.site_xpos[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, nm.sole_site(s))]
+        for s in (Side.LEFT, Side.RIGHT)
+    ]
+    mid = 0.5 * (soles[0] + soles[1])
+    return ModelInfo(
+        mass=float(np.sum(model.body_mass)),
+        com_height=float(com[2] - mid[2]),
+        com_offset=(float(com[0] - mid[0]), float(com[1] - mid[1])),
+    )
+
+
+def planner_params(
+    params: BipedModel | None = None, base: BipedParams | None = None
+) -> BipedParams:
+    """The planner's robot parameters derived from the MuJoCo model.
+
+    Mass and CoM height are measured (:func:`measure_model`); stance width and foot size are the
+    model's; the ankle-torque bound is ``U_MAX_FOOT_SHARE * m g * foot_width / 2`` (or the base's,
+    if smaller) so that a planned ZMP always lies inside the sole. Everything else (timing, reach,
+    heading limits) comes from ``base`` (default :class:`BipedParams`).
+    """
+    p = params if params is not None else BipedModel()
+    b = base if base is not None else BipedParams()
+    info = measure_model(p)
+    u_foot = U_MAX_FOOT_SHARE * info.mass * b.g * p.foot_width / 2.0
+    return replace(
+        b,
+        mass=info.mass,
+        com_height=info.com_height,
+        stance_width=p.hip_width,
+        foot_length=p.foot_length,
+        foot_width=p.foot_width,
+        u_max=min(b.u_max, u_foot),
+    )

@@ -1,0 +1,1234 @@
+"""Walk a footstep plan with the MuJoCo biped and measure it (document 000, section 5.5).
+
+Control loop (every ``control_dt``):
+
+1. **Measure** the ALIP state (eq. 5.1) of the robot about the stance contact point: the CoM
+   relative to the stance sole centre and either ``m z_H (-v_y, v_x)`` from the CoM velocity
+   (default) or the true angular momentum ``L = L_G + m (c - p) x v`` (MuJoCo's subtree CoM,
+   velocity and angular momentum; ``WalkOptions.true_momentum``).
+2. **Footstep / ankle-torque source** (:class:`FootstepAdjuster`): returns the next footstep and
+   the ankle torque of this tick. The built-in :class:`PlanFollower` uses the plan's footsteps and
+   ALIP torques, corrected by one-step ALIP foot placement; the MPC of eq. (5.19) plugs in here.
+3. **Reference**: the ALIP reference state is advanced by one tick with that torque, exactly
+   (zero-order hold, eq. 5.5), after blending it toward the measured state by ``com_feedback``.
+   In double support the contact point moves linearly to the new foot (the model behind the reset
+   map, eq. 5.8-5.10). The CoM height follows the footstep heights smoothly.
+4. **Whole body**: differential inverse kinematics with ``mink`` (one QP per iteration, solved by
+   ``daqp``) tracks the CoM, both sole poses (stance: where it stands; swing: a trajectory that
+   rises above every region it passes over before moving, see :func:`swing_reference`) and an
+   upright torso; the resulting joint angles are the set points of the joint servos.
+
+Everything reported is *measured* in the simulation: the centre of pressure (ZMP) of the stance
+foot's contact forces (``mj_contactForce``), its offset from the sole centre in the foot frame,
+where each foot lands, whether the robot fell. Planned quantities are only used for errors.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.linalg import expm
+
+from footfall._validate import finite_vector, non_negative, positive
+from footfall.errors import FootfallError, InputError
+from footfall.models.alip import ALIP
+from footfall.models.biped import Side
+from footfall.planning.plan import FootstepPlan
+from footfall.sim import biped_names as nm
+from footfall.sim.biped_model import BipedModel, BipedSimSettings, biped_mjcf, require_mujoco
+from footfall.sim.terrain_mjcf import terrain_xml
+from footfall.terrain.region import Region
+from footfall.terrain.scene import Scene
+
+FloatArray = NDArray[np.float64]
+
+#: a foot is loaded when its contact force exceeds this share of the weight
+CONTACT_FORCE_SHARE = 0.02
+#: the robot has fallen when the pelvis is lower than this share of its nominal height above the
+#: stance sole ...
+FALL_HEIGHT_SHARE = 0.6
+#: ... or the torso tilts more than this [rad], or the pelvis or torso touches the terrain
+FALL_TILT = math.radians(40.0)
+#: the CoP counts as "at the edge" of the sole (the foot starts to tip) within this distance [m]
+EDGE_TOL = 0.005
+#: the goal is reached when the final feet midpoint is this close to it in plan view [m]
+GOAL_TOL = 0.10
+#: video frame rate [1/s]
+VIDEO_FPS = 30
+#: extra footsteps after the plan's last one, taken where the feet already are and corrected by
+#: foot placement toward zero momentum: they absorb the momentum the walk ends with
+STOP_STEPS = 0
+#: sole-pose and CoM costs of the inverse kinematics: the feet must be where they are (the stance
+#: foot cannot move), the CoM is the ALIP's; torso and posture are secondary
+FOOT_POSITION_COST = 10.0
+FOOT_ORIENTATION_COST = 5.0
+COM_COST = 10.0
+TORSO_ORIENTATION_COST = 2.0
+POSTURE_COST = 0.05
+#: Levenberg-Marquardt style damping of the IK QP
+IK_DAMPING = 1e-3
+#: positions of the ankle joints in ``LEG_JOINTS``
+ANKLE_PITCH, ANKLE_ROLL = 4, 5
+#: damping of a torque-driven ankle [N m s / rad]
+ANKLE_TORQUE_DAMPING = 0.5
+#: share of the sole's contact rectangle the commanded ankle torque may use (CoP margin)
+SOLE_TORQUE_SHARE = 0.9
+
+
+# ============================================================================= options
+@dataclass(frozen=True)
+class Push:
+    """An external force on the torso.
+
+    Attributes:
+        start: time since the start of the walk [s].
+        duration: [s].
+        force: world-frame force (3,) [N].
+    """
+
+    start: float
+    duration: float
+    force: FloatArray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "start", non_negative("push.start", self.start))
+        object.__setattr__(self, "duration", positive("push.duration", self.duration))
+        f = finite_vector("push.force", self.force, 3)
+        f.setflags(write=False)
+        object.__setattr__(self, "force", f)
+
+    def active(self, t: float) -> bool:
+        """Whether the push acts at time ``t`` [s]."""
+        return self.start <= t < self.start + self.duration
+
+
+@dataclass(frozen=True)
+class WalkOptions:
+    """Options of the walking controller.
+
+    Attributes:
+        control_dt: control period (measurement, adjuster, reference, IK) [s]; a multiple of the
+            physics step.
+        ik_iterations: differential-IK QP solves per control tick.
+        swing_clearance: height of the swing sole above the highest region it passes over [m].
+        com_feedback: share in [0, 1] by which the ALIP reference is pulled toward the measured
+            state every tick: 0 tracks the planned CoM motion stiffly (the ankle absorbs every
+            error), 1 lets the CoM move as an ALIP from the measured state (errors are corrected
+            only by foot placement and torque).
+        settle_time: standing time before the CoM shifts over the first stance foot [s].
+        shift_time: duration of that shift [s].
+        stop_time: time to bring the CoM to the middle of the final feet after the last step [s].
+        hold_time: standing time at the end [s].
+        pushes: external pushes.
+        stop_steps: stopping steps after the plan (:func:`extend_plan`); the adjuster must
+            answer for phases up to ``N + stop_steps - 1`` (:class:`PlanFollower` does).
+        com_gain: gain of the CoM tracking feedback: the IK's CoM target is the reference plus
+            ``com_gain`` times the horizontal tracking error. Without it the joint servos'
+            compliance lets a robot standing on one foot roll slowly over it.
+        ankle_torque: in single support, drive the stance ankle (pitch and roll) with the ALIP
+            torque instead of a position servo: the sole then lies flat whatever the body does and
+            the CoP is the commanded torque over the weight (the ALIP input, eq. 5.3); the CoM
+            moves as the pendulum it is, with the reference following the measured state
+            (``com_feedback`` = 1 and no ``com_gain`` in single support). False: every joint is
+            position-servoed and the ankle torque is whatever tracking the CoM reference needs.
+        true_momentum: give the adjuster the true angular momentum about the stance point
+            (``L_G + m (c - p) x v``, Gong & Grizzle) instead of ``m z_H (-v_y, v_x)`` from the
+            CoM velocity. Default False: with this robot's fast swing legs the CoM-velocity state
+            walked further in our runs.
+        stop_on_fall: end the simulation when a fall is detected.
+    """
+
+    control_dt: float = 0.01
+    ik_iterations: int = 2
+    swing_clearance: float = 0.05
+    com_feedback: float = 0.0
+    settle_time: float = 0.3
+    shift_time: float = 2.0
+    stop_time: float = 1.0
+    hold_time: float = 0.5
+    pushes: tuple[Push, ...] = ()
+    stop_steps: int = STOP_STEPS
+    com_gain: float = 1.5
+    ankle_torque: bool = True
+    true_momentum: bool = False
+    stop_on_fall: bool = True
+
+    def __post_init__(self) -> None:
+        for name in ("control_dt", "swing_clearance", "shift_time", "stop_time"):
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        for name in ("settle_time", "hold_time", "com_gain"):
+            object.__setattr__(self, name, non_negative(name, getattr(self, name)))
+        fb = non_negative("com_feedback", self.com_feedback)
+        if fb > 1.0:
+            raise InputError("com_feedback", self.com_feedback, "a share in [0, 1]")
+        object.__setattr__(self, "com_feedback", fb)
+        it = self.ik_iterations
+        if isinstance(it, bool) or not isinstance(it, int) or it < 1:
+            raise InputError("ik_iterations", it, "an integer >= 1")
+        pushes = tuple(self.pushes)
+        for i, p in enumerate(pushes):
+            if not isinstance(p, Push):
+                raise InputError(f"pushes[{i}]", p, "a Push")
+        object.__setattr__(self, "pushes", pushes)
+
+
+# ============================================================================= adjuster
+class FootstepAdjuster(Protocol):
+    """Source of the next footstep and the ankle torque, called once per control tick.
+
+    This is where the MPC of document 000 eq. (5.19) plugs in: it receives the measured ALIP state
+    of the current single support and returns the (re-optimised) next footstep and the torque to
+    apply now.
+    """
+
+    def update(
+        self, t: float, state: FloatArray, stance: FloatArray, phase: int
+    ) -> tuple[FloatArray, FloatArray]:
+        """One control tick.
+
+        Args:
+            t: time since the start of single-support phase ``phase`` [s], in [0, T_ss).
+            state: measured ALIP state ``[x_c, y_c, L_x, L_y]`` (4,) relative to the stance
+                sole centre [m, m, kg m^2/s, kg m^2/s] (eq. 5.1).
+            stance: measured stance sole centre (3,) [m], world frame.
+            phase: single-support phase index i (stance on footstep i of the plan).
+
+        Returns:
+            ``(next_footstep (3,) [m] world, ankle torque (2,) [N m])`` with the torque in the
+            ALIP convention (ground on robot, ZMP = stance + (-tau_y, tau_x) / (m g)).
+        """
+        ...
+
+
+def extend_plan(plan: FootstepPlan, extra: int = STOP_STEPS) -> FootstepPlan:
+    """``plan`` with ``extra`` stopping steps appended (in place: each foot steps where it stands).
+
+    Their ALIP states and torques are zero (the CoM at rest over the stance foot): as a foot
+    placement reference this asks to end the next phase with zero momentum, i.e. to capture the
+    remaining motion.
+    """
+    if extra <= 0:
+        return plan
+    n = plan.n_steps
+    idx = [n - 1 + (j % 2) for j in range(extra)]
+    k = plan.states.shape[1]
+    return replace(
+        plan,
+        footsteps=np.vstack([plan.footsteps, plan.footsteps[idx]]),
+        headings=np.concatenate([plan.headings, plan.headings[idx]]),
+        sides=plan.sides + tuple(plan.sides[i] for i in idx),
+        regions=plan.regions + tuple(plan.regions[i] for i in idx),
+        states=np.concatenate([plan.states, np.zeros((extra, k, 4))]),
+        torques=np.concatenate([plan.torques, np.zeros((extra, k - 1, 2))]),
+    )
+
+
+def _point_in_region(region: Region, xy: FloatArray, margin: float) -> bool:
+    return float(region.signed_distance(xy)) <= -margin
+
+
+@dataclass
+class PlanFollower:
+    """Built-in source: the plan's footsteps and ALIP torques plus one-step foot placement.
+
+    The torque is the plan's zero-order-hold torque of the current node interval (eq. 5.12b). The
+    footstep correction is the one-step ALIP foot placement of Gong & Grizzle: the measured state
+    is predicted to the end of the phase with the planned torques, and the next footstep moves by
+    the ``dp`` that cancels the resulting angular-momentum error at the end of the *next* single
+    support (through the reset map, eq. 5.10: ``L`` after the next phase is linear in ``dp``).
+    The corrected footstep is kept inside the planned region (``region_margin`` from its edges),
+    its height is that region's plane, and it is frozen for the last ``1 - freeze_after`` of the
+    swing so the landing is not chased.
+
+    Attributes:
+        plan: the footstep plan.
+        regions: the scene's regions by name.
+        gain: share of the computed correction that is applied (0 = follow the plan exactly).
+        max_correction: bound on the correction's length [m].
+        region_margin: the corrected footstep stays this far inside its region [m].
+        freeze_after: phase share after which the footstep is frozen.
+        dcm_gain: gain of the capture-point feedback on the ZMP (0 = planned torque only).
+        stop_steps: stopping steps appended to the plan (:func:`extend_plan`); the walker asks
+            for phases up to ``N + stop_steps - 1``.
+    """
+
+    plan: FootstepPlan
+    regions: dict[str, Region]
+    gain: float = 1.0
+    max_correction: float = 0.12
+    region_margin: float = 0.05
+    freeze_after: float = 0.7
+    dcm_gain: float = 2.5
+    stop_steps: int = STOP_STEPS
+    _frozen: dict[int, FloatArray] = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        self.plan = extend_plan(self.plan, self.stop_steps)
+        robot = self.plan.robot
+        self._alip = robot.alip()
+        self._dt = robot.node_dt
+        self._ad, self._bd = self._alip.discretize(self._dt)
+        a_r, b_r = self._alip.reset_map(robot.t_ds)
+        ad_ss = np.linalg.matrix_power(self._ad, robot.n_nodes - 1)
+        self._to_next_end = ad_ss @ a_r  # end-of-phase state -> end of next phase (dp = 0)
+        self._dp_to_next_end = (ad_ss @ b_r)[2:4, 0:2]  # dp (x, y) -> L at end of next phase
+        self._dp_inv = np.linalg.inv(self._dp_to_next_end)
+
+    def torque(self, t: float, phase: int) -> FloatArray:
+        """Planned torque (2,) [N m] of ``phase`` at time ``t`` in it (zero-order hold)."""
+        k = min(int(t / self._dt), self.plan.torques.shape[1] - 1)
+        return np.array(self.plan.torques[phase, k])
+
+    def predict_end(self, t: float, state: FloatArray, phase: int) -> FloatArray:
+        """Measured ``state`` at ``t`` propagated to the end of the phase with planned torques."""
+        k = min(int(t / self._dt), self.plan.torques.shape[1] - 1)
+        # partial interval first, then the remaining whole node intervals
+        rest = (k + 1) * self._dt - t
+        a_p, b_p = self._alip.discretize(rest) if rest > 1e-9 else (np.eye(4), np.zeros((4, 2)))
+        x = a_p @ state + b_p @ self.plan.torques[phase, k]
+        for j in range(k + 1, self.plan.torques.shape[1]):
+            x = self._ad @ x + self._bd @ self.plan.torques[phase, j]
+        return np.asarray(x)
+
+    def planned_state(self, t: float, phase: int) -> FloatArray:
+        """The plan's ALIP state (4,) at ``t`` in ``phase`` (exact ZOH from the previous node)."""
+        k = min(int(t / self._dt), self.plan.torques.shape[1] - 1)
+        a_p, b_p = self._alip.discretize(max(t - k * self._dt, 1e-9))
+        return np.asarray(a_p @ self.plan.states[phase, k] + b_p @ self.plan.torques[phase, k])
+
+    def dcm_torque(self, t: float, state: FloatArray, phase: int) -> FloatArray:
+        """Planned torque plus divergent-component-of-motion feedback (capture point tracking).
+
+        With ``xi = c + v / omega`` the ALIP obeys ``xi' = omega (xi - zmp)``; the ZMP command
+        ``zmp_plan + dcm_gain (xi - xi_plan)`` makes the error decay as
+        ``exp(omega (1 - dcm_gain) t)``.
+        """
+        u = self.torque(t, phase)
+        if self.dcm_gain <= 0.0:
+            return u
+        omega = self._alip.omega
+        ref = self.planned_state(t, phase)
+        xi = state[:2] + self._alip.velocity(state) / omega
+        xi_ref = ref[:2] + self._alip.velocity(ref) / omega
+        zmp = self._alip.zmp(np.zeros(2), u) + self.dcm_gain * (xi - xi_ref)
+        return np.asarray(self._alip.torque_for_zmp(zmp))
+
+    def update(
+        self, t: float, state: FloatArray, stance: FloatArray, phase: int
+    ) -> tuple[FloatArray, FloatArray]:
+        """See :class:`FootstepAdjuster`."""
+        plan = self.plan
+        ref_next = np.array(plan.footsteps[phase + 1])
+        u = self.dcm_torque(t, state, phase)
+        if phase in self._frozen:
+            return self._frozen[phase], u
+        # the plan's footstep relative to where the stance foot really is
+        target = ref_next.copy()
+        if self.gain > 0.0:
+            x_end = self.predict_end(t, state, phase)
+            err = self._to_next_end @ (x_end - plan.states[phase, -1])
+            # The reset acts on the step p_{i+1} - p_i: if the robot stands off its planned
+            # footstep by s, keeping the planned step vector needs dp = s. The foot-placement
+            # term then cancels the angular-momentum error at the end of the next phase.
+            shift = (stance - plan.footsteps[phase])[:2]
+            fb = -self.gain * (self._dp_inv @ err[2:4])
+            norm = float(np.linalg.norm(fb))
+            if norm > self.max_correction:
+                fb *= self.max_correction / norm
+            target[:2] = ref_next[:2] + shift + fb
+            target = self._clamp_to_region(target, ref_next, plan.regions[phase + 1])
+        if t >= self.freeze_after * plan.robot.t_ss:
+            self._frozen[phase] = target
+        return target, u
+
+    def _clamp_to_region(self, target: FloatArray, ref: FloatArray, name: str) -> FloatArray:
+        region = self.regions.get(name)
+        if region is None:
+            return ref
+        xy = target[:2]
+        if not _point_in_region(region, xy, self.region_margin):
+            # bisect on the segment from the planned footstep (inside) to the corrected one
+            lo, hi = 0.0, 1.0
+            if not _point_in_region(region, ref[:2], self.region_margin):
+                return ref
+            for _ in range(20):
+                mid = 0.5 * (lo + hi)
+                if _point_in_region(region, ref[:2] + mid * (xy - ref[:2]), self.region_margin):
+                    lo = mid
+                else:
+                    hi = mid
+            xy = ref[:2] + lo * (xy - ref[:2])
+        return np.array([xy[0], xy[1], float(region.height_at(xy))])
+
+
+# ============================================================================= geometry helpers
+def smoothstep(s: float) -> float:
+    """Quintic 0 -> 1 on [0, 1] with zero velocity and acceleration at both ends."""
+    s = min(1.0, max(0.0, s))
+    return s * s * s * (10.0 + s * (-15.0 + 6.0 * s))
+
+
+def foot_rotation(normal: ArrayLike, heading: float) -> FloatArray:
+    """Rotation (3, 3) of a sole lying on a plane with ``normal`` and pointing along ``heading``.
+
+    Columns: the heading direction projected onto the plane, the lateral axis, the normal.
+    """
+    n = np.asarray(normal, dtype=float)
+    h = np.array([math.cos(heading), math.sin(heading), 0.0])
+    x = h - (h @ n) * n
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(n, x), n])
+
+
+def swing_reference(
+    tau: float, start: FloatArray, target: FloatArray, apex: float
+) -> tuple[FloatArray, float]:
+    """Swing sole position (3,) [m] at phase share ``tau`` and the horizontal progress in [0, 1].
+
+    The sole rises to ``apex`` in the first ``SWING_RISE`` of the swing, moves horizontally during
+    ``SWING_MOVE`` and descends in the last part, so it crosses every step edge at the apex
+    height; every profile is a quintic smoothstep (zero velocity at lift-off and touchdown).
+    """
+    s_h = smoothstep((tau - SWING_MOVE[0]) / (SWING_MOVE[1] - SWING_MOVE[0]))
+    if tau < SWING_RISE:
+        z = start[2] + (apex - start[2]) * smoothstep(tau / SWING_RISE)
+    elif tau < SWING_DESCEND:
+        z = apex
+    else:
+        z = apex + (target[2] - apex) * smoothstep((tau - SWING_DESCEND) / (1.0 - SWING_DESCEND))
+    xy = start[:2] + (target[:2] - start[:2]) * s_h
+    return np.array([xy[0], xy[1], z]), s_h
+
+
+#: swing phase shares: rise until, horizontal motion between, descent from
+SWING_RISE = 0.35
+SWING_MOVE = (0.1, 0.9)
+SWING_DESCEND = 0.65
+
+
+def terrain_height_along(
+    regions: tuple[Region, ...], start: FloatArray, target: FloatArray, half_length: float
+) -> float:
+    """Highest region surface under the segment start -> target (extended by a half foot) [m]."""
+    d = target[:2] - start[:2]
+    length = float(np.linalg.norm(d))
+    u = d / length if length > 1e-9 else np.zeros(2)
+    pts = [start[:2] + u * s for s in np.linspace(-half_length, length + half_length, 16)]
+    best = max(float(start[2]), float(target[2]))
+    for p in pts:
+        for r in regions:
+            if float(r.signed_distance(p)) <= half_length:
+                best = max(best, float(r.height_at(p)))
+    return best
+
+
+# ============================================================================= the simulator
+class BipedSim:
+    """MuJoCo model + data of the biped on a scene's terrain, with handles resolved by name."""
+
+    def __init__(
+        self,
+        scene: Scene,
+        model_params: BipedModel | None = None,
+        settings: BipedSimSettings | None = None,
+    ) -> None:
+        mujoco = require_mujoco()
+        self.mujoco = mujoco
+        self.params = model_params if model_params is not None else BipedModel()
+        self.settings = settings if settings is not None else BipedSimSettings()
+        xml = biped_mjcf(self.params, terrain_xml(scene.terrain), self.settings)
+        self.model = mujoco.MjModel.from_xml_string(xml)
+        self.data = mujoco.MjData(self.model)
+        m = self.model
+        obj = mujoco.mjtObj
+
+        def ident(kind: Any, name: str) -> int:
+            i = int(mujoco.mj_name2id(m, kind, name))
+            if i < 0:
+                raise FootfallError(f"biped model has no element named {name!r}")
+            return i
+
+        self.pelvis = ident(obj.mjOBJ_BODY, nm.PELVIS_BODY)
+        self.torso = ident(obj.mjOBJ_BODY, nm.TORSO_BODY)
+        self.root_adr = int(m.jnt_qposadr[ident(obj.mjOBJ_JOINT, nm.ROOT_JOINT)])
+        self.sides = (Side.LEFT, Side.RIGHT)
+        self.sole_sites = {s: ident(obj.mjOBJ_SITE, nm.sole_site(s)) for s in self.sides}
+        self.joint_qpos = np.array(
+            [
+                m.jnt_qposadr[ident(obj.mjOBJ_JOINT, nm.joint(s, j))]
+                for s in self.sides
+                for j in nm.LEG_JOINTS
+            ]
+        )
+        self.actuators = np.array(
+            [
+                ident(obj.mjOBJ_ACTUATOR, nm.actuator(s, j))
+                for s in self.sides
+                for j in nm.LEG_JOINTS
+            ]
+        )
+        self.foot_of_geom: dict[int, Side] = {}
+        for s in self.sides:
+            for k in range(len(nm.FOOT_CORNERS)):
+                self.foot_of_geom[ident(obj.mjOBJ_GEOM, nm.corner_geom(s, k))] = s
+        self.body_geoms = {
+            ident(obj.mjOBJ_GEOM, nm.PELVIS_GEOM),
+            ident(obj.mjOBJ_GEOM, nm.TORSO_GEOM),
+        }
+        self._kp = np.array(m.actuator_gainprm[self.actuators, 0])
+        self._bias = np.array(m.actuator_biasprm[self.actuators, :3])
+        self.mass = float(np.sum(m.body_mass))
+        self.weight = self.mass * float(-m.opt.gravity[2])
+        self._f6 = np.zeros(6)
+
+    def set_standing(self, left: FloatArray, right: FloatArray, heading: float) -> None:
+        """Nominal posture with the soles at ``left``/``right`` (3,) [m], then forward kinematics."""
+        d = self.data
+        d.qpos[:] = 0.0
+        d.qvel[:] = 0.0
+        mid = 0.5 * (np.asarray(left) + np.asarray(right))
+        d.qpos[self.root_adr : self.root_adr + 3] = (
+            mid[0],
+            mid[1],
+            mid[2] + self.params.pelvis_height,
+        )
+        d.qpos[self.root_adr + 3 : self.root_adr + 7] = (
+            math.cos(heading / 2),
+            0.0,
+            0.0,
+            math.sin(heading / 2),
+        )
+        q = self.params.nominal_joints()
+        d.qpos[self.joint_qpos] = q
+        d.ctrl[self.actuators] = q
+        self.mujoco.mj_forward(self.model, d)
+
+    def ankle_actuators(self, side: Side) -> NDArray[np.int_]:
+        """Indices into ``actuators`` of the ``side`` ankle (pitch, roll)."""
+        base = len(nm.LEG_JOINTS) * self.sides.index(side)
+        return np.array([base + ANKLE_PITCH, base + ANKLE_ROLL])
+
+    def set_ankle_torque_mode(self, side: Side, torque: bool) -> None:
+        """Switch the ``side`` ankle servos to torque (ctrl = joint torque [N m]) or position mode.
+
+        A MuJoCo position actuator is ``gain * ctrl + bias`` with gain ``kp`` and bias
+        ``(0, -kp, -kv)``; torque mode is gain 1 and only a small damping ``ANKLE_TORQUE_DAMPING``.
+        """
+        for j in self.ankle_actuators(side):
+            a = self.actuators[j]
+            if torque:
+                self.model.actuator_gainprm[a, 0] = 1.0
+                self.model.actuator_biasprm[a, :3] = (0.0, 0.0, -ANKLE_TORQUE_DAMPING)
+            else:
+                self.model.actuator_gainprm[a, 0] = self._kp[j]
+                self.model.actuator_biasprm[a, :3] = self._bias[j]
+
+    def sole(self, side: Side) -> tuple[FloatArray, FloatArray]:
+        """Measured sole centre (3,) [m] and rotation (3, 3) of the ``side`` foot."""
+        sid = self.sole_sites[side]
+        return np.array(self.data.site_xpos[sid]), np.array(self.data.site_xmat[sid]).reshape(3, 3)
+
+    def com_state(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """CoM position (3,) [m], velocity (3,) [m/s], angular momentum about the CoM (3,)."""
+        self.mujoco.mj_subtreeVel(self.model, self.data)
+        b = self.pelvis
+        d = self.data
+        return (
+            np.array(d.subtree_com[b]),
+            np.array(d.subtree_linvel[b]),
+            np.array(d.subtree_angmom[b]),
+        )
+
+    def contacts(self) -> tuple[dict[Side, tuple[FloatArray, FloatArray]], bool]:
+        """Per foot, contact points (n, 3) and forces on the robot (n, 3) [N]; body-hit flag."""
+        d, m = self.data, self.model
+        pts: dict[Side, list[FloatArray]] = {s: [] for s in self.sides}
+        frc: dict[Side, list[FloatArray]] = {s: [] for s in self.sides}
+        body_hit = False
+        for i in range(d.ncon):
+            c = d.contact[i]
+            g1, g2 = int(c.geom[0]), int(c.geom[1])
+            if g1 in self.body_geoms or g2 in self.body_geoms:
+                body_hit = True
+                continue
+            if g1 in self.foot_of_geom:
+                side, sign = self.foot_of_geom[g1], -1.0
+            elif g2 in self.foot_of_geom:
+                side, sign = self.foot_of_geom[g2], 1.0
+            else:
+                continue
+            self.mujoco.mj_contactForce(m, d, i, self._f6)
+            # the contact frame's rows are (normal, tangent1, tangent2) and the force acts from
+            # geom1 on geom2: on the robot as is when the foot is geom2, reversed otherwise
+            pts[side].append(np.array(c.pos))
+            frc[side].append(sign * (c.frame.reshape(3, 3).T @ self._f6[:3]))
+        out = {
+            s: (np.array(pts[s]).reshape(-1, 3), np.array(frc[s]).reshape(-1, 3))
+            for s in self.sides
+        }
+        return out, body_hit
+
+
+def sole_cop(
+    points: FloatArray, forces: FloatArray, sole_pos: FloatArray, sole_rot: FloatArray
+) -> tuple[FloatArray, float] | None:
+    """Centre of pressure of a foot in its sole frame.
+
+    The contact points lie (to within the contact penetration) on the sole plane, so the CoP is
+    the normal-force-weighted mean of the points; it is returned relative to the sole centre in
+    the foot's (x forward, y left) axes.
+
+    Args:
+        points: contact points (n, 3) [m], world.
+        forces: contact forces on the foot (n, 3) [N], world.
+        sole_pos: sole centre (3,) [m].
+        sole_rot: sole rotation (3, 3), columns x, y, normal.
+
+    Returns:
+        ``(offset (2,) [m], normal force [N])`` or None without a pushing contact.
+    """
+    if points.shape[0] == 0:
+        return None
+    fn = forces @ sole_rot[:, 2]
+    total = float(np.sum(fn))
+    if total <= 0.0:
+        return None
+    cop = (fn @ points) / total
+    local = sole_rot.T @ (cop - sole_pos)
+    return local[:2], total
+
+
+# ============================================================================= result
+@dataclass(frozen=True)
+class WalkResult:
+    """Measurements of one simulated walk (arrays sampled every control tick, T samples).
+
+    Attributes:
+        t: time since the start of the walk, shape (T,) [s].
+        phase: single-support phase index per tick, -1 outside single support, shape (T,).
+        com: measured CoM, shape (T, 3) [m].
+        com_ref: reference CoM sent to the IK, shape (T, 3) [m].
+        zmp_offset: stance-foot CoP relative to the sole centre in the foot frame, shape (T, 2)
+            [m] (NaN outside single support or without contact).
+        zmp_planned: the ZMP offset of the adjuster's commanded torque, shape (T, 2) [m].
+        feet: measured sole centres (left, right), shape (T, 2, 3) [m].
+        landed: measured sole centre after each planned footstep 1..N landed, shape (N, 3) [m]
+            (NaN if never reached).
+        targets: the commanded (corrected) footsteps 1..N, shape (N, 3) [m].
+        planned: the plan's footsteps 1..N, shape (N, 3) [m].
+        n_planned: the plan's N; entries beyond it are stopping steps.
+        fell: whether a fall was detected.
+        fall_time: when [s] (NaN if none).
+        metrics: summary numbers (:func:`summarise`).
+        timing: wall-clock seconds per part: ``control`` (measurement, adjuster, references),
+            ``ik``, ``physics``, ``render``.
+        sim_time: simulated time [s].
+        video: path of the MP4 or None; video_note says why there is none.
+    """
+
+    t: FloatArray
+    phase: NDArray[np.int_]
+    com: FloatArray
+    com_ref: FloatArray
+    zmp_offset: FloatArray
+    zmp_planned: FloatArray
+    feet: FloatArray
+    landed: FloatArray
+    targets: FloatArray
+    planned: FloatArray
+    n_planned: int
+    fell: bool
+    fall_time: float
+    metrics: dict[str, Any]
+    timing: dict[str, float]
+    sim_time: float
+    video: Path | None = None
+    video_note: str = ""
+
+
+# ============================================================================= controller
+class _IK:
+    """mink differential IK on a kinematic copy of the model (its own MjData)."""
+
+    def __init__(self, sim: BipedSim) -> None:
+        import mink
+
+        self.mink = mink
+        self.sim = sim
+        self.config = mink.Configuration(sim.model)
+        self.config.update(sim.data.qpos.copy())
+        self.feet = {
+            s: mink.FrameTask(
+                nm.sole_site(s),
+                "site",
+                position_cost=FOOT_POSITION_COST,
+                orientation_cost=FOOT_ORIENTATION_COST,
+            )
+            for s in sim.sides
+        }
+        self.com = mink.ComTask(cost=COM_COST)
+        self.torso = mink.FrameTask(
+            nm.TORSO_BODY, "body", position_cost=0.0, orientation_cost=TORSO_ORIENTATION_COST
+        )
+        self.posture = mink.PostureTask(sim.model, cost=POSTURE_COST)
+        self.posture.set_target(sim.data.qpos.copy())
+        self.tasks = [*self.feet.values(), self.com, self.torso, self.posture]
+        self.limits = [mink.ConfigurationLimit(sim.model)]
+        self.failures = 0
+
+    def solve(
+        self,
+        feet: dict[Side, tuple[FloatArray, FloatArray]],
+        com: FloatArray,
+        torso_yaw: float,
+        dt: float,
+        iterations: int,
+    ) -> FloatArray:
+        """Joint set points (12,) [rad] for sole poses, CoM (3,) [m] and torso yaw [rad]."""
+        mink = self.mink
+        for s, (pos, rot) in feet.items():
+            self.feet[s].set_target(
+                mink.SE3.from_rotation_and_translation(mink.SO3.from_matrix(rot), pos)
+            )
+        self.com.set_target(com)
+        c, s_ = math.cos(torso_yaw / 2), math.sin(torso_yaw / 2)
+        self.torso.set_target(
+            mink.SE3.from_rotation_and_translation(
+                mink.SO3(np.array([c, 0.0, 0.0, s_])), np.zeros(3)
+            )
+        )
+        for _ in range(iterations):
+            try:
+                vel = mink.solve_ik(
+                    self.config,
+                    self.tasks,
+                    dt,
+                    solver="daqp",
+                    damping=IK_DAMPING,
+                    limits=self.limits,
+                )
+            except mink.NoSolutionFound:
+                # infeasible limits (e.g. after a fall): keep the last set points
+                self.failures += 1
+                break
+            self.config.integrate_inplace(vel, dt)
+        return np.array(self.config.q[self.sim.joint_qpos])
+
+
+def _ds_propagator(alip: ALIP, dt: float) -> FloatArray:
+    """Exact one-tick map of [x (4); d (3); w (3)] for the double-support ALIP (eq. 5.8-5.10).
+
+    The contact point moves by ``d`` (its displacement from the old foot) at constant velocity
+    ``w``; measured from the old foot this is the single-support ALIP driven by ``E d``.
+    """
+    m = np.zeros((10, 10))
+    m[:4, :4] = alip.A
+    m[:4, 4:7] = alip.E
+    m[4:7, 7:10] = np.eye(3)
+    return np.asarray(expm(m * dt))
+
+
+def walk(
+    scene: Scene,
+    plan: FootstepPlan,
+    options: WalkOptions | None = None,
+    adjuster: FootstepAdjuster | None = None,
+    model_params: BipedModel | None = None,
+    settings: BipedSimSettings | None = None,
+    video_path: Path | None = None,
+    video_size: tuple[int, int] = (640, 480),
+    progress: Callable[[float], None] | None = None,
+) -> WalkResult:
+    """Simulate the biped walking ``plan`` over ``scene`` in MuJoCo and measure it.
+
+    Args:
+        scene: the scene the plan was made for (its terrain becomes MuJoCo geoms).
+        plan: a footstep plan with ALIP states and torques (any planner).
+        options: controller options.
+        adjuster: footstep / torque source; default :class:`PlanFollower`.
+        model_params: the biped's link parameters.
+        settings: physics settings.
+        video_path: write an MP4 here (offscreen GL); None = no video.
+        video_size: (width, height) [px].
+        progress: optional callback receiving the fraction done.
+
+    Returns:
+        A :class:`WalkResult`.
+
+    Raises:
+        InputError: when the plan has no footsteps or does not start on the scene's start feet.
+    """
+    opts = options if options is not None else WalkOptions()
+    if not plan.has_solution or plan.n_steps < 1:
+        raise InputError("plan", plan.status.value, "a plan with at least one footstep")
+    robot = plan.robot
+    start_stance = scene.start.stance_foot
+    if np.linalg.norm(plan.footsteps[0] - start_stance) > 1e-6:
+        raise InputError(
+            "plan.footsteps[0]",
+            plan.footsteps[0].tolist(),
+            f"the scene's start stance foot {start_stance.tolist()}",
+        )
+    sim = BipedSim(scene, model_params, settings)
+    mj, m, d = sim.mujoco, sim.model, sim.data
+    substeps = round(opts.control_dt / m.opt.timestep)
+    if substeps < 1 or abs(substeps * m.opt.timestep - opts.control_dt) > 1e-9:
+        raise InputError(
+            "control_dt", opts.control_dt, f"a multiple of the physics step {m.opt.timestep}"
+        )
+    dt = opts.control_dt
+    regions = {r.name: r for r in scene.terrain.regions}
+    src: FootstepAdjuster = adjuster if adjuster is not None else PlanFollower(plan, regions)
+    n_planned = plan.n_steps
+    plan = extend_plan(plan, opts.stop_steps)
+    alip = robot.alip()
+    ad_tick, bd_tick = alip.discretize(dt)
+    ds_map = _ds_propagator(alip, dt)
+    z_h = robot.com_height
+    n = plan.n_steps
+    t_ss, t_ds = robot.t_ss, robot.t_ds
+    t_step = t_ss + t_ds
+
+    sim.set_standing(scene.start.left, scene.start.right, scene.start.heading)
+    ik = _IK(sim)
+    # the IK's nominal CoM offset: the standing CoM is where the model puts it, not at mid-feet
+    com0, _, _ = sim.com_state()
+
+    # foot state: where each foot is (measured at its last touchdown) and its planned heading/region
+    foot_pos = {s: np.array(scene.start.foot(s)) for s in sim.sides}
+    start_region = scene.start_regions()
+    foot_rot = {
+        s: foot_rotation(regions[start_region[s]].normal, scene.start.heading) for s in sim.sides
+    }
+    normals = [regions[name].normal for name in plan.regions]
+
+    t_walk0 = opts.settle_time + opts.shift_time
+    t_end_steps = t_walk0 + n * t_step
+    t_total = t_end_steps + opts.stop_time + opts.hold_time
+    n_ticks = round(t_total / dt)
+
+    ts = np.arange(n_ticks, dtype=np.float64) * dt
+    phase_log = np.full(n_ticks, -1, dtype=int)
+    com_log = np.full((n_ticks, 3), np.nan)
+    ref_log = np.full((n_ticks, 3), np.nan)
+    zmp_log = np.full((n_ticks, 2), np.nan)
+    zmp_plan_log = np.full((n_ticks, 2), np.nan)
+    feet_log = np.full((n_ticks, 2, 3), np.nan)
+    landed = np.full((n, 3), np.nan)
+    targets = np.array(plan.footsteps[1:], dtype=float)
+    timing = {"control": 0.0, "ik": 0.0, "physics": 0.0, "render": 0.0}
+
+    renderer: Any = None
+    writer: Any = None
+    video_note = ""
+    if video_path is not None:
+        try:
+            renderer = mj.Renderer(m, height=video_size[1], width=video_size[0])
+        except Exception as exc:  # any GL failure means "no video", never a crash
+            renderer, video_note = (
+                None,
+                f"no offscreen GL ({type(exc).__name__}: {exc}); video skipped",
+            )
+        if renderer is not None:
+            import imageio.v2 as imageio
+
+            video_path.parent.mkdir(parents=True, exist_ok=True)
+            writer = imageio.get_writer(str(video_path), fps=VIDEO_FPS, macro_block_size=8)
+    frame_every = max(1, round(1.0 / (VIDEO_FPS * dt)))
+
+    stance_side = plan.sides[0]
+    x_ref = np.zeros(4)  # ALIP reference relative to the current stance contact point
+    prev_stance = np.array(scene.start.stance_foot)
+    ds_aug = np.zeros(10)
+    swing_start = foot_pos[stance_side.other].copy()
+    swing_rot0 = foot_rot[stance_side.other].copy()
+    apex = 0.0
+    cur_phase = -1
+    stop_from = np.zeros(2)
+    stop_vel = np.zeros(2)
+    fell, fall_time = False, math.nan
+    push_force = np.zeros(3)
+
+    def height_ref(t: float) -> float:
+        """CoM height [m]: z_H above the stance sole, blended between footstep heights from the
+        middle of one single support to the middle of the next."""
+        zs = plan.footsteps[:, 2]
+        if t < t_walk0 + 0.5 * t_ss:
+            return (
+                float(
+                    zs[0]
+                    if t >= opts.settle_time
+                    else 0.5 * (scene.start.left[2] + scene.start.right[2])
+                )
+                + z_h
+            )
+        u = (t - t_walk0 - 0.5 * t_ss) / t_step
+        i = math.floor(u)
+        if i >= n:
+            return float(zs[n]) + z_h
+        frac = smoothstep(u - i)
+        return float(zs[i] + (zs[i + 1] - zs[i]) * frac) + z_h
+
+    ankle_mode = {sd: False for sd in sim.sides}
+    ankle_u = np.zeros(2)
+    wall0 = time.perf_counter()
+    for k in range(n_ticks):
+        t = float(ts[k])
+        c0 = time.perf_counter()
+        com, vel, l_g = sim.com_state()
+        com_log[k] = com
+        feet_log[k, 0] = sim.sole(Side.LEFT)[0]
+        feet_log[k, 1] = sim.sole(Side.RIGHT)[0]
+        contacts, body_hit = sim.contacts()
+
+        # ---------------------------------------------------------------- schedule
+        if t < t_walk0:
+            # settle, then move the CoM over the first stance foot (the plan starts there at rest)
+            mid = 0.5 * (scene.start.left + scene.start.right)
+            s = smoothstep((t - opts.settle_time) / opts.shift_time)
+            target_xy = mid[:2] + (start_stance[:2] - mid[:2]) * s
+            com_ref = np.array([target_xy[0], target_xy[1], height_ref(t)])
+            # the standing CoM sits forward of the feet midpoint by the model's offset; keep it
+            com_ref[:2] += (com0[:2] - mid[:2]) * (1.0 - s)
+            targets_now = {sd: (foot_pos[sd], foot_rot[sd]) for sd in sim.sides}
+            yaw = scene.start.heading
+        elif t < t_end_steps:
+            tw = t - t_walk0
+            i = min(int(tw / t_step), n - 1)
+            tp = tw - i * t_step
+            if i != cur_phase:
+                # a new single support: the foot that just landed is the stance foot
+                if cur_phase >= 0:
+                    sd_landed = plan.sides[i]
+                    foot_pos[sd_landed] = sim.sole(sd_landed)[0]
+                    landed[i - 1] = foot_pos[sd_landed]
+                    # re-express the reference relative to the new stance (eq. 5.10's -I block)
+                    x_ref = ds_aug[:4].copy()
+                    x_ref[:2] -= (foot_pos[sd_landed] - prev_stance)[:2]
+                cur_phase = i
+                stance_side = plan.sides[i]
+                swing_side = stance_side.other
+                swing_start = sim.sole(swing_side)[0]
+                swing_rot0 = foot_rot[swing_side]
+                apex = (
+                    terrain_height_along(
+                        scene.terrain.regions,
+                        swing_start,
+                        plan.footsteps[i + 1],
+                        robot.foot_length / 2,
+                    )
+                    + opts.swing_clearance
+                )
+            stance = foot_pos[stance_side]
+            swing_side = stance_side.other
+            # measured ALIP state about the stance sole centre (eq. 5.1)
+            r = com - stance
+            l_c = l_g + sim.mass * np.cross(r, vel)
+            x_meas = np.array([r[0], r[1], l_c[0], l_c[1]])
+            if tp < t_ss:
+                phase_log[k] = i
+                nxt, u = src.update(
+                    tp,
+                    x_meas if opts.true_momentum else alip.state_from_velocity(r[:2], vel[:2]),
+                    stance,
+                    i,
+                )
+                targets[i] = nxt
+                zmp_plan_log[k] = alip.zmp(np.zeros(2), u)
+                fb = 1.0 if opts.ankle_torque else opts.com_feedback
+                # the kinematic reference follows the CoM's own velocity: the true momentum also
+                # holds the swing leg's and torso's (L_G), which the CoM does not move with
+                x_cv = alip.state_from_velocity(r[:2], vel[:2])
+                x_ref = x_ref + fb * (x_cv - x_ref)
+                ankle_u = u
+                x_ref = ad_tick @ x_ref + bd_tick @ u
+                tau = min(1.0, (tp + dt) / t_ss)
+                pos, s_h = swing_reference(tau, swing_start, nxt, apex)
+                rot1 = foot_rotation(normals[i + 1], plan.headings[i + 1])
+                rot = _blend_rot(swing_rot0, rot1, s_h)
+                targets_now = {stance_side: (stance, foot_rot[stance_side]), swing_side: (pos, rot)}
+                yaw = float(
+                    plan.headings[i] + (plan.headings[i + 1] - plan.headings[i]) * 0.5 * s_h
+                )
+                if tp + dt >= t_ss - 1e-9:
+                    foot_rot[swing_side] = rot1
+                ref_xy = stance[:2] + x_ref[:2]
+                # the contact point moves from the stance foot to the landing target during DS
+                prev_stance = stance.copy()
+                ds_aug = np.concatenate([x_ref, np.zeros(3), (targets[i] - stance) / t_ds])
+            else:
+                ds_aug = ds_map @ ds_aug
+                x_ref = ds_aug[:4]
+                ref_xy = prev_stance[:2] + x_ref[:2]
+                targets_now = {
+                    stance_side: (stance, foot_rot[stance_side]),
+                    swing_side: (targets[i], foot_rot[swing_side]),
+                }
+                yaw = float(0.5 * (plan.headings[i] + plan.headings[i + 1]))
+            com_ref = np.array([ref_xy[0], ref_xy[1], height_ref(t + dt)])
+            if k + 1 < n_ticks and t + dt >= t_end_steps - 1e-9:
+                stop_from = ref_xy.copy()
+                stop_vel = alip.velocity(x_ref)
+        else:
+            if not math.isnan(landed[n - 1, 0]) or cur_phase < n:
+                if math.isnan(landed[n - 1, 0]):
+                    sd_landed = plan.sides[n]
+                    foot_pos[sd_landed] = sim.sole(sd_landed)[0]
+                    landed[n - 1] = foot_pos[sd_landed]
+                    cur_phase = n
+            # stop: cubic Hermite from the last reference (position, velocity) to the middle of
+            # the final feet at rest
+            mid = 0.5 * (foot_pos[Side.LEFT] + foot_pos[Side.RIGHT])
+            s = min(1.0, (t + dt - t_end_steps) / opts.stop_time)
+            h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+            h01 = -2 * s**3 + 3 * s**2
+            xy = h00 * stop_from + h10 * opts.stop_time * stop_vel + h01 * mid[:2]
+            com_ref = np.array([xy[0], xy[1], height_ref(t + dt)])
+            targets_now = {sd: (foot_pos[sd], foot_rot[sd]) for sd in sim.sides}
+            yaw = float(plan.headings[n])
+
+        # ---------------------------------------------------------------- measurement: ZMP
+        if phase_log[k] >= 0:
+            pos_s, rot_s = sim.sole(stance_side)
+            pts, frc = contacts[stance_side]
+            cop = sole_cop(pts, frc, pos_s, rot_s)
+            if cop is not None and cop[1] > CONTACT_FORCE_SHARE * sim.weight:
+                zmp_log[k] = cop[0]
+        ref_log[k] = com_ref
+
+        # ---------------------------------------------------------------- fall detection
+        stance_z = (
+            max(foot_pos[Side.LEFT][2], foot_pos[Side.RIGHT][2])
+            if phase_log[k] < 0
+            else foot_pos[stance_side][2]
+        )
+        pelvis_z = float(d.xpos[sim.pelvis][2]) - float(stance_z)
+        up = d.xmat[sim.torso].reshape(3, 3)[:, 2]
+        tilt = math.acos(max(-1.0, min(1.0, float(up[2]))))
+        if not fell and (
+            body_hit or tilt > FALL_TILT or pelvis_z < FALL_HEIGHT_SHARE * sim.params.pelvis_height
+        ):
+            fell, fall_time = True, t
+            if opts.stop_on_fall:
+                timing["control"] += time.perf_counter() - c0
+                break
+        c1 = time.perf_counter()
+        timing["control"] += c1 - c0
+
+        # ---------------------------------------------------------------- whole body
+        com_cmd = com_ref.copy()
+        # which ankles are torque-driven and with what ALIP torque (None = position servo)
+        ankle_cmd: dict[Side, FloatArray | None] = {sd: None for sd in sim.sides}
+        if opts.ankle_torque and phase_log[k] >= 0:
+            ankle_cmd[stance_side] = ankle_u
+        elif opts.ankle_torque and t_walk0 <= t < t_end_steps:
+            # double support: both ankles passive, the legs form a closed chain whose joint
+            # servos place the CoM; each foot's CoP stays at its centre and the total CoP lies
+            # between the feet, where the contact-point ramp of eq. (5.8) puts it
+            ankle_cmd = {sd: np.zeros(2) for sd in sim.sides}
+        if ankle_cmd[stance_side] is None or phase_log[k] < 0:
+            com_cmd[:2] += opts.com_gain * (com_ref[:2] - com[:2])
+        q_des = ik.solve(targets_now, com_cmd, yaw, dt, opts.ik_iterations)
+        for sd in sim.sides:
+            cmd = ankle_cmd[sd]
+            if (cmd is not None) != ankle_mode[sd]:
+                sim.set_ankle_torque_mode(sd, cmd is not None)
+                ankle_mode[sd] = cmd is not None
+            if cmd is not None:
+                q_des[sim.ankle_actuators(sd)] = ankle_joint_torque(
+                    cmd, sim.sole(sd)[1], sim.weight, sim.params
+                )
+        d.ctrl[sim.actuators] = q_des
+        c2 = time.perf_counter()
+        timing["ik"] += c2 - c1
+
+        # ---------------------------------------------------------------- physics
+        push_force[:] = 0.0
+        for p in opts.pushes:
+            if p.active(t):
+                push_force += p.force
+        d.xfrc_applied[sim.torso, :3] = push_force
+        for _ in range(substeps):
+            mj.mj_step(m, d)
+        c3 = time.perf_counter()
+        timing["physics"] += c3 - c2
+        if writer is not None and k % frame_every == 0:
+            renderer.update_scene(d, camera=nm.TRACK_CAMERA)
+            writer.append_data(renderer.render())
+            timing["render"] += time.perf_counter() - c3
+        if progress is not None and k % 100 == 0:
+            progress(k / n_ticks)
+    wall = time.perf_counter() - wall0
+    if writer is not None:
+        writer.close()
+    if renderer is not None:
+        renderer.close()
+    k_end = k + 1
+    timing["total"] = wall
+    sim_time = k_end * dt
+    result = WalkResult(
+        t=ts[:k_end],
+        phase=phase_log[:k_end],
+        com=com_log[:k_end],
+        com_ref=ref_log[:k_end],
+        zmp_offset=zmp_log[:k_end],
+        zmp_planned=zmp_plan_log[:k_end],
+        feet=feet_log[:k_end],
+        landed=landed,
+        targets=targets,
+        planned=np.array(plan.footsteps[1:]),
+        n_planned=n_planned,
+        fell=fell,
+        fall_time=fall_time,
+        metrics={},
+        timing=timing,
+        sim_time=sim_time,
+        video=video_path if writer is not None else None,
+        video_note=video_note,
+    )
+    t_goal = t_walk0 + n_planned * t_step
+    metrics = summarise(result, scene, plan, sim.params, t_goal)
+    object.__setattr__(result, "metrics", metrics)
+    return result
+
+
+def ankle_joint_torque(
+    u: FloatArray, sole_rot: FloatArray, weight: float, params: BipedModel
+) -> FloatArray:
+    """Ankle (pitch, roll) joint torques [N m] that make the ground exert the ALIP torque ``u``.
+
+    ``u = (tau_x, tau_y)`` is the torque of the ground on the robot about the sole centre
+    (eq. 5.3). The foot is light, so the ankle joints pass it on: a hinge torque acts ``+tau`` on
+    the child (the foot) and ``-tau`` on the parent, hence joint torque = ``-u`` expressed in the
+    foot's axes. Each component is clipped so that the CoP stays ``SOLE_TORQUE_SHARE`` inside
+    the contact rectangle of the sole (a larger torque would only tip the foot).
+    """
+    local = sole_rot[:2, :2].T @ np.asarray(u, dtype=float)
+    lim_x = SOLE_TORQUE_SHARE * weight * (params.foot_width / 2 - params.corner_radius)
+    lim_y = SOLE_TORQUE_SHARE * weight * (params.foot_length / 2 - params.corner_radius)
+    tau_x = float(np.clip(local[0], -lim_x, lim_x))
+    tau_y = float(np.clip(local[1], -lim_y, lim_y))
+    return np.array([-tau_y, -tau_x])
+
+
+def _blend_rot(r0: FloatArray, r1: FloatArray, s: float) -> FloatArray:
+    """Rotation between ``r0`` (s = 0) and ``r1`` (s = 1) along the geodesic."""
+    from scipy.spatial.transform import Rotation, Slerp
+
+    if s <= 0.0:
+        return r0
+    if s >= 1.0:
+        return r1
+    slerp = Slerp([0.0, 1.0], Rotation.from_matrix(np.stack([r0, r1])))
+    return np.asarray(slerp([s]).as_matrix()[0])
+
+
+def summarise(
+    res: WalkResult, scene: Scene, plan: FootstepPlan, params: BipedModel, t_steps_end: float
+) -> dict[str, Any]:
+    """Summary metrics of a walk.
+
+    Keys: ``fell``, ``fall_time_s``, ``reached_goal``, ``goal_error_m``, ``time_to_goal_s`` (when
+    the last footstep landed, NaN if it did not), ``steps_planned``, ``steps_landed``,
+    ``footstep_error_m`` / ``footstep_error_vs_target_m`` (mean and max horizontal distance of the
+    landed sole centres from the plan / from the commanded footsteps), ``zmp`` (single-support
+    stance-foot CoP offset from the sole centre: mean and max norm [m], mean |x| and |y|, share of
+    ticks at a sole edge, share inside the sole), ``zmp_commanded`` (the adjuster's torque as a
+    ZMP, before the sole clip), ``zmp_plan`` (the plan's own torques) and ``per_step`` (per phase: mean and max offset norm, at-edge share).
+    """
+    n = res.n_planned
+    ss = (res.phase >= 0) & (res.phase < n)
+    z = res.zmp_offset[ss]
+    ok = ~np.isnan(z[:, 0])
+    z = z[ok]
+    half = np.array(
+        [
+            params.foot_length / 2 - params.corner_radius,
+            params.foot_width / 2 - params.corner_radius,
+        ]
+    )
+    sole_half = np.array([params.foot_length / 2, params.foot_width / 2])
+
+    def stats(a: FloatArray) -> dict[str, float]:
+        if a.shape[0] == 0:
+            return {
+                "mean": math.nan,
+                "max": math.nan,
+                "mean_abs_x": math.nan,
+                "mean_abs_y": math.nan,
+            }
+        nrm = np.linalg.norm(a, axis=1)
+        return {
+            "mean": float(np.mean(nrm)),
+            "max": float(np.max(nrm)),
+            "mean_abs_x": float(np.mean(np.abs(a[:, 0]))),
+            "mean_abs_y": float(np.mean(np.abs(a[:, 1]))),
+        }
+
+    zs = stats(z)
+    if z.shape[0]:
+        at_edge = np.any(np.abs(z) >= half - EDGE_TOL, axis=1)
+        zs["at_edge_share"] = float(np.mean(at_edge))
+        zs["inside_share"] = float(np.mean(np.all(np.abs(z) <= sole_half, axis=1)))
+    zs["samples"] = int(z.shape[0])
+    zp = res.zmp_planned[ss]
+    zp = zp[~np.isnan(zp[:, 0])]
+    per_step = []
+    for i in range(n):
+        sel = (res.phase == i) & ~np.isnan(res.zmp_offset[:, 0])
+        a = res.zmp_offset[sel]
+        if a.shape[0] == 0:
+            continue
+        nrm = np.linalg.norm(a, axis=1)
+        per_step.append(
+            {
+                "phase": i,
+                "region": plan.regions[i],
+                "mean": float(np.mean(nrm)),
+                "max": float(np.max(nrm)),
+                "at_edge_share": float(np.mean(np.any(np.abs(a) >= half - EDGE_TOL, axis=1))),
+            }
+        )
+    npl = res.n_planned
+    landed, planned, targets = res.landed[:npl], res.planned[:npl], res.targets[:npl]
+    done = ~np.isnan(landed[:, 0])
+    err_plan = np.linalg.norm((landed - planned)[done, :2], axis=1)
+    err_tgt = np.linalg.norm((landed - targets)[done, :2], axis=1)
+    err_z = np.abs((landed - planned)[done, 2])
+
+    def mm(a: FloatArray) -> dict[str, float]:
+        return {
+            "mean": float(np.mean(a)) if a.size else math.nan,
+            "max": float(np.max(a)) if a.size else math.nan,
+        }
+
+    final_mid = 0.5 * (res.feet[-1, 0] + res.feet[-1, 1])
+    goal_err = float(np.linalg.norm(final_mid[:2] - scene.goal.position[:2]))
+    all_landed = bool(np.all(done))
+    reached = (not res.fell) and all_landed and goal_err <= GOAL_TOL
+    return {
+        "fell": res.fell,
+        "fall_time_s": res.fall_time if res.fell else None,
+        "reached_goal": reached,
+        "goal_error_m": goal_err,
+        "time_to_goal_s": t_steps_end if (all_landed and not res.fell) else None,
+        "steps_planned": npl,
+        "stop_steps": int(res.landed.shape[0] - npl),
+        "steps_landed": int(np.sum(done)),
+        "footstep_error_m": mm(err_plan),
+        "footstep_height_error_m": mm(err_z),
+        "footstep_error_vs_target_m": mm(err_tgt),
+        "zmp": zs,
+        "zmp_commanded": stats(zp),
+        "zmp_plan": stats(plan.zmp_offsets()[:n].reshape(-1, 2)),
+        "per_step": per_step,
+        "sim_time_s": res.sim_time,
+        "wall_time_s": res.timing.get("total", math.nan),
+    }
