@@ -159,7 +159,7 @@ def test_project_to_polygon_is_the_nearest_point() -> None:
 def test_corrected_footsteps_stay_in_the_reach_trapezoid(short_walk) -> None:  # type: ignore[no-untyped-def]
     scene, plan, _ = short_walk
     regions = {r.name: r for r in scene.terrain.regions}
-    fol = PlanFollower(plan, regions)
+    fol = PlanFollower(plan, regions, limit_reach=True)
     robot = plan.robot
     # a huge forward velocity asks for a step far beyond the reach
     state = robot.alip().state_from_velocity(np.zeros(2), np.array([3.0, 0.0]))
