@@ -19,9 +19,12 @@ from footfall.planning import make_plan  # noqa: E402
 from footfall.sim.biped_model import planner_params  # noqa: E402
 from footfall.sim.biped_walk import (  # noqa: E402
     BipedSim,
+    PlanFollower,
     Push,
     WalkOptions,
+    _ds_propagator,
     ankle_joint_torque,
+    project_to_polygon,
     sole_cop,
     walk,
 )
@@ -37,6 +40,8 @@ WEIGHT_TOL = 0.02
 LANDING_TOL = 0.06
 #: settling time of the static stance [s]
 SETTLE = 0.6
+#: exactness of the closed-form stop step against the propagated double-support ALIP [m]
+STOP_FORMULA_TOL = 1e-9
 
 
 def test_sole_cop_is_the_normal_force_weighted_mean() -> None:
@@ -141,3 +146,50 @@ def test_cli_walk_rejects_bad_input(args: list[str], tmp_path) -> None:  # type:
     # a FootfallError, which `footfall` (main) turns into exit code 2
     assert isinstance(res.exception, FootfallError)
     assert not (tmp_path / "walk.json").exists()
+
+
+def test_project_to_polygon_is_the_nearest_point() -> None:
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    inside = np.array([0.3, 0.6])
+    assert np.array_equal(project_to_polygon(inside, square), inside)
+    assert project_to_polygon(np.array([2.0, 0.5]), square) == pytest.approx([1.0, 0.5])
+    assert project_to_polygon(np.array([-1.0, -2.0]), square) == pytest.approx([0.0, 0.0])
+
+
+def test_corrected_footsteps_stay_in_the_reach_trapezoid(short_walk) -> None:  # type: ignore[no-untyped-def]
+    scene, plan, _ = short_walk
+    regions = {r.name: r for r in scene.terrain.regions}
+    fol = PlanFollower(plan, regions, limit_reach=True)
+    robot = plan.robot
+    # a huge forward velocity asks for a step far beyond the reach
+    state = robot.alip().state_from_velocity(np.zeros(2), np.array([3.0, 0.0]))
+    for phase in (1, 2):
+        stance = np.array(plan.footsteps[phase])
+        target, _ = fol.update(0.0, state, stance, phase)
+        th = float(plan.headings[phase])
+        rot = np.array([[np.cos(th), np.sin(th)], [-np.sin(th), np.cos(th)]])
+        q = rot @ (target - stance)[:2]  # in the stance foot's heading frame
+        assert robot.reach.contains(q, plan.sides[phase], tol=1e-9)
+
+
+def test_stop_target_leaves_the_capture_point_midway(short_walk) -> None:  # type: ignore[no-untyped-def]
+    # The closed form of PlanFollower.stop_target against the exact double-support ALIP
+    # (contact point ramping from the stance foot to the new foot, eq. 5.8-5.10)
+    scene, plan, _ = short_walk
+    fol = PlanFollower(plan, {r.name: r for r in scene.terrain.regions})
+    robot = plan.robot
+    alip = robot.alip()
+    state = np.array([0.02, -0.03, 2.0, 6.0])
+    u = np.array([1.0, -2.0])
+    stance = np.array([0.3, -0.1, 0.0])
+    t = 0.1
+    d = fol.stop_target(t, state, stance, 0, u) - stance[:2]
+    a, b = alip.discretize(robot.t_ss - t)
+    x = a @ state + b @ u
+    step = round(robot.t_ds / 1e-3)
+    ds = _ds_propagator(alip, robot.t_ds / step)
+    aug = np.concatenate([x, np.zeros(3), np.array([d[0], d[1], 0.0]) / robot.t_ds])
+    for _ in range(step):
+        aug = ds @ aug
+    xi = aug[:2] + alip.velocity(aug[:4]) / alip.omega
+    assert xi == pytest.approx(d / 2, abs=STOP_FORMULA_TOL)

@@ -80,6 +80,9 @@ ANKLE_PITCH, ANKLE_ROLL = 4, 5
 ANKLE_TORQUE_DAMPING = 0.5
 #: share of the sole's contact rectangle the commanded ankle torque may use (CoP margin)
 SOLE_TORQUE_SHARE = 0.9
+#: corrected footsteps stay this far inside the reach trapezoid [m]; the planners use its
+#: boundary (the first lateral step of the reactive plan lies on it), so no margin
+REACH_MARGIN = 0.0
 
 
 # ============================================================================= options
@@ -257,6 +260,16 @@ class PlanFollower:
         dcm_gain: gain of the capture-point feedback on the ZMP (0 = planned torque only).
         stop_steps: stopping steps appended to the plan (:func:`extend_plan`); the walker asks
             for phases up to ``N + stop_steps - 1``.
+        capture_stop: place the final footstep by the capture point (:meth:`stop_target`)
+            instead of the plan's: the walk must end with the divergent component of motion
+            between the feet, whatever the plan's final state was.
+        limit_reach: project every corrected footstep into the reach trapezoid (the capture-point
+            final step always is, so the robot ends in a legal stance). Off by default:
+            on flat ground (five goals, issue 7 note) it lowered the share of walks without a
+            fall from 2/5 to 1/5, because this walker's lateral recovery needs steps narrower
+            than the trapezoid's 0.12 m minimum width.
+        reach_margin: with ``limit_reach``, every corrected footstep stays this far inside the reach trapezoid of the
+            measured stance foot (``BipedParams.reach``) [m].
     """
 
     plan: FootstepPlan
@@ -267,6 +280,9 @@ class PlanFollower:
     freeze_after: float = 0.7
     dcm_gain: float = 2.5
     stop_steps: int = STOP_STEPS
+    capture_stop: bool = True
+    limit_reach: bool = False
+    reach_margin: float = REACH_MARGIN
     _frozen: dict[int, FloatArray] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
@@ -331,7 +347,11 @@ class PlanFollower:
             return self._frozen[phase], u
         # the plan's footstep relative to where the stance foot really is
         target = ref_next.copy()
-        if self.gain > 0.0:
+        if self.capture_stop and phase == plan.n_steps - 1:
+            target[:2] = self.stop_target(t, state, stance, phase, u)
+            target = self._limit_reach(target, stance, phase)
+            target = self._clamp_to_region(target, ref_next, plan.regions[phase + 1])
+        elif self.gain > 0.0:
             x_end = self.predict_end(t, state, phase)
             err = self._to_next_end @ (x_end - plan.states[phase, -1])
             # The reset acts on the step p_{i+1} - p_i: if the robot stands off its planned
@@ -343,10 +363,52 @@ class PlanFollower:
             if norm > self.max_correction:
                 fb *= self.max_correction / norm
             target[:2] = ref_next[:2] + shift + fb
+            if self.limit_reach:
+                target = self._limit_reach(target, stance, phase)
             target = self._clamp_to_region(target, ref_next, plan.regions[phase + 1])
         if t >= self.freeze_after * plan.robot.t_ss:
             self._frozen[phase] = target
         return target, u
+
+    def stop_target(
+        self, t: float, state: FloatArray, stance: FloatArray, phase: int, u: FloatArray
+    ) -> FloatArray:
+        """Final footstep (x, y) [m] that leaves the capture point midway between the feet.
+
+        The measured state is propagated to the end of the phase with the torque ``u`` of this
+        tick held (the ankle's, clipped to the sole). In the following double support the
+        contact point moves linearly from the stance foot to the new foot ``d`` away (eq. 5.8);
+        the divergent component ``xi = c + v / omega`` then ends at
+        ``e^(w) xi_0 - d (e^(w) - 1 - w) / w`` with ``w = omega T_ds``. Asking it to end at the
+        feet's midpoint ``d / 2`` gives ``d``: the robot can then shift its CoM between its feet
+        and stand.
+        """
+        robot = self.plan.robot
+        alip = self._alip
+        sole_half = SOLE_TORQUE_SHARE * np.array([robot.foot_length / 2, robot.foot_width / 2])
+        zmp = np.clip(alip.zmp(np.zeros(2), u), -sole_half, sole_half)
+        u_hold = alip.torque_for_zmp(zmp)
+        rest = max(robot.t_ss - t, 0.0)
+        a_p, b_p = alip.discretize(rest) if rest > 1e-9 else (np.eye(4), np.zeros((4, 2)))
+        x_end = a_p @ state + b_p @ u_hold
+        xi = x_end[:2] + alip.velocity(x_end) / alip.omega
+        w = alip.omega * robot.t_ds
+        d = math.exp(w) * xi / (0.5 + (math.exp(w) - 1.0 - w) / w)
+        return np.asarray(stance[:2] + d)
+
+    def _limit_reach(self, target: FloatArray, stance: FloatArray, phase: int) -> FloatArray:
+        """``target`` moved into the reach trapezoid of the measured stance foot (eq. 5.12f)."""
+        robot = self.plan.robot
+        side = self.plan.sides[phase]
+        th = float(self.plan.headings[phase])
+        c, s = math.cos(th), math.sin(th)
+        rot = np.array([[c, -s], [s, c]])
+        q = rot.T @ (target[:2] - stance[:2])
+        poly = shrink_polygon(robot.reach.for_stance(side), self.reach_margin)
+        q = project_to_polygon(q, poly)
+        out = np.array(target, dtype=float)
+        out[:2] = stance[:2] + rot @ q
+        return out
 
     def _clamp_to_region(self, target: FloatArray, ref: FloatArray, name: str) -> FloatArray:
         region = self.regions.get(name)
@@ -369,6 +431,38 @@ class PlanFollower:
 
 
 # ============================================================================= geometry helpers
+def shrink_polygon(vertices: FloatArray, margin: float) -> FloatArray:
+    """Convex CCW polygon (n, 2) moved ``margin`` [m] inward toward its centroid (scaled).
+
+    Scaling about the centroid is enough for the reach trapezoid (a small margin, a fat shape);
+    a margin larger than the polygon leaves its centroid.
+    """
+    v = np.asarray(vertices, dtype=float)
+    c = v.mean(axis=0)
+    r = float(np.min(np.linalg.norm(v - c, axis=1)))
+    scale = max(0.0, 1.0 - margin / r) if r > 0 else 0.0
+    return np.asarray(c + (v - c) * scale)
+
+
+def project_to_polygon(q: FloatArray, vertices: FloatArray) -> FloatArray:
+    """Closest point (2,) of a convex CCW polygon (n, 2) to ``q`` (itself when inside)."""
+    v = np.asarray(vertices, dtype=float)
+    nxt = np.roll(v, -1, axis=0)
+    edge = nxt - v
+    # inside when left of every CCW edge
+    cross = edge[:, 0] * (q[1] - v[:, 1]) - edge[:, 1] * (q[0] - v[:, 0])
+    if np.all(cross >= 0.0):
+        return np.array(q, dtype=float)
+    best, best_d = np.array(q, dtype=float), math.inf
+    for a, e in zip(v, edge, strict=True):
+        s = float(np.clip((q - a) @ e / (e @ e), 0.0, 1.0))
+        p = a + s * e
+        dist = float(np.linalg.norm(q - p))
+        if dist < best_d:
+            best, best_d = p, dist
+    return best
+
+
 def smoothstep(s: float) -> float:
     """Quintic 0 -> 1 on [0, 1] with zero velocity and acceleration at both ends."""
     s = min(1.0, max(0.0, s))
@@ -974,8 +1068,9 @@ def walk(
                 yaw = float(0.5 * (plan.headings[i] + plan.headings[i + 1]))
             com_ref = np.array([ref_xy[0], ref_xy[1], height_ref(t + dt)])
             if k + 1 < n_ticks and t + dt >= t_end_steps - 1e-9:
-                stop_from = ref_xy.copy()
-                stop_vel = alip.velocity(x_ref)
+                # the stop starts from the measured CoM motion: the reference may have drifted
+                stop_from = com[:2].copy()
+                stop_vel = vel[:2].copy()
         else:
             if not math.isnan(landed[n - 1, 0]) or cur_phase < n:
                 if math.isnan(landed[n - 1, 0]):
@@ -1042,9 +1137,13 @@ def walk(
                 sim.set_ankle_torque_mode(sd, cmd is not None)
                 ankle_mode[sd] = cmd is not None
             if cmd is not None:
-                q_des[sim.ankle_actuators(sd)] = ankle_joint_torque(
-                    cmd, sim.sole(sd)[1], sim.weight, sim.params
-                )
+                # the CoP bound scales with the normal force the foot carries *now*: during
+                # vertical CoM and swing-leg accelerations it is below the weight, and a torque
+                # sized for the weight would tip the foot onto its edge
+                pos_a, rot_a = sim.sole(sd)
+                cop_a = sole_cop(*contacts[sd], pos_a, rot_a)
+                f_n = min(sim.weight, cop_a[1]) if cop_a is not None else 0.0
+                q_des[sim.ankle_actuators(sd)] = ankle_joint_torque(cmd, rot_a, f_n, sim.params)
         d.ctrl[sim.actuators] = q_des
         c2 = time.perf_counter()
         timing["ik"] += c2 - c1
