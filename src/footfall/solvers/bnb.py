@@ -35,6 +35,7 @@ plan and an honest gap.
 
 from __future__ import annotations
 
+import dataclasses
 import heapq
 import math
 import time
@@ -73,23 +74,51 @@ class UnsupportedProblem(ValueError):
 class _Member:
     """Indicator rows of one binary: ``a^T x <= beta`` when the binary is 1.
 
-    ``rows``, ``cols``, ``vals`` are COO entries (row numbering local to the member, columns are
-    original variable indices), ``beta`` the right-hand sides, ``pos`` the position of each column
-    in the group's variable list ``V``.
+    Attributes:
+        var: the binary's index.
+        a_v: rows over the group's variables ``V`` (private variables eliminated), (m, |V|).
+        a_f: the same rows over the group's forms ``f = B x_V``, (m, k).
+        beta: right-hand sides, (m,).
+        orig: the original rows ``(columns, coefficients, rhs)``, to recover private variables.
     """
 
     var: int
-    rows: IntArray
-    cols: IntArray
-    vals: FloatArray
+    a_v: FloatArray
+    a_f: FloatArray
     beta: FloatArray
-    pos: IntArray
+    orig: tuple[tuple[IntArray, FloatArray, float], ...]
 
 
 @dataclass(frozen=True)
 class _Group:
-    members: tuple[int, ...]  # binary variable indices, ascending
-    variables: IntArray  # V: continuous variables of the indicator rows
+    """A choice group ``sum_{z in members} z = 1``.
+
+    Attributes:
+        members: binary variable indices, ascending.
+        variables: ``V``, the continuous variables of the members' rows (private ones removed).
+        basis: ``B`` (k, |V|), orthonormal basis of the row space of every member row over ``V``;
+            the relaxation copies the k forms ``B x_V`` instead of ``x_V``.
+        f_lb, f_ub: bounds of the forms over the variable bounds, (k,).
+        private: variables that appear in this group's rows and nowhere else but their bounds;
+            they are eliminated (Fourier-Motzkin) and recovered from the chosen member.
+        cost_rows: objective rows ``w (F x - t)^2`` that lie in the span of the group's forms
+            (e.g. the horizontal step-length terms of eq. 5.11 in a heading-segment group); the
+            relaxation charges them in perspective form (see :class:`HullRelaxation`).
+        cost_v, cost_f: those rows over ``V`` (m, |V|) and over the forms (m, k).
+        cost_t, cost_w: their targets and weights, (m,).
+    """
+
+    members: tuple[int, ...]
+    variables: IntArray
+    basis: FloatArray
+    f_lb: FloatArray
+    f_ub: FloatArray
+    private: IntArray
+    cost_rows: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    cost_v: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
+    cost_f: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
+    cost_t: FloatArray = field(default_factory=lambda: np.zeros(0))
+    cost_w: FloatArray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass
@@ -102,13 +131,51 @@ class _Structure:
     group_of: dict[int, int]
     plain_le: sp.csr_matrix
     plain_b: FloatArray
-    p_mat: sp.csc_matrix  # Clarabel's P (upper triangle) over the original variables
-    q_vec: FloatArray
-    const: float
+    assigned: NDArray[np.bool_]  # cost rows charged in perspective form by a group
 
 
-def analyse(problem: MIQCQP) -> _Structure:
-    """Split ``problem`` into choice groups and indicator rows; raise :class:`UnsupportedProblem`."""
+#: eliminate a private variable only when Fourier-Motzkin makes at most this many rows per member
+MAX_FM_ROWS = 8
+#: singular values below this (relative) do not count in a group's row space
+RANK_TOL = 1e-10
+
+
+def _eliminate(
+    rows: list[tuple[dict[int, float], float]], v: int, lb: float, ub: float
+) -> list[tuple[dict[int, float], float]] | None:
+    """Fourier-Motzkin elimination of ``v`` from ``rows`` (each ``sum coef x <= rhs``) given
+    ``lb <= v <= ub``: the exact projection. None when it would make too many rows."""
+    upper = [(r, b) for r, b in rows if r.get(v, 0.0) > 0.0]
+    lower = [(r, b) for r, b in rows if r.get(v, 0.0) < 0.0]
+    rest = [(r, b) for r, b in rows if r.get(v, 0.0) == 0.0]
+    if len(upper) * len(lower) + len(upper) + len(lower) > MAX_FM_ROWS:
+        return None
+    out = list(rest)
+    for r, b in upper:  # v <= (b - r x)/a and v >= lb
+        a = r[v]
+        out.append(({k: c for k, c in r.items() if k != v}, b - a * lb))
+    for r, b in lower:  # v >= (b - r x)/a and v <= ub
+        a = r[v]
+        out.append(({k: c for k, c in r.items() if k != v}, b - a * ub))
+    for ru, bu in upper:
+        for rl, bl in lower:
+            au, al = ru[v], -rl[v]
+            comb: dict[int, float] = {}
+            for k, c in ru.items():
+                if k != v:
+                    comb[k] = comb.get(k, 0.0) + c / au
+            for k, c in rl.items():
+                if k != v:
+                    comb[k] = comb.get(k, 0.0) + c / al
+            out.append((comb, bu / au + bl / al))
+    return out
+
+
+def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
+    """Split ``problem`` into choice groups and indicator rows; raise :class:`UnsupportedProblem`.
+
+    With ``perspective``, objective rows within one group's forms are assigned to that group.
+    """
     n = problem.n
     integer = problem.integer
     if np.any(integer & ((problem.lb < 0.0) | (problem.ub > 1.0))):
@@ -134,7 +201,7 @@ def analyse(problem: MIQCQP) -> _Structure:
         if int(c) not in group_of:
             raise UnsupportedProblem(f"binary {problem.names[c]} is in no choice group")
     for mat, what in ((problem.cost_matrix, "objective"),):
-        if mat.shape[0] and np.any(integer[mat.tocsc().indices]):
+        if mat.shape[0] and np.any(integer[mat.tocsr().indices]):
             raise UnsupportedProblem(f"binaries in the {what}")
     for idx, _ in problem.cones:
         if np.any(integer[idx]):
@@ -148,7 +215,7 @@ def analyse(problem: MIQCQP) -> _Structure:
         vals = a_le.data[a_le.indptr[r] : a_le.indptr[r + 1]]
         ints = integer[cols]
         k = int(np.count_nonzero(ints))
-        if k == 0:
+        if k == 0 or k == len(cols):  # continuous rows, or valid inequalities on binaries only
             plain.append(r)
             continue
         if k > 1 or vals[ints][0] <= 0.0:
@@ -161,39 +228,118 @@ def analyse(problem: MIQCQP) -> _Structure:
             raise UnsupportedProblem(f"row {problem.le_labels[r]!r}: its z = 0 form is not implied")
         ind_rows.setdefault(z, []).append((cc, vv, float(problem.b_le[r]) - big_m))
 
+    # Where each continuous variable appears outside the indicator rows.
+    used = np.zeros(n, dtype=bool)
+    used[problem.cost_matrix.tocsr().indices] = True
+    used[a_eq.indices] = True
+    used[a_le[plain].indices] = True
+    for idx, _ in problem.cones:
+        used[idx] = True
+    owner: dict[int, set[int]] = {}
+    for g, mem in enumerate(group_rows):
+        for z in mem:
+            for cc, _, _ in ind_rows.get(z, []):
+                for c in cc:
+                    owner.setdefault(int(c), set()).add(g)
+
     member: dict[int, _Member] = {}
     for g, mem in enumerate(group_rows):
+        rows_of = {
+            z: [
+                (dict(zip(cc.tolist(), vv.tolist(), strict=True)), bb)
+                for cc, vv, bb in ind_rows.get(z, [])
+            ]
+            for z in mem
+        }
         cols_all = sorted({int(c) for z in mem for cc, _, _ in ind_rows.get(z, []) for c in cc})
-        variables = np.array(cols_all, dtype=np.int64)
-        where = {c: k for k, c in enumerate(cols_all)}
-        for z in mem:
-            rr, cc_l, vv_l, beta = [], [], [], []
-            for j, (cc, vv, bb) in enumerate(ind_rows.get(z, [])):
-                rr.append(np.full(len(cc), j, dtype=np.int64))
-                cc_l.append(cc)
-                vv_l.append(vv)
-                beta.append(bb)
-            cols = np.concatenate(cc_l) if cc_l else np.zeros(0, dtype=np.int64)
-            member[z] = _Member(
-                var=z,
-                rows=np.concatenate(rr) if rr else np.zeros(0, dtype=np.int64),
-                cols=cols,
-                vals=np.concatenate(vv_l) if vv_l else np.zeros(0),
-                beta=np.array(beta, dtype=float),
-                pos=np.array([where[int(c)] for c in cols], dtype=np.int64),
-            )
+        private: list[int] = []
         for c in cols_all:
+            if used[c] or owner[c] != {g}:
+                continue
+            reduced = {z: _eliminate(rows_of[z], c, problem.lb[c], problem.ub[c]) for z in mem}
+            if any(r is None for r in reduced.values()):
+                continue
+            rows_of = {z: r for z, r in reduced.items() if r is not None}
+            private.append(c)
+        variables = np.array([c for c in cols_all if c not in private], dtype=np.int64)
+        for c in variables:
             if not (math.isfinite(problem.lb[c]) and math.isfinite(problem.ub[c])):
                 raise UnsupportedProblem(f"{problem.names[c]} is in an indicator row but unbounded")
-        groups.append(_Group(members=tuple(mem), variables=variables))
+        where = {int(c): k for k, c in enumerate(variables)}
+        dense: dict[int, tuple[FloatArray, FloatArray]] = {}
+        for z in mem:
+            a_v = np.zeros((len(rows_of[z]), len(variables)))
+            beta = np.zeros(len(rows_of[z]))
+            for j, (row, rhs) in enumerate(rows_of[z]):
+                for c, v in row.items():
+                    a_v[j, where[c]] += v
+                beta[j] = rhs
+            dense[z] = (a_v, beta)
+        stacked = np.vstack([dense[z][0] for z in mem] + [np.zeros((0, len(variables)))])
+        if stacked.shape[0] and len(variables):
+            _, sv, vt = np.linalg.svd(stacked, full_matrices=False)
+            k = int(np.count_nonzero(sv > RANK_TOL * max(float(sv[0]), 1e-300)))
+            basis = vt[:k]
+        else:
+            basis = np.zeros((0, len(variables)))
+        lbv, ubv = problem.lb[variables], problem.ub[variables]
+        f_lb = np.sum(np.minimum(basis * lbv, basis * ubv), axis=1)
+        f_ub = np.sum(np.maximum(basis * lbv, basis * ubv), axis=1)
+        for z in mem:
+            a_v, beta = dense[z]
+            a_f = a_v @ basis.T
+            if a_v.size and float(np.max(np.abs(a_f @ basis - a_v))) > 1e-9 * max(
+                1.0, float(np.max(np.abs(a_v)))
+            ):
+                raise UnsupportedProblem(
+                    "indicator rows are not in their row space"
+                )  # pragma: no cover
+            member[z] = _Member(var=z, a_v=a_v, a_f=a_f, beta=beta, orig=tuple(ind_rows.get(z, [])))
+        groups.append(
+            _Group(
+                members=tuple(mem),
+                variables=variables,
+                basis=basis,
+                f_lb=f_lb,
+                f_ub=f_ub,
+                private=np.array(private, dtype=np.int64),
+            )
+        )
 
-    w = problem.cost_weight
-    f_mat = problem.cost_matrix.tocsr()
-    wf = sp.diags(w) @ f_mat
-    p_full = 2.0 * (f_mat.T @ wf)
-    p_mat = sp.triu(p_full, format="csc")
-    q_vec = -2.0 * np.asarray(wf.T @ problem.cost_target).ravel()
-    const = float(np.sum(w * problem.cost_target**2))
+    assigned = np.zeros(problem.cost_matrix.shape[0], dtype=bool)
+    if perspective:
+        f_csr = problem.cost_matrix.tocsr()
+        for g, grp in enumerate(groups):
+            if grp.basis.shape[0] == 0 or len(grp.members) < 2:
+                continue
+            where = {int(c): k for k, c in enumerate(grp.variables)}
+            rows, dense = [], []
+            for j in range(f_csr.shape[0]):
+                if assigned[j]:
+                    continue
+                cc = f_csr.indices[f_csr.indptr[j] : f_csr.indptr[j + 1]]
+                if not all(int(c) in where for c in cc):
+                    continue
+                row = np.zeros(len(grp.variables))
+                for c, v in zip(cc, f_csr.data[f_csr.indptr[j] : f_csr.indptr[j + 1]], strict=True):
+                    row[where[int(c)]] += v
+                if np.max(np.abs(row @ grp.basis.T @ grp.basis - row)) > 1e-9 * max(
+                    1.0, float(np.max(np.abs(row)))
+                ):
+                    continue
+                rows.append(j)
+                dense.append(row)
+            if rows:
+                assigned[rows] = True
+                cost_v = np.array(dense)
+                groups[g] = dataclasses.replace(
+                    grp,
+                    cost_rows=np.array(rows, dtype=np.int64),
+                    cost_v=cost_v,
+                    cost_f=cost_v @ grp.basis.T,
+                    cost_t=problem.cost_target[rows],
+                    cost_w=problem.cost_weight[rows],
+                )
     return _Structure(
         problem=problem,
         groups=groups,
@@ -201,19 +347,17 @@ def analyse(problem: MIQCQP) -> _Structure:
         group_of=group_of,
         plain_le=a_le[plain],
         plain_b=problem.b_le[plain],
-        p_mat=p_mat,
-        q_vec=q_vec,
-        const=const,
+        assigned=assigned,
     )
 
 
 @dataclass
 class _Relaxation:
-    """Result of one node relaxation."""
+    """Result of one node relaxation: ``x`` holds the original variables (condensed ones recovered)."""
 
     status: str  # "solved", "infeasible", "failed"
     bound: float = math.inf
-    x: FloatArray | None = None  # original variables only
+    x: FloatArray | None = None
     iterations: int = 0
 
 
@@ -228,155 +372,336 @@ class _Coo:
         self.m = 0
 
     def add(self, rows: IntArray, cols: IntArray, vals: FloatArray, rhs: FloatArray) -> None:
-        self.r.append(rows + self.m)
-        self.c.append(cols)
-        self.v.append(vals)
-        self.b.append(rhs)
+        self.r.append(np.asarray(rows, dtype=np.int64) + self.m)
+        self.c.append(np.asarray(cols, dtype=np.int64))
+        self.v.append(np.asarray(vals, dtype=float))
+        self.b.append(np.asarray(rhs, dtype=float))
         self.m += len(rhs)
 
     def add_csr(self, mat: sp.csr_matrix, rhs: FloatArray) -> None:
         coo = mat.tocoo()
-        self.add(coo.row.astype(np.int64), coo.col.astype(np.int64), coo.data.astype(float), rhs)
+        self.add(coo.row, coo.col, coo.data, rhs)
+
+    def copy(self) -> _Coo:
+        out = _Coo()
+        out.r, out.c, out.v, out.b, out.m = [*self.r], [*self.c], [*self.v], [*self.b], self.m
+        return out
+
+
+@dataclass
+class _Base:
+    """The node-independent part of a relaxation over ``n_cols`` columns.
+
+    ``col`` maps original variables to columns (-1: condensed out). For a condensed base the
+    eliminated variables ``y`` are recovered as ``y = y_lin @ x[y_from] + y_off``.
+    """
+
+    n_cols: int
+    col: IntArray
+    eq: _Coo
+    le: _Coo
+    soc: _Coo
+    soc_dims: list[int]
+    p_mat: sp.csc_matrix  # Clarabel's P (upper triangle), n_cols x n_cols
+    q_vec: FloatArray
+    const: float
+    y_idx: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    y_from: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    y_lin: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
+    y_off: FloatArray = field(default_factory=lambda: np.zeros(0))
+
+
+def _cost_pq(
+    f_mat: sp.csr_matrix, target: FloatArray, weight: FloatArray
+) -> tuple[sp.csc_matrix, FloatArray, float]:
+    """``sum w (F x - f)^2`` as Clarabel's ``(1/2) x^T P x + q^T x + const``."""
+    wf = sp.diags(weight) @ f_mat
+    p_mat = sp.triu(2.0 * (f_mat.T @ wf), format="csc")
+    q_vec = -2.0 * np.asarray(wf.T @ target).ravel()
+    return p_mat, q_vec, float(np.sum(weight * target**2))
+
+
+def _full_base(s: _Structure) -> _Base:
+    """All variables, rows, bounds and cones of the problem (binaries' bounds are per node)."""
+    pr = s.problem
+    eq = _Coo()
+    eq.add_csr(pr.a_eq.tocsr(), pr.b_eq)
+    le = _Coo()
+    le.add_csr(s.plain_le, s.plain_b)
+    cont = np.flatnonzero(~pr.integer)
+    fin_u = cont[np.isfinite(pr.ub[cont])]
+    fin_l = cont[np.isfinite(pr.lb[cont])]
+    le.add(np.arange(len(fin_u)), fin_u, np.ones(len(fin_u)), pr.ub[fin_u])
+    le.add(np.arange(len(fin_l)), fin_l, -np.ones(len(fin_l)), -pr.lb[fin_l])
+    soc = _Coo()
+    dims = []
+    for idx, radius in pr.cones:
+        k = len(idx)
+        b = np.zeros(k + 1)
+        b[0] = radius
+        soc.add(np.arange(1, k + 1), idx, -np.ones(k), b)
+        dims.append(k + 1)
+    keep = ~s.assigned
+    p_mat, q_vec, const = _cost_pq(
+        pr.cost_matrix.tocsr()[keep], pr.cost_target[keep], pr.cost_weight[keep]
+    )
+    return _Base(pr.n, np.arange(pr.n, dtype=np.int64), eq, le, soc, dims, p_mat, q_vec, const)
+
+
+def _condensed_base(s: _Structure) -> _Base | None:
+    """Eliminate the variables ``y`` that appear only in equality rows, the objective, bounds and
+    cones (the ALIP states and torques of the planner): ``V(w) = min_y cost`` subject to the
+    equality rows is a convex quadratic of the remaining ``w``, computed once from the KKT system.
+    Dropping the bounds and cones of ``y`` gives a valid lower bound; a point whose recovered ``y``
+    satisfies them is exact. Returns None when nothing can be eliminated or the KKT system is
+    singular (e.g. a zero torque weight).
+    """
+    pr = s.problem
+    n = pr.n
+    keep = np.zeros(n, dtype=bool)
+    keep[pr.integer] = True
+    keep[s.plain_le.indices] = True
+    for grp in s.groups:
+        keep[grp.variables] = True
+        keep[grp.private] = True
+    # a variable in no equality row and no cost row has nothing to determine it: keep it
+    keep[np.asarray(abs(pr.a_eq).sum(axis=0) + abs(pr.cost_matrix).sum(axis=0)).ravel() == 0] = True
+    y_mask = ~keep
+    for idx, _ in pr.cones:
+        if np.any(keep[idx]):
+            return None
+    y_idx = np.flatnonzero(y_mask)
+    w_idx = np.flatnonzero(keep)
+    if len(y_idx) == 0:
+        return None
+    a_eq = pr.a_eq.tocsr()
+    touches_y = np.asarray(abs(a_eq[:, y_idx]).sum(axis=1) > 0).ravel()
+    e_y = a_eq[touches_y][:, y_idx]
+    e_w = a_eq[touches_y][:, w_idx]
+    e_rhs = pr.b_eq[touches_y]
+    f_mat = pr.cost_matrix.tocsr()
+    rows_y = np.asarray(abs(f_mat[:, y_idx]).sum(axis=1) > 0).ravel()
+    f_y = f_mat[rows_y][:, y_idx]
+    f_wy = f_mat[rows_y][:, w_idx]
+    t_y = pr.cost_target[rows_y]
+    wt_y = pr.cost_weight[rows_y]
+    # Parameters that move y: w columns of the y equality rows and of the y cost rows.
+    support = np.flatnonzero(
+        np.asarray(abs(e_w).sum(axis=0)).ravel() + np.asarray(abs(f_wy).sum(axis=0)).ravel()
+    )
+    h = 2.0 * (f_y.T @ sp.diags(wt_y) @ f_y)
+    m_y = e_y.shape[0]
+    kkt = sp.bmat([[h, e_y.T], [e_y, None]], format="csc")
+    ny = len(y_idx)
+    rhs_lin = np.vstack(
+        [
+            -2.0 * (f_y.T @ sp.diags(wt_y) @ f_wy[:, support]).toarray(),
+            -e_w[:, support].toarray(),
+        ]
+    )
+    rhs_off = np.concatenate([2.0 * (f_y.T @ (wt_y * t_y)), e_rhs])
+    try:
+        lu = sp.linalg.splu(kkt)
+        sol = lu.solve(np.column_stack([rhs_lin, rhs_off]))
+    except RuntimeError:
+        return None
+    kkt_res = kkt @ sol - np.column_stack([rhs_lin, rhs_off])
+    if not np.all(np.isfinite(sol)) or float(np.max(np.abs(kkt_res))) > 1e-6 * max(
+        1.0, float(np.max(np.abs(sol)))
+    ):
+        return None
+    y_lin, y_off = sol[:ny, :-1], sol[:ny, -1]
+    del m_y
+    # New cost rows over w: F_y (Y w_S + y0) + F_wy w - t.
+    w_pos = np.full(n, -1, dtype=np.int64)
+    w_pos[w_idx] = np.arange(len(w_idx))
+    f_eff = (f_y @ y_lin) + f_wy[:, support].toarray()
+    t_eff = t_y - f_y @ y_off
+    sq = np.sqrt(wt_y)
+    a_s = sq[:, None] * f_eff
+    t_s = sq * t_eff
+    # other cost rows (only w)
+    other = ~rows_y & ~s.assigned
+    if np.any(rows_y & s.assigned):  # pragma: no cover - assigned rows hold only group variables
+        return None
+    f_o = f_mat[other][:, w_idx]
+    p_o, q_o, c_o = _cost_pq(f_o.tocsr(), pr.cost_target[other], pr.cost_weight[other])
+    nw = len(w_idx)
+    p_s = np.zeros((nw, nw))
+    p_s_sub = 2.0 * (a_s.T @ a_s)
+    p_s[np.ix_(support, support)] = p_s_sub
+    p_mat = sp.triu(p_o + sp.csc_matrix(np.triu(p_s)), format="csc")
+    q_vec = q_o.copy()
+    q_vec[support] += -2.0 * (a_s.T @ t_s)
+    const = c_o + float(t_s @ t_s)
+    # rows over w: equality rows without y, plain le rows, bounds of w
+    eq = _Coo()
+    eq.add_csr(a_eq[~touches_y][:, w_idx].tocsr(), pr.b_eq[~touches_y])
+    le = _Coo()
+    le.add_csr(s.plain_le[:, w_idx].tocsr(), s.plain_b)
+    cont = np.flatnonzero(~pr.integer[w_idx])
+    fin_u = cont[np.isfinite(pr.ub[w_idx][cont])]
+    fin_l = cont[np.isfinite(pr.lb[w_idx][cont])]
+    le.add(np.arange(len(fin_u)), fin_u, np.ones(len(fin_u)), pr.ub[w_idx][fin_u])
+    le.add(np.arange(len(fin_l)), fin_l, -np.ones(len(fin_l)), -pr.lb[w_idx][fin_l])
+    return _Base(
+        nw,
+        w_pos,
+        eq,
+        le,
+        _Coo(),
+        [],
+        p_mat,
+        q_vec,
+        const,
+        y_idx=y_idx,
+        y_from=w_idx[support],
+        y_lin=y_lin,
+        y_off=y_off,
+    )
 
 
 class HullRelaxation:
-    """Builds and solves the node relaxation of :mod:`footfall.solvers.bnb` (see module docstring)."""
+    """Builds and solves the node relaxation of :mod:`footfall.solvers.bnb` (see module docstring).
 
-    def __init__(self, structure: _Structure) -> None:
+    Two bases: ``full`` (every variable, bound and cone: exact at integral nodes) and, when the
+    problem allows it, ``condensed`` (see :func:`_condensed_base`: a lower bound, much smaller).
+    """
+
+    def __init__(self, structure: _Structure, condense: bool = True) -> None:
         import clarabel
 
         self._clarabel = clarabel
         self.s = structure
-        pr = structure.problem
-        n = pr.n
-        # Static rows: equalities (with the group rows), plain inequalities, bounds and cones.
-        eq = _Coo()
-        eq.add_csr(pr.a_eq.tocsr(), pr.b_eq)
-        self._eq = eq
-        le = _Coo()
-        le.add_csr(structure.plain_le, structure.plain_b)
-        cont = np.flatnonzero(~pr.integer)
-        fin_u = cont[np.isfinite(pr.ub[cont])]
-        fin_l = cont[np.isfinite(pr.lb[cont])]
-        le.add(np.arange(len(fin_u)), fin_u, np.ones(len(fin_u)), pr.ub[fin_u])
-        le.add(np.arange(len(fin_l)), fin_l, -np.ones(len(fin_l)), -pr.lb[fin_l])
-        self._le = le
-        self._binaries = np.flatnonzero(pr.integer)
-        soc_r, soc_c, soc_v, soc_b, dims = [], [], [], [], []
-        m = 0
-        for idx, radius in pr.cones:
-            k = len(idx)
-            soc_r.append(np.arange(1, k + 1) + m)
-            soc_c.append(np.asarray(idx, dtype=np.int64))
-            soc_v.append(-np.ones(k))
-            b = np.zeros(k + 1)
-            b[0] = radius
-            soc_b.append(b)
-            dims.append(k + 1)
-            m += k + 1
-        self._soc = (
-            np.concatenate(soc_r) if soc_r else np.zeros(0, dtype=np.int64),
-            np.concatenate(soc_c) if soc_c else np.zeros(0, dtype=np.int64),
-            np.concatenate(soc_v) if soc_v else np.zeros(0),
-            np.concatenate(soc_b) if soc_b else np.zeros(0),
-            dims,
-            m,
-        )
-        self.n = n
+        self.full = _full_base(structure)
+        self.condensed = _condensed_base(structure) if condense else None
         settings = clarabel.DefaultSettings()
         settings.verbose = False
         self._settings = settings
         self.solves = 0
         self.solve_time = 0.0
 
-    def solve(self, allowed: tuple[tuple[int, ...], ...]) -> _Relaxation:
+    def recover(self, x: FloatArray) -> FloatArray:
+        """Fill the condensed-out variables of ``x`` (a full-length vector) in place; returns x."""
+        base = self.condensed
+        if base is not None:
+            x[base.y_idx] = base.y_lin @ x[base.y_from] + base.y_off
+        return x
+
+    def solve(self, allowed: tuple[tuple[int, ...], ...], full: bool = False) -> _Relaxation:
         """Solve the relaxation where group ``g`` may use only the binaries ``allowed[g]``."""
+        base = self.full if full or self.condensed is None else self.condensed
         s = self.s
         pr = s.problem
-        n = self.n
-        ncol = n
-        eq_r, eq_c, eq_v, eq_b = list(self._eq.r), list(self._eq.c), list(self._eq.v), []
-        eq_b = list(self._eq.b)
-        m_eq = self._eq.m
-        le_r, le_c, le_v, le_b = list(self._le.r), list(self._le.c), list(self._le.v), []
-        le_b = list(self._le.b)
-        m_le = self._le.m
-        # binaries: 0 <= z <= 1 (allowed) or z = 0 (excluded)
-        zb_ub = np.zeros(pr.n)
-        for g, mem in enumerate(allowed):
-            del g
-            zb_ub[list(mem)] = 1.0
-        bins = self._binaries
-        le_r.append(np.arange(len(bins)) + m_le)
-        le_c.append(bins)
-        le_v.append(np.ones(len(bins)))
-        le_b.append(zb_ub[bins])
-        m_le += len(bins)
-        le_r.append(np.arange(len(bins)) + m_le)
-        le_c.append(bins)
-        le_v.append(-np.ones(len(bins)))
-        le_b.append(np.zeros(len(bins)))
-        m_le += len(bins)
-        for g, mem in enumerate(allowed):
-            grp = s.groups[g]
+        col = base.col
+        ncol = base.n_cols
+        eq = base.eq.copy()
+        le = base.le.copy()
+        soc_x = base.soc.copy()
+        soc_dims = list(base.soc_dims)
+        p_extra: list[tuple[IntArray, IntArray, FloatArray]] = []
+        q_extra: list[tuple[IntArray, FloatArray]] = []
+        const = base.const
+        # binaries: 0 <= z <= 1 when allowed in a group with a choice, z = 0 when excluded
+        for mem, grp in zip(allowed, s.groups, strict=True):
+            excluded = [z for z in grp.members if z not in mem]
+            if excluded:
+                ex = col[excluded]
+                eq.add(np.arange(len(ex)), ex, np.ones(len(ex)), np.zeros(len(ex)))
+            vcols = col[grp.variables]
+            n_cost = len(grp.cost_rows)
             if len(mem) == 1:
                 mb = s.member[mem[0]]
                 if len(mb.beta):
-                    le_r.append(mb.rows + m_le)
-                    le_c.append(mb.cols)
-                    le_v.append(mb.vals)
-                    le_b.append(mb.beta)
-                    m_le += len(mb.beta)
+                    rr, cc = np.nonzero(mb.a_v)
+                    le.add(rr, vcols[cc], mb.a_v[rr, cc], mb.beta)
+                if n_cost:  # the group's objective rows, plainly
+                    wv = grp.cost_w[:, None] * grp.cost_v
+                    pg = 2.0 * grp.cost_v.T @ wv
+                    ii, jj = np.nonzero(np.triu(pg))
+                    p_extra.append((vcols[ii], vcols[jj], pg[ii, jj]))
+                    q_extra.append((vcols, -2.0 * wv.T @ grp.cost_t))
+                    const += float(np.sum(grp.cost_w * grp.cost_t**2))
                 continue
-            nv = len(grp.variables)
-            if nv == 0:
+            zc = col[list(mem)]
+            nz = len(zc)
+            le.add(np.arange(nz), zc, np.ones(nz), np.ones(nz))
+            le.add(np.arange(nz), zc, -np.ones(nz), np.zeros(nz))
+            basis = grp.basis
+            k = basis.shape[0]
+            if k == 0:
                 continue
-            # linking x_V - sum_z y^z = 0
-            eq_r.append(np.arange(nv) + m_eq)
-            eq_c.append(grp.variables)
-            eq_v.append(np.ones(nv))
-            for _ in mem:
-                eq_r.append(np.arange(nv) + m_eq)
-                eq_c.append(ncol + np.arange(nv))
-                eq_v.append(-np.ones(nv))
-                ncol += nv
-            ncol -= nv * len(mem)
-            eq_b.append(np.zeros(nv))
-            m_eq += nv
-            lbv, ubv = pr.lb[grp.variables], pr.ub[grp.variables]
+            # linking B x_V - sum_z f^z = 0
+            br, bc = np.nonzero(basis)
+            eq.add(
+                np.concatenate([br, np.tile(np.arange(k), nz)]),
+                np.concatenate([vcols[bc], ncol + np.arange(k * nz)]),
+                np.concatenate([basis[br, bc], -np.ones(k * nz)]),
+                np.zeros(k),
+            )
+            ar = np.arange(k)
+            two = np.r_[ar, ar]
+            copies: list[tuple[int, IntArray]] = []
             for z in mem:
                 mb = s.member[z]
-                ycols = ncol + np.arange(nv)
-                # y - ub z <= 0 ; -y + lb z <= 0
-                rr = np.arange(nv) + m_le
-                le_r += [rr, rr, rr + nv, rr + nv]
-                le_c += [ycols, np.full(nv, z), ycols, np.full(nv, z)]
-                le_v += [np.ones(nv), -ubv, -np.ones(nv), lbv]
-                le_b.append(np.zeros(2 * nv))
-                m_le += 2 * nv
-                if len(mb.beta):
-                    k = len(mb.beta)
-                    le_r += [mb.rows + m_le, np.arange(k) + m_le]
-                    le_c += [ncol + mb.pos, np.full(k, z)]
-                    le_v += [mb.vals, -mb.beta]
-                    le_b.append(np.zeros(k))
-                    m_le += k
-                ncol += nv
-        soc_r, soc_c, soc_v, soc_b, dims, m_soc = self._soc
-        rows = np.concatenate([*eq_r, *(r + m_eq for r in le_r), soc_r + m_eq + m_le])
-        cols = np.concatenate([*eq_c, *le_c, soc_c])
-        vals = np.concatenate([*eq_v, *le_v, soc_v])
-        b = np.concatenate([*eq_b, *le_b, soc_b])
-        a_mat = sp.csc_matrix((vals, (rows, cols)), shape=(m_eq + m_le + m_soc, ncol))
+                fcols = ncol + ar
+                zcol = np.full(k, col[z])
+                # f - f_ub z <= 0 ; -f + f_lb z <= 0
+                le.add(two, np.r_[fcols, zcol], np.r_[np.ones(k), -grp.f_ub], np.zeros(k))
+                le.add(two, np.r_[fcols, zcol], np.r_[-np.ones(k), grp.f_lb], np.zeros(k))
+                nb = len(mb.beta)
+                if nb:
+                    rr, cc = np.nonzero(mb.a_f)
+                    le.add(
+                        np.r_[rr, np.arange(nb)],
+                        np.r_[ncol + cc, np.full(nb, col[z])],
+                        np.r_[mb.a_f[rr, cc], -mb.beta],
+                        np.zeros(nb),
+                    )
+                ncol += k
+                copies.append((z, fcols))
+            if n_cost:
+                sw = 2.0 * np.sqrt(grp.cost_w)
+                cf = sw[:, None] * grp.cost_f
+                rr, cc = np.nonzero(cf)
+                for z, fcols in copies:
+                    # perspective: t_z z >= sum w (C f^z - t z)^2, i.e.
+                    # ||(2 sqrt(w) (C f^z - t z), t_z - z)|| <= t_z + z
+                    tcol, zc1 = ncol, int(col[z])
+                    ncol += 1
+                    q_extra.append((np.array([tcol]), np.array([1.0])))
+                    soc_x.add(
+                        np.r_[0, 0, 1, 1, rr + 2, np.arange(n_cost) + 2],
+                        np.r_[tcol, zc1, tcol, zc1, fcols[cc], np.full(n_cost, zc1)],
+                        np.r_[-1.0, -1.0, -1.0, 1.0, -cf[rr, cc], sw * grp.cost_t],
+                        np.zeros(n_cost + 2),
+                    )
+                    soc_dims.append(n_cost + 2)
+        soc = soc_x
+        m_eq, m_le = eq.m, le.m
+        rows = np.concatenate([*eq.r, *(r + m_eq for r in le.r), *(r + m_eq + m_le for r in soc.r)])
+        cols = np.concatenate([*eq.c, *le.c, *soc.c])
+        vals = np.concatenate([*eq.v, *le.v, *soc.v])
+        b = np.concatenate([*eq.b, *le.b, *soc.b])
+        a_mat = sp.csc_matrix((vals, (rows, cols)), shape=(m_eq + m_le + soc.m, ncol))
+        pm = base.p_mat
+        extra = ncol - base.n_cols
         p_mat = sp.csc_matrix(
-            (s.p_mat.data, s.p_mat.indices, np.r_[s.p_mat.indptr, [s.p_mat.nnz] * (ncol - n)]),
-            shape=(ncol, ncol),
+            (pm.data, pm.indices, np.r_[pm.indptr, np.full(extra, pm.nnz)]), shape=(ncol, ncol)
         )
+        if p_extra:
+            pi = np.concatenate([e[0] for e in p_extra])
+            pj = np.concatenate([e[1] for e in p_extra])
+            pv = np.concatenate([e[2] for e in p_extra])
+            lo, hi = np.minimum(pi, pj), np.maximum(pi, pj)
+            p_mat = (p_mat + sp.csc_matrix((pv, (lo, hi)), shape=(ncol, ncol))).tocsc()
         q = np.zeros(ncol)
-        q[:n] = s.q_vec
+        q[: base.n_cols] = base.q_vec
+        for qi, qv in q_extra:
+            np.add.at(q, qi, qv)
         cl = self._clarabel
         cones: list[Any] = [cl.ZeroConeT(m_eq), cl.NonnegativeConeT(m_le)]
-        cones += [cl.SecondOrderConeT(d) for d in dims]
+        cones += [cl.SecondOrderConeT(d) for d in soc_dims]
         t0 = time.perf_counter()
         solver = cl.DefaultSolver(p_mat, q, a_mat, b, cones, self._settings)
         sol = solver.solve()
@@ -384,8 +709,14 @@ class HullRelaxation:
         self.solves += 1
         status = str(sol.status)
         if status in ("Solved", "AlmostSolved"):
-            bound = min(float(sol.obj_val), float(sol.obj_val_dual)) + s.const
-            return _Relaxation("solved", bound, np.asarray(sol.x)[:n], int(sol.iterations))
+            bound = min(float(sol.obj_val), float(sol.obj_val_dual)) + const
+            xs = np.asarray(sol.x)
+            x = np.zeros(pr.n)
+            mapped = col >= 0
+            x[mapped] = xs[col[mapped]]
+            if base is self.condensed:
+                self.recover(x)
+            return _Relaxation("solved", bound, x, int(sol.iterations))
         if status in ("PrimalInfeasible", "AlmostPrimalInfeasible"):
             return _Relaxation("infeasible", iterations=int(sol.iterations))
         return _Relaxation("failed", iterations=int(sol.iterations))
@@ -398,22 +729,21 @@ class _Node:
     allowed: tuple[tuple[int, ...], ...] = field(compare=False)
     x: FloatArray | None = field(compare=False, default=None)
     depth: int = field(compare=False, default=0)
+    full: bool = field(compare=False, default=False)
 
 
 def _weights(x: FloatArray, mem: tuple[int, ...]) -> FloatArray:
     return np.clip(x[list(mem)], 0.0, 1.0)
 
 
-def _violations(s: _Structure, x: FloatArray, mem: tuple[int, ...]) -> FloatArray:
+def _violations(s: _Structure, x: FloatArray, g: int, mem: tuple[int, ...]) -> FloatArray:
     """Largest violation of each member's indicator rows at ``x``, shape (len(mem),)."""
-    out = np.empty(len(mem))
+    xv = x[s.groups[g].variables]
+    out = np.zeros(len(mem))
     for k, z in enumerate(mem):
         mb = s.member[z]
-        if not len(mb.beta):
-            out[k] = 0.0
-            continue
-        lhs = np.bincount(mb.rows, weights=mb.vals * x[mb.cols], minlength=len(mb.beta))
-        out[k] = float(np.max(lhs - mb.beta))
+        if len(mb.beta):
+            out[k] = float(np.max(mb.a_v @ xv - mb.beta))
     return out
 
 
@@ -426,11 +756,11 @@ def _choice(
     is integer feasible even when the IPM spread the weights over several equally good members.
     """
     out = []
-    for mem in allowed:
+    for g, mem in enumerate(allowed):
         if len(mem) == 1:
             out.append(mem)
             continue
-        v = _violations(s, x, mem)
+        v = _violations(s, x, g, mem)
         k = int(np.argmin(v))
         if v[k] > tol:
             return None
@@ -450,7 +780,7 @@ def _branch(
     for g, mem in enumerate(allowed):
         if len(mem) < 2:
             continue
-        viol = float(np.min(_violations(s, x, mem)))
+        viol = float(np.min(_violations(s, x, g, mem)))
         if viol > best:
             best, best_g = viol, g
     if best_g < 0:
@@ -466,13 +796,39 @@ def _branch(
     return tuple(left), tuple(right)
 
 
-def _finish(pr: MIQCQP, x: FloatArray, chosen: tuple[tuple[int, ...], ...]) -> FloatArray:
-    """The relaxation solution as a MIQCQP point: binaries of the chosen members set to 1."""
+def _finish(s: _Structure, x: FloatArray, chosen: tuple[tuple[int, ...], ...]) -> FloatArray:
+    """A relaxation solution as a MIQCQP point: the chosen binaries set to 1, the others to 0, and
+    each group's private variables recovered from the chosen member's rows."""
+    pr = s.problem
     out = x.copy()
     out[pr.integer] = 0.0
-    for mem in chosen:
-        out[mem[0]] = 1.0
+    for g, mem in enumerate(chosen):
+        z = mem[0]
+        out[z] = 1.0
+        for v in s.groups[g].private:
+            lo, hi = float(pr.lb[v]), float(pr.ub[v])
+            for cc, vv, bb in s.member[z].orig:
+                hit = cc == v
+                if not np.any(hit):
+                    continue
+                a = float(vv[hit][0])
+                rest = float(vv[~hit] @ out[cc[~hit]])
+                if a > 0.0:
+                    hi = min(hi, (bb - rest) / a)
+                else:
+                    lo = max(lo, (bb - rest) / a)
+            out[v] = 0.5 * (lo + hi) if lo <= hi else lo
     return out
+
+
+def _root_allowed(s: _Structure) -> tuple[tuple[int, ...], ...]:
+    """Members allowed by the binaries' own bounds (a binary fixed to 1 excludes the others)."""
+    pr = s.problem
+    out = []
+    for grp in s.groups:
+        ones = tuple(z for z in grp.members if pr.lb[z] >= 0.5)
+        out.append(ones if ones else tuple(z for z in grp.members if pr.ub[z] >= 0.5))
+    return tuple(out)
 
 
 def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
@@ -481,30 +837,33 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
     deadline = start + options.time_limit
     structure = analyse(problem)
     relax = HullRelaxation(structure)
-    root_allowed = tuple(g.members for g in structure.groups)
+    root_allowed = _root_allowed(structure)
     incumbent: FloatArray | None = None
     inc_obj = math.inf
     tried: set[tuple[tuple[int, ...], ...]] = set()
     nodes = 0
     counter = 0
 
-    def offer(x: FloatArray, chosen: tuple[tuple[int, ...], ...]) -> None:
+    def offer(cand: FloatArray) -> bool:
         nonlocal incumbent, inc_obj
-        cand = _finish(problem, x, chosen)
         if problem.violation(cand) > FEAS_TOL:
-            return
+            return False
         obj = problem.objective(cand)
         if obj < inc_obj:
             incumbent, inc_obj = cand, obj
+        return True
 
-    def try_rounding(x: FloatArray, allowed: tuple[tuple[int, ...], ...]) -> None:
-        fixed = _rounded(x, allowed)
+    def solve_fixed(fixed: tuple[tuple[int, ...], ...]) -> None:
+        """One convex solve with every group fixed; the full model if the condensed one is off."""
         if fixed in tried:
             return
         tried.add(fixed)
-        res = relax.solve(fixed)
-        if res.status == "solved" and res.x is not None:
-            offer(res.x, fixed)
+        for full in (False, True):
+            res = relax.solve(fixed, full=full)
+            if res.status != "solved" or res.x is None:
+                return
+            if offer(_finish(structure, res.x, fixed)):
+                return
 
     if options.initial_solution is not None:
         x0 = np.asarray(options.initial_solution, dtype=float)
@@ -522,10 +881,12 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
     heap: list[_Node] = []
     failed = False
 
-    def evaluate(allowed: tuple[tuple[int, ...], ...], parent_bound: float, depth: int) -> None:
+    def evaluate(
+        allowed: tuple[tuple[int, ...], ...], parent_bound: float, depth: int, full: bool
+    ) -> None:
         """Solve a node; keep it when it may hold a better plan than the incumbent."""
         nonlocal nodes, counter, failed
-        res = relax.solve(allowed)
+        res = relax.solve(allowed, full=full)
         nodes += 1
         if res.status == "failed":
             failed = True
@@ -533,20 +894,29 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
         if res.status != "solved" or res.x is None:
             return
         bound = max(res.bound, parent_bound)
-        chosen = _choice(structure, res.x, allowed, ROW_TOL)
-        if chosen is not None:
-            offer(res.x, chosen)  # the relaxation optimum is feasible: the node is solved
-            return
         if bound >= inc_obj:
             return
-        heapq.heappush(heap, _Node(bound, counter, allowed, res.x, depth))
+        chosen = _choice(structure, res.x, allowed, ROW_TOL)
+        if chosen is not None:
+            # The relaxation optimum satisfies one member of every group.
+            if offer(_finish(structure, res.x, chosen)):
+                return  # exact: the node is solved
+            if not full:  # only the dropped bounds/cones of the condensed variables fail
+                evaluate(allowed, bound, depth, True)
+                return
+            solve_fixed(chosen)
+            return
+        heapq.heappush(heap, _Node(bound, counter, allowed, res.x, depth, full))
         counter += 1
         if depth == 0 or nodes % ROUNDING_EVERY == 0:
-            try_rounding(res.x, allowed)
+            solve_fixed(_rounded(res.x, allowed))
 
-    evaluate(root_allowed, -math.inf, 0)
+    evaluate(root_allowed, -math.inf, 0, False)
     timed_out = False
+    trace: list[tuple[int, float, float, float]] = []
     while heap:
+        if len(trace) == 0 or nodes >= trace[-1][0] + 25:
+            trace.append((nodes, time.perf_counter() - start, inc_obj, heap[0].bound))
         if gap_of(heap[0].bound) <= options.gap:
             break
         if time.perf_counter() > deadline:
@@ -560,7 +930,7 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
         if split is None:  # pragma: no cover - evaluate() resolved such nodes
             continue
         for child in split:
-            evaluate(child, node.bound, node.depth + 1)
+            evaluate(child, node.bound, node.depth + 1, node.full)
 
     best_bound = min((nd.bound for nd in heap), default=inc_obj)
     if incumbent is None:
@@ -597,5 +967,6 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
             "variables": problem.n,
             "integer_variables": problem.n_integer,
             "groups": len(structure.groups),
+            "trace": trace,
         },
     )
