@@ -60,10 +60,13 @@ INT_TOL = 1e-6
 FEAS_TOL = 1e-6
 #: the z = 0 form of a big-M row must be implied by the bounds within this
 REDUNDANT_TOL = 1e-7
+COPY_BOUNDS = False
 #: a member's indicator rows count as satisfied by a relaxation solution within this
 ROW_TOL = 1e-7
-#: try rounding the relaxation solution to an incumbent at every this many nodes
+#: try rounding the relaxation solution to an incumbent at every this many nodes (0: never)
 ROUNDING_EVERY = 8
+#: dive from the root relaxation for an early incumbent
+DIVE = True
 
 
 class UnsupportedProblem(ValueError):
@@ -171,6 +174,34 @@ def _eliminate(
     return out
 
 
+def _drop_redundant(
+    a_v: FloatArray, beta: FloatArray, lb: FloatArray, ub: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Remove rows implied by the box that the bounds and the single-variable rows define.
+
+    Single-variable rows are kept (they bound the member's copies). Removing implied rows leaves
+    the member's set unchanged.
+    """
+    if not len(beta):
+        return a_v, beta
+    lo, hi = lb.copy(), ub.copy()
+    nnz = np.count_nonzero(a_v, axis=1)
+    for j in np.flatnonzero(nnz == 1):
+        c = int(np.flatnonzero(a_v[j])[0])
+        v = a_v[j, c]
+        if v > 0:
+            hi[c] = min(hi[c], beta[j] / v)
+        else:
+            lo[c] = max(lo[c], beta[j] / v)
+    top = np.sum(np.maximum(a_v * lo, a_v * hi), axis=1)
+    keep = (nnz == 1) | ~(top <= beta - REDUNDANT_TOL * np.maximum(1.0, np.abs(beta)))
+    keep &= nnz > 0
+    # a row with no variables left is kept only if it is violated (the member is impossible)
+    empty = (nnz == 0) & (beta < -REDUNDANT_TOL)
+    keep |= empty
+    return a_v[keep], beta[keep]
+
+
 def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
     """Split ``problem`` into choice groups and indicator rows; raise :class:`UnsupportedProblem`.
 
@@ -274,7 +305,7 @@ def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
                 for c, v in row.items():
                     a_v[j, where[c]] += v
                 beta[j] = rhs
-            dense[z] = (a_v, beta)
+            dense[z] = _drop_redundant(a_v, beta, problem.lb[variables], problem.ub[variables])
         stacked = np.vstack([dense[z][0] for z in mem] + [np.zeros((0, len(variables)))])
         if stacked.shape[0] and len(variables):
             _, sv, vt = np.linalg.svd(stacked, full_matrices=False)
@@ -561,11 +592,224 @@ def _condensed_base(s: _Structure) -> _Base | None:
     )
 
 
+def _cat(parts: list[Any], dtype: Any) -> Any:
+    return np.concatenate(parts) if parts else np.zeros(0, dtype=dtype)
+
+
+@dataclass
+class _Templates:
+    """Per-node pieces of the relaxation over one base, as flat arrays gathered by member mask.
+
+    Members are numbered globally (group after group). Entry arrays carry the owning member
+    (``*_mem``) and a column kind: 0 = the member's copy of form ``loc``, 1 = the member's binary,
+    2 = the member's perspective variable ``t``.
+    """
+
+    base: _Base
+    # static rows of the base, concatenated
+    eq_r: IntArray
+    eq_c: IntArray
+    eq_v: FloatArray
+    eq_b: FloatArray
+    le_r: IntArray
+    le_c: IntArray
+    le_v: FloatArray
+    le_b: FloatArray
+    m_eq: int
+    m_le: int
+    # per member
+    group: IntArray  # group of each member
+    zcol: IntArray  # column of each member's binary
+    k: IntArray  # number of forms of the member's group
+    n_rows: IntArray  # hull rows of the member (copy bounds + its rows)
+    has_cost: NDArray[np.bool_]
+    cost_dim: IntArray  # cone dimension of its perspective term
+    # hull rows (multi-member groups)
+    h_mem: IntArray
+    h_row: IntArray
+    h_kind: IntArray
+    h_loc: IntArray
+    h_val: FloatArray
+    # perspective cones
+    c_mem: IntArray
+    c_row: IntArray
+    c_kind: IntArray
+    c_loc: IntArray
+    c_val: FloatArray
+    # direct rows (single-member groups)
+    d_mem: IntArray
+    d_row: IntArray
+    d_col: IntArray
+    d_val: FloatArray
+    d_nrows: IntArray
+    d_beta: FloatArray  # concatenated in member order
+    d_beta_mem: IntArray
+    # direct cost (single-member groups), upper triangle entries
+    dp_mem: IntArray
+    dp_i: IntArray
+    dp_j: IntArray
+    dp_v: FloatArray
+    dq_mem: IntArray
+    dq_i: IntArray
+    dq_v: FloatArray
+    d_const: FloatArray  # per member
+    # linking rows per group: B x_V - sum f^z = 0
+    l_grp: IntArray
+    l_row: IntArray
+    l_col: IntArray
+    l_val: FloatArray
+
+
+def _templates(s: _Structure, base: _Base) -> _Templates:
+    col = base.col
+    groups, zcol, kk, nrows, has_cost, cdim = [], [], [], [], [], []
+    h = ([], [], [], [], [], [])
+    c = ([], [], [], [], [], [])
+    d = ([], [], [], [], [], [], [])
+    dp = ([], [], [], [])
+    dq = ([], [], [])
+    dconst = []
+    link = ([], [], [], [])
+    mi = 0
+    for g, grp in enumerate(s.groups):
+        k = grp.basis.shape[0]
+        vcols = col[grp.variables]
+        br, bc = np.nonzero(grp.basis)
+        link[0].append(np.full(len(br), g))
+        link[1].append(br)
+        link[2].append(vcols[bc])
+        link[3].append(grp.basis[br, bc])
+        n_cost = len(grp.cost_rows)
+        if n_cost:
+            sw = 2.0 * np.sqrt(grp.cost_w)
+            cf = sw[:, None] * grp.cost_f
+            cr, cc = np.nonzero(cf)
+            wv = grp.cost_w[:, None] * grp.cost_v
+            pg = np.triu(2.0 * grp.cost_v.T @ wv)
+            pi, pj = np.nonzero(pg)
+            qg = -2.0 * wv.T @ grp.cost_t
+        for z in grp.members:
+            mb = s.member[z]
+            groups.append(g)
+            zcol.append(col[z])
+            kk.append(k)
+            nb = len(mb.beta)
+            nrows.append(2 * k + nb if COPY_BOUNDS else nb)
+            has_cost.append(n_cost > 0)
+            cdim.append(n_cost + 2 if n_cost else 0)
+            # hull rows: f - f_ub z <= 0 ; -f + f_lb z <= 0 ; a_f f - beta z <= 0
+            ar = np.arange(k)
+            rr, cc2 = np.nonzero(mb.a_f)
+            rows = np.r_[ar, ar, ar + k, ar + k, rr + 2 * k, np.arange(nb) + 2 * k]
+            kind = np.r_[np.zeros(k), np.ones(k), np.zeros(k), np.ones(k), np.zeros(len(rr)),
+                         np.ones(nb)].astype(np.int64)  # fmt: skip
+            loc = np.r_[ar, ar, ar, ar, cc2, np.zeros(nb)].astype(np.int64)
+            val = np.r_[np.ones(k), -grp.f_ub, -np.ones(k), grp.f_lb, mb.a_f[rr, cc2], -mb.beta]
+            if not COPY_BOUNDS:
+                keep = rows >= 2 * k
+                rows, kind, loc, val = rows[keep] - 2 * k, kind[keep], loc[keep], val[keep]
+            h[0].append(np.full(len(rows), mi))
+            h[1].append(rows)
+            h[2].append(kind)
+            h[3].append(loc)
+            h[4].append(val)
+            if n_cost:
+                # perspective: ||(2 sqrt(w) (C f^z - t z), t_z - z)|| <= t_z + z
+                rows = np.r_[0, 0, 1, 1, cr + 2, np.arange(n_cost) + 2]
+                kind = np.r_[2, 1, 2, 1, np.zeros(len(cr)), np.ones(n_cost)].astype(np.int64)
+                loc = np.r_[0, 0, 0, 0, cc, np.zeros(n_cost)].astype(np.int64)
+                val = np.r_[-1.0, -1.0, -1.0, 1.0, -cf[cr, cc], sw * grp.cost_t]
+                c[0].append(np.full(len(rows), mi))
+                c[1].append(rows)
+                c[2].append(kind)
+                c[3].append(loc)
+                c[4].append(val)
+            # direct rows
+            rr, cc2 = np.nonzero(mb.a_v)
+            d[0].append(np.full(len(rr), mi))
+            d[1].append(rr)
+            d[2].append(vcols[cc2])
+            d[3].append(mb.a_v[rr, cc2])
+            d[4].append(nb)
+            d[5].append(mb.beta)
+            d[6].append(np.full(nb, mi))
+            if n_cost:
+                lo = np.minimum(vcols[pi], vcols[pj])
+                hi = np.maximum(vcols[pi], vcols[pj])
+                dp[0].append(np.full(len(pi), mi))
+                dp[1].append(lo)
+                dp[2].append(hi)
+                dp[3].append(pg[pi, pj])
+                dq[0].append(np.full(len(vcols), mi))
+                dq[1].append(vcols)
+                dq[2].append(qg)
+                dconst.append(float(np.sum(grp.cost_w * grp.cost_t**2)))
+            else:
+                dconst.append(0.0)
+            mi += 1
+    i64, f64 = np.int64, float
+    return _Templates(
+        base=base,
+        eq_r=_cat(base.eq.r, i64),
+        eq_c=_cat(base.eq.c, i64),
+        eq_v=_cat(base.eq.v, f64),
+        eq_b=_cat(base.eq.b, f64),
+        le_r=_cat(base.le.r, i64),
+        le_c=_cat(base.le.c, i64),
+        le_v=_cat(base.le.v, f64),
+        le_b=_cat(base.le.b, f64),
+        m_eq=base.eq.m,
+        m_le=base.le.m,
+        group=np.array(groups, dtype=i64),
+        zcol=np.array(zcol, dtype=i64),
+        k=np.array(kk, dtype=i64),
+        n_rows=np.array(nrows, dtype=i64),
+        has_cost=np.array(has_cost, dtype=bool),
+        cost_dim=np.array(cdim, dtype=i64),
+        h_mem=_cat(h[0], i64),
+        h_row=_cat(h[1], i64),
+        h_kind=_cat(h[2], i64),
+        h_loc=_cat(h[3], i64),
+        h_val=_cat(h[4], f64),
+        c_mem=_cat(c[0], i64),
+        c_row=_cat(c[1], i64),
+        c_kind=_cat(c[2], i64),
+        c_loc=_cat(c[3], i64),
+        c_val=_cat(c[4], f64),
+        d_mem=_cat(d[0], i64),
+        d_row=_cat(d[1], i64),
+        d_col=_cat(d[2], i64),
+        d_val=_cat(d[3], f64),
+        d_nrows=np.array(d[4], dtype=i64),
+        d_beta=_cat(d[5], f64),
+        d_beta_mem=_cat(d[6], i64),
+        dp_mem=_cat(dp[0], i64),
+        dp_i=_cat(dp[1], i64),
+        dp_j=_cat(dp[2], i64),
+        dp_v=_cat(dp[3], f64),
+        dq_mem=_cat(dq[0], i64),
+        dq_i=_cat(dq[1], i64),
+        dq_v=_cat(dq[2], f64),
+        d_const=np.array(dconst, dtype=f64),
+        l_grp=_cat(link[0], i64),
+        l_row=_cat(link[1], i64),
+        l_col=_cat(link[2], i64),
+        l_val=_cat(link[3], f64),
+    )
+
+
+def _offsets(counts: IntArray, mask: NDArray[np.bool_]) -> IntArray:
+    """Start of each selected item in a packed layout (garbage where not selected)."""
+    c = np.where(mask, counts, 0)
+    return np.cumsum(c) - c
+
+
 class HullRelaxation:
     """Builds and solves the node relaxation of :mod:`footfall.solvers.bnb` (see module docstring).
 
     Two bases: ``full`` (every variable, bound and cone: exact at integral nodes) and, when the
     problem allows it, ``condensed`` (see :func:`_condensed_base`: a lower bound, much smaller).
+    A node's relaxation is assembled from flat templates by masking (no Python loop per member).
     """
 
     def __init__(self, structure: _Structure, condense: bool = True) -> None:
@@ -575,6 +819,14 @@ class HullRelaxation:
         self.s = structure
         self.full = _full_base(structure)
         self.condensed = _condensed_base(structure) if condense else None
+        self._tpl = {id(self.full): _templates(structure, self.full)}
+        if self.condensed is not None:
+            self._tpl[id(self.condensed)] = _templates(structure, self.condensed)
+        n = structure.problem.n
+        self.member_index = np.full(n, -1, dtype=np.int64)
+        order = [z for grp in structure.groups for z in grp.members]
+        self.member_index[order] = np.arange(len(order))
+        self.n_members = len(order)
         settings = clarabel.DefaultSettings()
         settings.verbose = False
         self._settings = settings
@@ -591,117 +843,114 @@ class HullRelaxation:
     def solve(self, allowed: tuple[tuple[int, ...], ...], full: bool = False) -> _Relaxation:
         """Solve the relaxation where group ``g`` may use only the binaries ``allowed[g]``."""
         base = self.full if full or self.condensed is None else self.condensed
-        s = self.s
-        pr = s.problem
-        col = base.col
-        ncol = base.n_cols
-        eq = base.eq.copy()
-        le = base.le.copy()
-        soc_x = base.soc.copy()
-        soc_dims = list(base.soc_dims)
-        p_extra: list[tuple[IntArray, IntArray, FloatArray]] = []
-        q_extra: list[tuple[IntArray, FloatArray]] = []
-        const = base.const
-        # binaries: 0 <= z <= 1 when allowed in a group with a choice, z = 0 when excluded
-        for mem, grp in zip(allowed, s.groups, strict=True):
-            excluded = [z for z in grp.members if z not in mem]
-            if excluded:
-                ex = col[excluded]
-                eq.add(np.arange(len(ex)), ex, np.ones(len(ex)), np.zeros(len(ex)))
-            vcols = col[grp.variables]
-            n_cost = len(grp.cost_rows)
-            if len(mem) == 1:
-                mb = s.member[mem[0]]
-                if len(mb.beta):
-                    rr, cc = np.nonzero(mb.a_v)
-                    le.add(rr, vcols[cc], mb.a_v[rr, cc], mb.beta)
-                if n_cost:  # the group's objective rows, plainly
-                    wv = grp.cost_w[:, None] * grp.cost_v
-                    pg = 2.0 * grp.cost_v.T @ wv
-                    ii, jj = np.nonzero(np.triu(pg))
-                    p_extra.append((vcols[ii], vcols[jj], pg[ii, jj]))
-                    q_extra.append((vcols, -2.0 * wv.T @ grp.cost_t))
-                    const += float(np.sum(grp.cost_w * grp.cost_t**2))
-                continue
-            zc = col[list(mem)]
-            nz = len(zc)
-            le.add(np.arange(nz), zc, np.ones(nz), np.ones(nz))
-            le.add(np.arange(nz), zc, -np.ones(nz), np.zeros(nz))
-            basis = grp.basis
-            k = basis.shape[0]
-            if k == 0:
-                continue
-            # linking B x_V - sum_z f^z = 0
-            br, bc = np.nonzero(basis)
-            eq.add(
-                np.concatenate([br, np.tile(np.arange(k), nz)]),
-                np.concatenate([vcols[bc], ncol + np.arange(k * nz)]),
-                np.concatenate([basis[br, bc], -np.ones(k * nz)]),
-                np.zeros(k),
-            )
-            ar = np.arange(k)
-            two = np.r_[ar, ar]
-            copies: list[tuple[int, IntArray]] = []
-            for z in mem:
-                mb = s.member[z]
-                fcols = ncol + ar
-                zcol = np.full(k, col[z])
-                # f - f_ub z <= 0 ; -f + f_lb z <= 0
-                le.add(two, np.r_[fcols, zcol], np.r_[np.ones(k), -grp.f_ub], np.zeros(k))
-                le.add(two, np.r_[fcols, zcol], np.r_[-np.ones(k), grp.f_lb], np.zeros(k))
-                nb = len(mb.beta)
-                if nb:
-                    rr, cc = np.nonzero(mb.a_f)
-                    le.add(
-                        np.r_[rr, np.arange(nb)],
-                        np.r_[ncol + cc, np.full(nb, col[z])],
-                        np.r_[mb.a_f[rr, cc], -mb.beta],
-                        np.zeros(nb),
-                    )
-                ncol += k
-                copies.append((z, fcols))
-            if n_cost:
-                sw = 2.0 * np.sqrt(grp.cost_w)
-                cf = sw[:, None] * grp.cost_f
-                rr, cc = np.nonzero(cf)
-                for z, fcols in copies:
-                    # perspective: t_z z >= sum w (C f^z - t z)^2, i.e.
-                    # ||(2 sqrt(w) (C f^z - t z), t_z - z)|| <= t_z + z
-                    tcol, zc1 = ncol, int(col[z])
-                    ncol += 1
-                    q_extra.append((np.array([tcol]), np.array([1.0])))
-                    soc_x.add(
-                        np.r_[0, 0, 1, 1, rr + 2, np.arange(n_cost) + 2],
-                        np.r_[tcol, zc1, tcol, zc1, fcols[cc], np.full(n_cost, zc1)],
-                        np.r_[-1.0, -1.0, -1.0, 1.0, -cf[rr, cc], sw * grp.cost_t],
-                        np.zeros(n_cost + 2),
-                    )
-                    soc_dims.append(n_cost + 2)
-        soc = soc_x
-        m_eq, m_le = eq.m, le.m
-        rows = np.concatenate([*eq.r, *(r + m_eq for r in le.r), *(r + m_eq + m_le for r in soc.r)])
-        cols = np.concatenate([*eq.c, *le.c, *soc.c])
-        vals = np.concatenate([*eq.v, *le.v, *soc.v])
-        b = np.concatenate([*eq.b, *le.b, *soc.b])
-        a_mat = sp.csc_matrix((vals, (rows, cols)), shape=(m_eq + m_le + soc.m, ncol))
-        pm = base.p_mat
-        extra = ncol - base.n_cols
-        p_mat = sp.csc_matrix(
-            (pm.data, pm.indices, np.r_[pm.indptr, np.full(extra, pm.nnz)]), shape=(ncol, ncol)
+        t = self._tpl[id(base)]
+        pr = self.s.problem
+        n_groups = len(self.s.groups)
+        sel = np.zeros(self.n_members, dtype=bool)
+        sel[self.member_index[[z for mem in allowed for z in mem]]] = True
+        count = np.bincount(t.group[sel], minlength=n_groups)
+        multi_g = count >= 2
+        multi = sel & multi_g[t.group]
+        single = sel & ~multi
+        excluded = ~sel
+
+        ncol0 = base.n_cols
+        # columns: copies of the forms, then the perspective variables
+        copy_start = ncol0 + _offsets(t.k, multi)
+        n_copies = int(np.sum(t.k[multi]))
+        persp = multi & t.has_cost
+        t_col = ncol0 + n_copies + _offsets(np.ones_like(t.k), persp)
+        ncol = ncol0 + n_copies + int(np.count_nonzero(persp))
+
+        # equalities: static, excluded binaries = 0, linking rows of multi groups
+        ex_cols = t.zcol[excluded]
+        n_ex = len(ex_cols)
+        k_group = np.zeros(n_groups, dtype=np.int64)
+        k_group[t.group] = t.k
+        link_start = t.m_eq + n_ex + _offsets(k_group, multi_g)
+        lm = multi_g[t.l_grp]
+        # copies: -1 at (link_start[g] + j, copy_start[m] + j)
+        cm = np.repeat(np.flatnonzero(multi), t.k[multi])
+        cj = np.arange(len(cm)) - np.repeat(_offsets(t.k, multi)[multi], t.k[multi])
+        eq_r = np.concatenate(
+            [t.eq_r, t.m_eq + np.arange(n_ex), link_start[t.l_grp[lm]] + t.l_row[lm],
+             link_start[t.group[cm]] + cj]
+        )  # fmt: skip
+        eq_c = np.concatenate([t.eq_c, ex_cols, t.l_col[lm], copy_start[cm] + cj])
+        eq_v = np.concatenate([t.eq_v, np.ones(n_ex), t.l_val[lm], -np.ones(len(cm))])
+        m_eq = t.m_eq + n_ex + int(np.sum(k_group[multi_g]))
+        eq_b = np.concatenate([t.eq_b, np.zeros(m_eq - t.m_eq)])
+
+        # inequalities: static, -z <= 0 for multi members, hull rows, direct rows
+        zm = t.zcol[multi]
+        nzm = len(zm)
+        row0 = t.m_le + nzm
+        h_start = row0 + _offsets(t.n_rows, multi)
+        hm = multi[t.h_mem]
+        hmem = t.h_mem[hm]
+        hkind = t.h_kind[hm]
+        h_cols = np.where(hkind == 0, copy_start[hmem] + t.h_loc[hm], t.zcol[hmem])
+        n_h = int(np.sum(t.n_rows[multi]))
+        d_start = row0 + n_h + _offsets(t.d_nrows, single)
+        dm = single[t.d_mem]
+        n_d = int(np.sum(t.d_nrows[single]))
+        le_r = np.concatenate(
+            [t.le_r, t.m_le + np.arange(nzm), h_start[hmem] + t.h_row[hm],
+             d_start[t.d_mem[dm]] + t.d_row[dm]]
+        )  # fmt: skip
+        le_c = np.concatenate([t.le_c, zm, h_cols, t.d_col[dm]])
+        le_v = np.concatenate([t.le_v, -np.ones(nzm), t.h_val[hm], t.d_val[dm]])
+        le_b = np.concatenate([t.le_b, np.zeros(nzm + n_h), t.d_beta[single[t.d_beta_mem]]])
+        m_le = row0 + n_h + n_d
+
+        # cones: static (base) and perspective
+        c_start = _offsets(t.cost_dim, persp)
+        cmask = persp[t.c_mem]
+        cmem = t.c_mem[cmask]
+        ckind = t.c_kind[cmask]
+        c_cols = np.where(
+            ckind == 0,
+            copy_start[cmem] + t.c_loc[cmask],
+            np.where(ckind == 1, t.zcol[cmem], t_col[cmem]),
         )
-        if p_extra:
-            pi = np.concatenate([e[0] for e in p_extra])
-            pj = np.concatenate([e[1] for e in p_extra])
-            pv = np.concatenate([e[2] for e in p_extra])
-            lo, hi = np.minimum(pi, pj), np.maximum(pi, pj)
-            p_mat = (p_mat + sp.csc_matrix((pv, (lo, hi)), shape=(ncol, ncol))).tocsc()
+        soc = base.soc
+        soc_r = _cat(soc.r, np.int64)
+        n_pc = int(np.sum(t.cost_dim[persp]))
+        rows = np.concatenate(
+            [
+                eq_r,
+                le_r + m_eq,
+                soc_r + m_eq + m_le,
+                c_start[cmem] + t.c_row[cmask] + m_eq + m_le + soc.m,
+            ]
+        )
+        cols = np.concatenate([eq_c, le_c, _cat(soc.c, np.int64), c_cols])
+        vals = np.concatenate([eq_v, le_v, _cat(soc.v, float), t.c_val[cmask]])
+        b = np.concatenate([eq_b, le_b, _cat(soc.b, float), np.zeros(n_pc)])
+        a_mat = sp.csc_matrix((vals, (rows, cols)), shape=(m_eq + m_le + soc.m + n_pc, ncol))
+
+        pm = base.p_mat
+        p_mat = sp.csc_matrix(
+            (pm.data, pm.indices, np.r_[pm.indptr, np.full(ncol - base.n_cols, pm.nnz)]),
+            shape=(ncol, ncol),
+        )
+        pmask = single[t.dp_mem]
+        if np.any(pmask):
+            p_mat = (
+                p_mat
+                + sp.csc_matrix((t.dp_v[pmask], (t.dp_i[pmask], t.dp_j[pmask])), shape=(ncol, ncol))
+            ).tocsc()
         q = np.zeros(ncol)
         q[: base.n_cols] = base.q_vec
-        for qi, qv in q_extra:
-            np.add.at(q, qi, qv)
+        qmask = single[t.dq_mem]
+        np.add.at(q, t.dq_i[qmask], t.dq_v[qmask])
+        q[t_col[persp]] = 1.0
+        const = base.const + float(np.sum(t.d_const[single]))
+
         cl = self._clarabel
         cones: list[Any] = [cl.ZeroConeT(m_eq), cl.NonnegativeConeT(m_le)]
-        cones += [cl.SecondOrderConeT(d) for d in soc_dims]
+        cones += [cl.SecondOrderConeT(int(dd)) for dd in base.soc_dims]
+        cones += [cl.SecondOrderConeT(int(dd)) for dd in t.cost_dim[persp]]
         t0 = time.perf_counter()
         solver = cl.DefaultSolver(p_mat, q, a_mat, b, cones, self._settings)
         sol = solver.solve()
@@ -712,6 +961,7 @@ class HullRelaxation:
             bound = min(float(sol.obj_val), float(sol.obj_val_dual)) + const
             xs = np.asarray(sol.x)
             x = np.zeros(pr.n)
+            col = base.col
             mapped = col >= 0
             x[mapped] = xs[col[mapped]]
             if base is self.condensed:
@@ -832,141 +1082,214 @@ def _root_allowed(s: _Structure) -> tuple[tuple[int, ...], ...]:
 
 
 def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
-    """Solve ``problem`` by branch and bound on hull relaxations (see the module docstring)."""
-    start = time.perf_counter()
-    deadline = start + options.time_limit
-    structure = analyse(problem)
-    relax = HullRelaxation(structure)
-    root_allowed = _root_allowed(structure)
-    incumbent: FloatArray | None = None
-    inc_obj = math.inf
-    tried: set[tuple[tuple[int, ...], ...]] = set()
-    nodes = 0
-    counter = 0
+    """Solve ``problem`` by branch and bound on hull relaxations (see the module docstring).
 
-    def offer(cand: FloatArray) -> bool:
-        nonlocal incumbent, inc_obj
-        if problem.violation(cand) > FEAS_TOL:
+    A problem without the choice-group shape is handed to SCIP (``stats["fallback"]`` says why).
+    """
+    start = time.perf_counter()
+    try:
+        structure = analyse(problem)
+    except UnsupportedProblem as exc:
+        from footfall.solvers import scip
+
+        res = scip.solve(problem, options)
+        res.stats["fallback"] = f"bnb cannot take this problem ({exc}); solved by SCIP"
+        return res
+    search = _Search(structure, options, start)
+    return search.run()
+
+
+class _Search:
+    """State of one branch-and-bound run (see the module docstring)."""
+
+    def __init__(self, structure: _Structure, options: SolverOptions, start: float) -> None:
+        self.s = structure
+        self.problem = structure.problem
+        self.options = options
+        self.start = start
+        self.deadline = start + options.time_limit
+        self.relax = HullRelaxation(structure)
+        self.incumbent: FloatArray | None = None
+        self.inc_obj = math.inf
+        self.tried: set[tuple[tuple[int, ...], ...]] = set()
+        self.heap: list[_Node] = []
+        self.nodes = 0
+        self.counter = 0
+        self.failed = False
+        self.trace: list[tuple[int, float, float, float]] = []
+        if options.initial_solution is not None:
+            x0 = np.asarray(options.initial_solution, dtype=float)
+            if x0.shape == (self.problem.n,):
+                self.offer(x0.copy())
+
+    # ----------------------------------------------------------------------------- incumbents
+    def offer(self, cand: FloatArray) -> bool:
+        """Take ``cand`` as incumbent if it is feasible and better; True if feasible."""
+        if self.problem.violation(cand) > FEAS_TOL:
             return False
-        obj = problem.objective(cand)
-        if obj < inc_obj:
-            incumbent, inc_obj = cand, obj
+        obj = self.problem.objective(cand)
+        if obj < self.inc_obj:
+            self.incumbent, self.inc_obj = cand, obj
         return True
 
-    def solve_fixed(fixed: tuple[tuple[int, ...], ...]) -> None:
+    def solve_fixed(self, fixed: tuple[tuple[int, ...], ...]) -> None:
         """One convex solve with every group fixed; the full model if the condensed one is off."""
-        if fixed in tried:
+        if fixed in self.tried:
             return
-        tried.add(fixed)
+        self.tried.add(fixed)
         for full in (False, True):
-            res = relax.solve(fixed, full=full)
+            res = self.relax.solve(fixed, full=full)
             if res.status != "solved" or res.x is None:
                 return
-            if offer(_finish(structure, res.x, fixed)):
+            if self.offer(_finish(self.s, res.x, fixed)):
                 return
 
-    if options.initial_solution is not None:
-        x0 = np.asarray(options.initial_solution, dtype=float)
-        if problem.violation(x0) <= FEAS_TOL:
-            incumbent, inc_obj = x0.copy(), problem.objective(x0)
+    def dive(self, x: FloatArray, allowed: tuple[tuple[int, ...], ...]) -> None:
+        """Depth-first dive from a relaxation solution: fix the group whose nearest member (least
+        violated rows) is nearest to that member and re-solve, until the relaxation is integral
+        (an incumbent) or hopeless."""
+        cur = allowed
+        for _ in range(2 * len(cur)):
+            if time.perf_counter() > self.deadline:
+                return
+            best_g, best_v, z = -1, math.inf, -1
+            for g, mem in enumerate(cur):
+                if len(mem) > 1:
+                    viol = _violations(self.s, x, g, mem)
+                    k = int(np.argmin(viol))
+                    if viol[k] < best_v:
+                        best_g, best_v, z = g, float(viol[k]), mem[k]
+            if best_g < 0:
+                return
+            mem = cur[best_g]
+            fixed = list(cur)
+            fixed[best_g] = (z,)
+            res = self.relax.solve(tuple(fixed))
+            if res.status != "solved" or res.x is None:
+                rest = list(cur)
+                rest[best_g] = tuple(m for m in mem if m != z)
+                cur = tuple(rest)
+                res = self.relax.solve(cur)
+                if res.status != "solved" or res.x is None:
+                    return
+            else:
+                cur = tuple(fixed)
+            if res.bound >= self.inc_obj:
+                return
+            x = res.x
+            chosen = _choice(self.s, x, cur, ROW_TOL)
+            if chosen is not None:
+                self.solve_fixed(chosen)
+                return
 
-    def gap_of(bound: float) -> float:
-        if not math.isfinite(inc_obj):
+    # ---------------------------------------------------------------------------------- search
+    def gap_of(self, bound: float) -> float:
+        """Relative gap of the incumbent against ``bound`` (SCIP's definition)."""
+        if not math.isfinite(self.inc_obj):
             return math.inf
-        if inc_obj <= bound:
+        if self.inc_obj <= bound:
             return 0.0
-        denom = min(abs(inc_obj), abs(bound))
-        return math.inf if denom == 0.0 else (inc_obj - bound) / denom
-
-    heap: list[_Node] = []
-    failed = False
+        denom = min(abs(self.inc_obj), abs(bound))
+        return math.inf if denom == 0.0 else (self.inc_obj - bound) / denom
 
     def evaluate(
-        allowed: tuple[tuple[int, ...], ...], parent_bound: float, depth: int, full: bool
-    ) -> None:
+        self, allowed: tuple[tuple[int, ...], ...], parent_bound: float, depth: int, full: bool
+    ) -> _Relaxation | None:
         """Solve a node; keep it when it may hold a better plan than the incumbent."""
-        nonlocal nodes, counter, failed
-        res = relax.solve(allowed, full=full)
-        nodes += 1
+        res = self.relax.solve(allowed, full=full)
+        self.nodes += 1
+        if res.status == "failed" and not full:
+            res = self.relax.solve(allowed, full=True)  # numerical trouble: try the plain model
+            full = True
         if res.status == "failed":
-            failed = True
-            return
+            self.failed = True
+            return None
         if res.status != "solved" or res.x is None:
-            return
+            return None
         bound = max(res.bound, parent_bound)
-        if bound >= inc_obj:
-            return
-        chosen = _choice(structure, res.x, allowed, ROW_TOL)
+        if bound >= self.inc_obj:
+            return None
+        chosen = _choice(self.s, res.x, allowed, ROW_TOL)
         if chosen is not None:
             # The relaxation optimum satisfies one member of every group.
-            if offer(_finish(structure, res.x, chosen)):
-                return  # exact: the node is solved
+            if self.offer(_finish(self.s, res.x, chosen)):
+                return None  # exact: the node is solved
             if not full:  # only the dropped bounds/cones of the condensed variables fail
-                evaluate(allowed, bound, depth, True)
-                return
-            solve_fixed(chosen)
-            return
-        heapq.heappush(heap, _Node(bound, counter, allowed, res.x, depth, full))
-        counter += 1
-        if depth == 0 or nodes % ROUNDING_EVERY == 0:
-            solve_fixed(_rounded(res.x, allowed))
+                return self.evaluate(allowed, bound, depth, True)
+            self.solve_fixed(chosen)
+            return None
+        heapq.heappush(self.heap, _Node(bound, self.counter, allowed, res.x, depth, full))
+        self.counter += 1
+        if ROUNDING_EVERY and self.nodes % ROUNDING_EVERY == 0:
+            self.solve_fixed(_rounded(res.x, allowed))
+        return res
 
-    evaluate(root_allowed, -math.inf, 0, False)
-    timed_out = False
-    trace: list[tuple[int, float, float, float]] = []
-    while heap:
-        if len(trace) == 0 or nodes >= trace[-1][0] + 25:
-            trace.append((nodes, time.perf_counter() - start, inc_obj, heap[0].bound))
-        if gap_of(heap[0].bound) <= options.gap:
-            break
-        if time.perf_counter() > deadline:
-            timed_out = True
-            break
-        node = heapq.heappop(heap)
-        if node.bound >= inc_obj:
-            continue
-        assert node.x is not None
-        split = _branch(structure, node.x, node.allowed, ROW_TOL)
-        if split is None:  # pragma: no cover - evaluate() resolved such nodes
-            continue
-        for child in split:
-            evaluate(child, node.bound, node.depth + 1, node.full)
+    def run(self) -> SolverResult:
+        """Best-first branch and bound; returns the best plan with an honest gap."""
+        root_allowed = _root_allowed(self.s)
+        timed_out = False
+        if all(root_allowed):
+            root = self.evaluate(root_allowed, -math.inf, 0, False)
+            if root is not None and root.x is not None and DIVE:
+                self.dive(root.x, root_allowed)
+        while self.heap:
+            top = self.heap[0].bound
+            if not self.trace or self.nodes >= self.trace[-1][0] + 25:
+                self.trace.append((self.nodes, time.perf_counter() - self.start, self.inc_obj, top))
+            if self.gap_of(top) <= self.options.gap:
+                break
+            if time.perf_counter() > self.deadline:
+                timed_out = True
+                break
+            node = heapq.heappop(self.heap)
+            if node.bound >= self.inc_obj:
+                continue
+            assert node.x is not None
+            split = _branch(self.s, node.x, node.allowed, ROW_TOL)
+            if split is None:  # pragma: no cover - evaluate() resolved such nodes
+                continue
+            for child in split:
+                self.evaluate(child, node.bound, node.depth + 1, node.full)
+        return self.result(timed_out)
 
-    best_bound = min((nd.bound for nd in heap), default=inc_obj)
-    if incumbent is None:
-        if timed_out:
-            status = SolveStatus.TIME_LIMIT
-        elif failed:
-            status = SolveStatus.ERROR
+    def result(self, timed_out: bool) -> SolverResult:
+        """The :class:`SolverResult` of the search so far."""
+        open_bounds = [nd.bound for nd in self.heap if nd.bound < self.inc_obj]
+        best_bound = min(open_bounds, default=self.inc_obj)
+        if self.incumbent is None:
+            if timed_out:
+                status = SolveStatus.TIME_LIMIT
+            elif self.failed:
+                status = SolveStatus.ERROR
+            else:
+                status = SolveStatus.INFEASIBLE
+            gap = math.inf
         else:
-            status = SolveStatus.INFEASIBLE
-        gap = math.inf
-    else:
-        gap = max(0.0, gap_of(best_bound))
-        if failed:
-            status = SolveStatus.FEASIBLE
-        elif gap <= options.gap:
-            status = SolveStatus.OPTIMAL
-        elif timed_out:
-            status = SolveStatus.TIME_LIMIT
-        else:
-            status = SolveStatus.FEASIBLE
-    return SolverResult(
-        status=status,
-        x=incumbent,
-        objective=inc_obj if incumbent is not None else math.nan,
-        bound=best_bound if math.isfinite(best_bound) else math.nan,
-        gap=gap,
-        solve_time=time.perf_counter() - start,
-        solver=NAME,
-        stats={
-            "raw_status": status.value,
-            "nodes": nodes,
-            "relaxations": relax.solves,
-            "relaxation_time_s": relax.solve_time,
-            "variables": problem.n,
-            "integer_variables": problem.n_integer,
-            "groups": len(structure.groups),
-            "trace": trace,
-        },
-    )
+            gap = max(0.0, self.gap_of(best_bound))
+            if gap <= self.options.gap and not self.failed:
+                status = SolveStatus.OPTIMAL
+            elif timed_out:
+                status = SolveStatus.TIME_LIMIT
+            else:
+                status = SolveStatus.FEASIBLE
+        return SolverResult(
+            status=status,
+            x=self.incumbent,
+            objective=self.inc_obj if self.incumbent is not None else math.nan,
+            bound=best_bound if math.isfinite(best_bound) else math.nan,
+            gap=gap,
+            solve_time=time.perf_counter() - self.start,
+            solver=NAME,
+            stats={
+                "raw_status": status.value,
+                "nodes": self.nodes,
+                "relaxations": self.relax.solves,
+                "relaxation_time_s": self.relax.solve_time,
+                "variables": self.problem.n,
+                "integer_variables": self.problem.n_integer,
+                "groups": len(self.s.groups),
+                "members": self.relax.n_members,
+                "condensed": self.relax.condensed is not None,
+                "trace": self.trace,
+            },
+        )
