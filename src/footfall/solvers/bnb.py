@@ -344,32 +344,33 @@ def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
             if grp.basis.shape[0] == 0 or len(grp.members) < 2:
                 continue
             where = {int(c): k for k, c in enumerate(grp.variables)}
-            rows, dense = [], []
+            c_rows: list[int] = []
+            c_dense: list[FloatArray] = []
             for j in range(f_csr.shape[0]):
                 if assigned[j]:
                     continue
                 cc = f_csr.indices[f_csr.indptr[j] : f_csr.indptr[j + 1]]
                 if not all(int(c) in where for c in cc):
                     continue
-                row = np.zeros(len(grp.variables))
+                crow = np.zeros(len(grp.variables))
                 for c, v in zip(cc, f_csr.data[f_csr.indptr[j] : f_csr.indptr[j + 1]], strict=True):
-                    row[where[int(c)]] += v
-                if np.max(np.abs(row @ grp.basis.T @ grp.basis - row)) > 1e-9 * max(
-                    1.0, float(np.max(np.abs(row)))
+                    crow[where[int(c)]] += v
+                if np.max(np.abs(crow @ grp.basis.T @ grp.basis - crow)) > 1e-9 * max(
+                    1.0, float(np.max(np.abs(crow)))
                 ):
                     continue
-                rows.append(j)
-                dense.append(row)
-            if rows:
-                assigned[rows] = True
-                cost_v = np.array(dense)
+                c_rows.append(j)
+                c_dense.append(crow)
+            if c_rows:
+                assigned[c_rows] = True
+                cost_v = np.array(c_dense)
                 groups[g] = dataclasses.replace(
                     grp,
-                    cost_rows=np.array(rows, dtype=np.int64),
+                    cost_rows=np.array(c_rows, dtype=np.int64),
                     cost_v=cost_v,
                     cost_f=cost_v @ grp.basis.T,
-                    cost_t=problem.cost_target[rows],
-                    cost_w=problem.cost_weight[rows],
+                    cost_t=problem.cost_target[c_rows],
+                    cost_w=problem.cost_weight[c_rows],
                 )
     return _Structure(
         problem=problem,
@@ -662,14 +663,19 @@ class _Templates:
 
 def _templates(s: _Structure, base: _Base) -> _Templates:
     col = base.col
-    groups, zcol, kk, nrows, has_cost, cdim = [], [], [], [], [], []
-    h = ([], [], [], [], [], [])
-    c = ([], [], [], [], [], [])
-    d = ([], [], [], [], [], [], [])
-    dp = ([], [], [], [])
-    dq = ([], [], [])
-    dconst = []
-    link = ([], [], [], [])
+    groups: list[int] = []
+    zcol: list[int] = []
+    kk: list[int] = []
+    nrows: list[int] = []
+    has_cost: list[bool] = []
+    cdim: list[int] = []
+    h: tuple[list[Any], ...] = ([], [], [], [], [], [])
+    c: tuple[list[Any], ...] = ([], [], [], [], [], [])
+    d: tuple[list[Any], ...] = ([], [], [], [], [], [], [])
+    dp: tuple[list[Any], ...] = ([], [], [], [])
+    dq: tuple[list[Any], ...] = ([], [], [])
+    dconst: list[float] = []
+    link: tuple[list[Any], ...] = ([], [], [], [])
     mi = 0
     for g, grp in enumerate(s.groups):
         k = grp.basis.shape[0]
