@@ -33,6 +33,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--time-limit-fast", type=float, default=60.0)
     ap.add_argument("--gap", type=float, default=1e-3)
     ap.add_argument("--fast-only", action="store_true", help="skip the direct model")
+    ap.add_argument("--fast-threads", type=int, default=2, help="fast planner worker processes")
     ap.add_argument("--json", type=Path, default=None, help="write every run here")
     args = ap.parse_args(argv)
 
@@ -49,6 +50,7 @@ def main(argv: list[str] | None = None) -> int:
         time_limit_fast=args.time_limit_fast,
         gap=args.gap,
         direct=not args.fast_only,
+        fast_threads=args.fast_threads,
         progress=progress,
     )
     print(format_table(rows))

@@ -157,6 +157,7 @@ def bench_plan(
     time_limit_fast: float = 60.0,
     gap: float = 1e-3,
     direct: bool = True,
+    fast_threads: int = 2,
     progress: Callable[[BenchRun], Any] | None = None,
 ) -> list[BenchRow]:
     """Run the direct model (SCIP) and the fast planner on the same instances.
@@ -170,6 +171,8 @@ def bench_plan(
         time_limit_direct, time_limit_fast: wall-time limits [s].
         gap: relative optimality gap of both.
         direct: also run the direct model (False: fast planner only).
+        fast_threads: worker processes of the fast planner (the direct model uses SCIP's single
+            thread, as in the issue's measurements).
         progress: called with every finished run.
 
     Returns:
@@ -183,11 +186,11 @@ def bench_plan(
             d_runs: list[BenchRun] = []
             f_runs: list[BenchRun] = []
             for scene in instances:
-                pairs = [("bnb", time_limit_fast, f_runs)]
+                pairs = [("bnb", time_limit_fast, fast_threads, f_runs)]
                 if direct:
-                    pairs.insert(0, ("scip", time_limit_direct, d_runs))
-                for solver, limit, sink in pairs:
-                    opts = PlannerOptions(time_limit=limit, gap=gap)
+                    pairs.insert(0, ("scip", time_limit_direct, 1, d_runs))
+                for solver, limit, threads, sink in pairs:
+                    opts = PlannerOptions(time_limit=limit, gap=gap, threads=threads)
                     run, _ = _run(scene, int(n), int(k), solver, opts)
                     sink.append(run)
                     if progress is not None:

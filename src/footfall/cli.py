@@ -197,6 +197,7 @@ def bench_plan_cmd(
     time_limit_fast: float = typer.Option(60.0, help="Time limit of the fast planner [s]."),
     gap: float = typer.Option(1e-3, help="Relative optimality gap of both."),
     fast_only: bool = typer.Option(False, help="Skip the direct model."),
+    fast_threads: int = typer.Option(2, help="Worker processes of the fast planner."),
     out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_plan.json/.md."),
 ) -> None:
     """Direct SCIP model vs the fast planner on the same instances: a table of times and gaps."""
@@ -224,6 +225,7 @@ def bench_plan_cmd(
         time_limit_fast=time_limit_fast,
         gap=gap,
         direct=not fast_only,
+        fast_threads=fast_threads,
         progress=lambda run: console.print(
             f"{run.instance} N={run.n_steps} K={run.n_nodes} {run.solver}: {run.status} "
             f"{run.time:.2f} s obj {run.objective:.6g}"

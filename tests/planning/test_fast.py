@@ -146,3 +146,13 @@ def test_unsupported_problem_falls_back_to_scip() -> None:
     assert "fallback" in res.stats
     assert res.status is SolveStatus.OPTIMAL
     assert res.objective == pytest.approx(0.0, abs=1e-6)
+
+
+def test_parallel_workers_find_the_same_optimum() -> None:
+    scene = random_stepping_stones(1, 8, robot=ROBOT)
+    fp = build_footstep_problem(scene, ROBOT, 8)
+    serial = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=1))
+    parallel = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=2))
+    assert serial.status is parallel.status is SolveStatus.OPTIMAL
+    assert parallel.objective == pytest.approx(serial.objective, rel=OBJ_RTOL)
+    assert parallel.stats["nodes"] > 1  # the search branched, so the workers were used

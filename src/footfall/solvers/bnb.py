@@ -1,36 +1,48 @@
 """Branch and bound on convex-hull relaxations, with Clarabel as the node solver.
 
 This backend solves the :class:`~footfall.solvers.problem.MIQCQP` exactly as built (same variables,
-rows, cones and objective), for problems of the shape the footstep planner builds (document 000,
-eq. 5.11-5.18):
+rows, cones, bounds and objective), for problems of the shape the footstep planner builds
+(document 000, eq. 5.11-5.18):
 
 * every integer variable is a binary and belongs to exactly one *choice group*: an equality row
   ``sum_{z in G} z = 1`` (one region per footstep, eq. 5.12j; one heading segment, eq. 5.12k);
-* every inequality row holds at most one binary ``z``, as a big-M row ``a^T x + M z <= b`` with
-  ``M > 0`` whose ``z = 0`` form ``a^T x <= b`` is implied by the variable bounds (rows built by
-  :meth:`ProblemBuilder.add_le_big_m`); it reads "z = 1 implies a^T x <= b - M";
-* binaries do not appear in the objective, the cones or other equality rows.
+* every inequality row holds no binary, only binaries (a valid inequality), or one binary ``z`` as a
+  big-M row ``a^T x + M z <= b`` (``M > 0``) whose ``z = 0`` form is implied by the variable bounds
+  (rows of :meth:`ProblemBuilder.add_le_big_m`): "z = 1 implies a^T x <= b - M";
+* binaries appear in no objective row, cone or other equality row.
 
-Relaxation (Balas' extended formulation of each disjunction). For a group ``G`` whose allowed
-members at a node are ``Z``, let ``V`` be the continuous variables of its indicator rows. Each member
-``z`` gets a copy ``y^z`` of ``x_V`` and
+Anything else raises :class:`UnsupportedProblem` in :func:`analyse`, and :func:`solve` hands the
+problem to SCIP (``stats["fallback"]``).
 
-    x_V = sum_{z in Z} y^z,   lb_V z <= y^z <= ub_V z,   a^T y^z <= (b - M) z  (rows of z),
+Relaxation of a node (each group ``G`` may use the members ``Z`` still allowed):
 
-with ``z`` in [0, 1] (the group row gives ``sum z = 1``). This is the convex hull of the union of
-the member sets intersected with the bounds, the tightest convex relaxation of each group, where
-big-M only gives its bounding box. Excluded members are fixed to 0; a group with one allowed
-member gets its rows on ``x`` directly. Everything else (dynamics, cones, objective) is kept as is,
-so a node whose relaxation has every group at a vertex (one ``z = 1``) is feasible for the MIQCQP and
-its value is exact.
+* Hull (Balas' extended formulation). The member rows of ``G`` are written over *forms*
+  ``f = B x_V`` (an orthonormal basis of their row space; for a heading segment: heading and the
+  two step components). Each member ``z`` gets a copy ``f^z`` and ``B x_V = sum_z f^z``,
+  ``a_f^T f^z <= beta z`` (its rows scaled by ``z``), ``z >= 0``; the group row gives ``sum z = 1``.
+  This is the convex hull of the union of the member sets, where big-M only gives a box. A group
+  with one allowed member gets its rows on ``x`` directly; excluded members are fixed to 0.
+  Variables private to a group's rows (the piecewise-linear sin/cos of eq. 5.12g-h) are removed by
+  Fourier-Motzkin elimination (the exact projection) and recovered from the chosen member.
+* Perspective. Objective rows that lie in one group's forms (the horizontal step-length terms of
+  eq. 5.11 in the heading-segment group) are charged ``sum_z w (C f^z - t z)^2 / z`` (rotated
+  second-order cones): equal at integral points, tighter in between.
+* Condensed dynamics. Variables that appear only in equality rows, the objective, their bounds and
+  cones (the ALIP states and torques) are eliminated: their optimal cost is a convex quadratic of
+  the rest, from one KKT solve. Dropping their bounds and cones keeps a lower bound; when a node's
+  recovered point violates one, the node is re-solved with the full model.
 
-Search: best-first on the relaxation bound; a node branches on its most fractional group by
-splitting the allowed members (in index order, which for heading segments is the angle order) where
-the cumulative weight crosses 1/2 (SOS1 branching); children are solved at once and pruned against
-the incumbent. Incumbents come from relaxation solutions that are already integral and from
-rounding (each group to its largest weight, then one convex solve). The search stops when
-``(incumbent - bound) / |incumbent| <= gap`` (SCIP's definition) or at the time limit, with the best
-plan and an honest gap.
+Every bound is ``min(primal, dual)`` of a Clarabel solve of a convex problem, so it is valid.
+
+Search: best-first on the bound. A relaxation point that satisfies the rows of one member of every
+group is a feasible point of the MIQCQP (the binaries are then set to those members), so the node
+is solved exactly even when the interior-point weights are spread. Otherwise the group whose nearest
+member is violated most is split where the cumulative weight of its members (in index order, the
+angle order for segments) crosses 1/2 (SOS1 branching). Incumbents come from such nodes, a dive
+from the root, and periodic rounding. With ``threads >= 2`` the children of the best open nodes are
+solved in parallel by forked workers. The search stops when ``(incumbent - bound) / min(|incumbent|,
+|bound|) <= gap`` (SCIP's definition) or at the time limit, returning the best point and an honest
+gap; a node whose solve fails numerically makes the result ``feasible`` at best, never ``optimal``.
 """
 
 from __future__ import annotations
@@ -60,6 +72,8 @@ INT_TOL = 1e-6
 FEAS_TOL = 1e-6
 #: the z = 0 form of a big-M row must be implied by the bounds within this
 REDUNDANT_TOL = 1e-7
+#: also bound every copy by the variable bounds (lb z <= f^z <= ub z); the member rows bound the
+#: footstep groups already, and without these rows node solves are about 20 % faster
 COPY_BOUNDS = False
 #: a member's indicator rows count as satisfied by a relaxation solution within this
 ROW_TOL = 1e-7
@@ -67,6 +81,13 @@ ROW_TOL = 1e-7
 ROUNDING_EVERY = 8
 #: dive from the root relaxation for an early incumbent
 DIVE = True
+#: drop members whose dual bound (node bound + multiplier of z >= 0) reaches the incumbent
+REDUCED_COST_FIXING = False
+#: branching group: "violation" (its nearest member is violated most), "fractional" (smallest
+#: largest weight) or "first" (lowest group index, i.e. step order)
+BRANCH_SELECT = "violation"
+#: split: "sos" (members in index order at the weighted mean) or "nearest" (one member vs rest)
+BRANCH_SPLIT = "sos"
 
 
 class UnsupportedProblem(ValueError):
@@ -391,6 +412,10 @@ class _Relaxation:
     bound: float = math.inf
     x: FloatArray | None = None
     iterations: int = 0
+    #: per variable, the multiplier of ``z >= 0`` for binaries with a choice at the node (else 0):
+    #: any solution of the node with ``z = 1`` costs at least ``bound + zdual[z]`` (the value of a
+    #: convex program is convex in the right-hand side; the multiplier is a subgradient)
+    zdual: FloatArray | None = None
 
 
 class _Coo:
@@ -832,6 +857,7 @@ class HullRelaxation:
         self.member_index = np.full(n, -1, dtype=np.int64)
         order = [z for grp in structure.groups for z in grp.members]
         self.member_index[order] = np.arange(len(order))
+        self.member_vars = np.array(order, dtype=np.int64)
         self.n_members = len(order)
         settings = clarabel.DefaultSettings()
         settings.verbose = False
@@ -972,7 +998,10 @@ class HullRelaxation:
             x[mapped] = xs[col[mapped]]
             if base is self.condensed:
                 self.recover(x)
-            return _Relaxation("solved", bound, x, int(sol.iterations))
+            zdual = np.zeros(pr.n)
+            lo = m_eq + t.m_le
+            zdual[self.member_vars[multi]] = np.maximum(np.asarray(sol.z)[lo : lo + nzm], 0.0)
+            return _Relaxation("solved", bound, x, int(sol.iterations), zdual)
         if status in ("PrimalInfeasible", "AlmostPrimalInfeasible"):
             return _Relaxation("infeasible", iterations=int(sol.iterations))
         return _Relaxation("failed", iterations=int(sol.iterations))
@@ -986,6 +1015,7 @@ class _Node:
     x: FloatArray | None = field(compare=False, default=None)
     depth: int = field(compare=False, default=0)
     full: bool = field(compare=False, default=False)
+    zdual: FloatArray | None = field(compare=False, default=None)
 
 
 def _weights(x: FloatArray, mem: tuple[int, ...]) -> FloatArray:
@@ -1024,6 +1054,16 @@ def _choice(
     return tuple(out)
 
 
+def _fix_by_duals(
+    allowed: tuple[tuple[int, ...], ...], member_bound: FloatArray, incumbent: float
+) -> tuple[tuple[int, ...], ...]:
+    """Drop the members whose bound with ``z = 1`` (``member_bound[z]``) reaches the incumbent."""
+    return tuple(
+        mem if len(mem) == 1 else tuple(z for z in mem if member_bound[z] < incumbent)
+        for mem in allowed
+    )
+
+
 def _rounded(x: FloatArray, allowed: tuple[tuple[int, ...], ...]) -> tuple[tuple[int, ...], ...]:
     return tuple(m if len(m) == 1 else (m[int(np.argmax(_weights(x, m)))],) for m in allowed)
 
@@ -1031,24 +1071,37 @@ def _rounded(x: FloatArray, allowed: tuple[tuple[int, ...], ...]) -> tuple[tuple
 def _branch(
     s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], tol: float
 ) -> tuple[tuple[tuple[int, ...], ...], tuple[tuple[int, ...], ...]] | None:
-    """Split the group whose best member is violated most, at the weighted mean member position."""
-    best, best_g = tol, -1
+    """Split a violated group (see ``BRANCH_SELECT``) into two halves (see ``BRANCH_SPLIT``)."""
+    best, best_g = -math.inf, -1
     for g, mem in enumerate(allowed):
         if len(mem) < 2:
             continue
-        viol = float(np.min(_violations(s, x, g, mem)))
-        if viol > best:
-            best, best_g = viol, g
+        viol = _violations(s, x, g, mem)
+        if float(np.min(viol)) <= tol:
+            continue
+        if BRANCH_SELECT == "violation":
+            score = float(np.min(viol))
+        elif BRANCH_SELECT == "fractional":
+            score = 1.0 - float(np.max(_weights(x, mem)))
+        else:  # "first"
+            score = -g
+        if score > best:
+            best, best_g = score, g
     if best_g < 0:
         return None
     mem = allowed[best_g]
     w = _weights(x, mem)
-    centre = float(np.dot(w, np.arange(len(mem)))) / max(float(np.sum(w)), 1e-12)
-    k = min(max(round(centre + 0.5), 1), len(mem) - 1)
+    if BRANCH_SPLIT == "sos":
+        centre = float(np.dot(w, np.arange(len(mem)))) / max(float(np.sum(w)), 1e-12)
+        k = min(max(round(centre + 0.5), 1), len(mem) - 1)
+        one, other = mem[:k], mem[k:]
+    else:  # "nearest": the least violated member against the rest
+        z = mem[int(np.argmin(_violations(s, x, best_g, mem)))]
+        one, other = (z,), tuple(m for m in mem if m != z)
     left = [*allowed]
     right = [*allowed]
-    left[best_g] = mem[:k]
-    right[best_g] = mem[k:]
+    left[best_g] = one
+    right[best_g] = other
     return tuple(left), tuple(right)
 
 
@@ -1105,6 +1158,33 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
     return search.run()
 
 
+_WORKER: HullRelaxation | None = None
+
+
+def _work(task: tuple[tuple[tuple[int, ...], ...], bool]) -> _Relaxation:
+    """Solve one node relaxation in a worker process (forked with the relaxation built)."""
+    assert _WORKER is not None
+    allowed, full = task
+    res = _WORKER.solve(allowed, full=full)
+    if res.status == "failed" and not full:
+        res = _WORKER.solve(allowed, full=True)
+    return res
+
+
+def _pool(relax: HullRelaxation, threads: int) -> Any:
+    """A pool of ``threads`` forked workers sharing ``relax`` (None for 1 thread or no fork)."""
+    import multiprocessing as mp
+
+    global _WORKER
+    if threads < 2 or "fork" not in mp.get_all_start_methods():
+        return None
+    _WORKER = relax
+    try:
+        return mp.get_context("fork").Pool(threads)
+    finally:
+        _WORKER = None
+
+
 class _Search:
     """State of one branch-and-bound run (see the module docstring)."""
 
@@ -1122,6 +1202,7 @@ class _Search:
         self.nodes = 0
         self.counter = 0
         self.failed = False
+        self.fixed_by_duals = 0
         self.trace: list[tuple[int, float, float, float]] = []
         if options.initial_solution is not None:
             x0 = np.asarray(options.initial_solution, dtype=float)
@@ -1199,10 +1280,17 @@ class _Search:
         return math.inf if denom == 0.0 else (self.inc_obj - bound) / denom
 
     def evaluate(
-        self, allowed: tuple[tuple[int, ...], ...], parent_bound: float, depth: int, full: bool
+        self,
+        allowed: tuple[tuple[int, ...], ...],
+        parent_bound: float,
+        depth: int,
+        full: bool,
+        res: _Relaxation | None = None,
     ) -> _Relaxation | None:
-        """Solve a node; keep it when it may hold a better plan than the incumbent."""
-        res = self.relax.solve(allowed, full=full)
+        """Solve a node (unless ``res`` holds its relaxation already); keep it when it may hold a
+        better plan than the incumbent."""
+        if res is None:
+            res = self.relax.solve(allowed, full=full)
         self.nodes += 1
         if res.status == "failed" and not full:
             res = self.relax.solve(allowed, full=True)  # numerical trouble: try the plain model
@@ -1224,7 +1312,9 @@ class _Search:
                 return self.evaluate(allowed, bound, depth, True)
             self.solve_fixed(chosen)
             return None
-        heapq.heappush(self.heap, _Node(bound, self.counter, allowed, res.x, depth, full))
+        heapq.heappush(
+            self.heap, _Node(bound, self.counter, allowed, res.x, depth, full, res.zdual)
+        )
         self.counter += 1
         if ROUNDING_EVERY and self.nodes % ROUNDING_EVERY == 0:
             self.solve_fixed(_rounded(res.x, allowed))
@@ -1238,6 +1328,18 @@ class _Search:
             root = self.evaluate(root_allowed, -math.inf, 0, False)
             if root is not None and root.x is not None and DIVE:
                 self.dive(root.x, root_allowed)
+        pool = _pool(self.relax, self.options.threads) if self.heap else None
+        try:
+            timed_out = self._loop(pool)
+        finally:
+            if pool is not None:
+                pool.terminate()
+        return self.result(timed_out)
+
+    def _loop(self, pool: Any) -> bool:
+        """The best-first loop; returns True when stopped by the time limit. With a ``pool``, the
+        children of the best ``threads`` open nodes are solved in parallel."""
+        batch = 1 if pool is None else self.options.threads
         while self.heap:
             top = self.heap[0].bound
             if not self.trace or self.nodes >= self.trace[-1][0] + 25:
@@ -1245,18 +1347,31 @@ class _Search:
             if self.gap_of(top) <= self.options.gap:
                 break
             if time.perf_counter() > self.deadline:
-                timed_out = True
-                break
-            node = heapq.heappop(self.heap)
-            if node.bound >= self.inc_obj:
-                continue
-            assert node.x is not None
-            split = _branch(self.s, node.x, node.allowed, ROW_TOL)
-            if split is None:  # pragma: no cover - evaluate() resolved such nodes
-                continue
-            for child in split:
-                self.evaluate(child, node.bound, node.depth + 1, node.full)
-        return self.result(timed_out)
+                return True
+            tasks: list[tuple[tuple[tuple[int, ...], ...], _Node]] = []
+            while self.heap and len(tasks) < 2 * batch:
+                node = heapq.heappop(self.heap)
+                if node.bound >= self.inc_obj:
+                    continue
+                assert node.x is not None
+                allowed = node.allowed
+                if REDUCED_COST_FIXING and node.zdual is not None and math.isfinite(self.inc_obj):
+                    allowed = _fix_by_duals(allowed, node.bound + node.zdual, self.inc_obj)
+                    if not all(allowed):
+                        continue  # every member of some group is worse than the incumbent
+                    self.fixed_by_duals += sum(map(len, node.allowed)) - sum(map(len, allowed))
+                split = _branch(self.s, node.x, allowed, ROW_TOL)
+                if split is None:  # pragma: no cover - evaluate() resolved such nodes
+                    continue
+                tasks.extend((child, node) for child in split)
+            if pool is None:
+                for child, node in tasks:
+                    self.evaluate(child, node.bound, node.depth + 1, node.full)
+            else:
+                results = pool.map(_work, [(child, node.full) for child, node in tasks])
+                for (child, node), res in zip(tasks, results, strict=True):
+                    self.evaluate(child, node.bound, node.depth + 1, node.full, res)
+        return False
 
     def result(self, timed_out: bool) -> SolverResult:
         """The :class:`SolverResult` of the search so far."""
@@ -1296,6 +1411,7 @@ class _Search:
                 "groups": len(self.s.groups),
                 "members": self.relax.n_members,
                 "condensed": self.relax.condensed is not None,
+                "fixed_by_duals": self.fixed_by_duals,
                 "trace": self.trace,
             },
         )
