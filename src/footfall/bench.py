@@ -99,12 +99,22 @@ class BenchRow:
         return (d_med / f_med if f_med > 0 else math.inf), lower
 
     def disagreements(self) -> list[str]:
-        """Instances where both proved optimality but the objectives differ beyond the gaps."""
+        """Instances where the two runs contradict each other beyond the gaps: both optimal with
+        different objectives, a fast optimum outside a time-limited direct run's [bound,
+        incumbent], or one infeasible where the other found a plan."""
         out = []
         for d, f in zip(self.direct, self.fast, strict=True):
             if d.status == f.status == SolveStatus.OPTIMAL.value:
                 tol = max(d.gap, f.gap, 0.0) + AGREE_SLACK
                 if abs(d.objective - f.objective) > tol * max(abs(d.objective), 1e-12) + 1e-9:
+                    out.append(d.instance)
+            elif f.status == SolveStatus.OPTIMAL.value and math.isfinite(d.objective):
+                # a time-limited direct run brackets the optimum: bound <= optimum <= incumbent
+                tol = max(f.gap, 0.0) + AGREE_SLACK
+                scale = max(abs(f.objective), 1e-12)
+                if f.objective > d.objective + tol * scale or (
+                    math.isfinite(d.bound) and f.objective < d.bound - tol * scale
+                ):
                     out.append(d.instance)
             elif d.status == SolveStatus.INFEASIBLE.value or f.status == "infeasible":
                 if d.status != f.status and d.status != SolveStatus.TIME_LIMIT.value:
@@ -217,8 +227,11 @@ def _fmt_obj(runs: tuple[BenchRun, ...]) -> str:
 
 
 def _fmt_gap(runs: tuple[BenchRun, ...]) -> str:
-    gaps = [r.gap for r in runs]
-    worst = max(gaps) if gaps else math.nan
+    """Worst gap over the runs that returned a plan (infeasible ones have none)."""
+    gaps = [r.gap for r in runs if math.isfinite(r.objective)]
+    if not gaps:
+        return "-"
+    worst = max(gaps)
     return "inf" if math.isinf(worst) else f"{worst:.1e}"
 
 
@@ -261,7 +274,12 @@ def format_table(rows: Sequence[BenchRow]) -> str:
     ]
     lines.append("")
     lines.append(
-        "objective agreement (both optimal, within the gap): "
+        "times: median / max over the instances; gap: worst over the runs with a plan; objective:"
+        " median over the runs with a plan (a time-limited direct run reports its incumbent)"
+    )
+    lines.append(
+        "objective agreement (both optimal: equal within the gap; direct time-limited: the fast"
+        " optimum lies between the direct bound and incumbent): "
         + ("all agree" if not bad else f"DISAGREE on {bad}")
     )
     lines.append(
@@ -273,3 +291,19 @@ def format_table(rows: Sequence[BenchRow]) -> str:
 def rows_to_dict(rows: Sequence[BenchRow]) -> list[dict[str, Any]]:
     """JSON-ready form of the runs."""
     return [dataclasses.asdict(run) for row in rows for run in (*row.direct, *row.fast)]
+
+
+def rows_from_dict(runs: Sequence[dict[str, Any]]) -> list[BenchRow]:
+    """Rebuild the table rows from :func:`rows_to_dict` output (to re-print a saved run)."""
+    keyed: dict[tuple[int, int], list[BenchRun]] = {}
+    for d in runs:
+        run = BenchRun(**d)
+        keyed.setdefault((run.n_steps, run.n_nodes), []).append(run)
+    out = []
+    for (n, k), group in keyed.items():
+        direct = tuple(r for r in group if r.solver != "bnb")
+        fast = tuple(r for r in group if r.solver == "bnb")
+        counts = [r.regions for r in fast]
+        lo, hi = min(counts), max(counts)
+        out.append(BenchRow(n, k, str(lo) if lo == hi else f"{lo}-{hi}", len(fast), direct, fast))
+    return out

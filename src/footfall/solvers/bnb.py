@@ -1202,6 +1202,7 @@ class _Search:
         self.nodes = 0
         self.counter = 0
         self.failed = False
+        self.lost_bound = math.inf
         self.fixed_by_duals = 0
         self.trace: list[tuple[int, float, float, float]] = []
         if options.initial_solution is not None:
@@ -1296,7 +1297,9 @@ class _Search:
             res = self.relax.solve(allowed, full=True)  # numerical trouble: try the plain model
             full = True
         if res.status == "failed":
+            # unsolved node: its parent's bound stays in the reported bound (an honest gap)
             self.failed = True
+            self.lost_bound = min(self.lost_bound, parent_bound)
             return None
         if res.status != "solved" or res.x is None:
             return None
@@ -1376,7 +1379,8 @@ class _Search:
     def result(self, timed_out: bool) -> SolverResult:
         """The :class:`SolverResult` of the search so far."""
         open_bounds = [nd.bound for nd in self.heap if nd.bound < self.inc_obj]
-        best_bound = min(open_bounds, default=self.inc_obj)
+        best_bound = min([*open_bounds, self.lost_bound], default=self.inc_obj)
+        best_bound = min(best_bound, self.inc_obj)
         if self.incumbent is None:
             if timed_out:
                 status = SolveStatus.TIME_LIMIT
