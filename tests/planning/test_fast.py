@@ -156,3 +156,28 @@ def test_parallel_workers_find_the_same_optimum() -> None:
     assert serial.status is parallel.status is SolveStatus.OPTIMAL
     assert parallel.objective == pytest.approx(serial.objective, rel=OBJ_RTOL)
     assert parallel.stats["nodes"] > 1  # the search branched, so the workers were used
+
+
+def test_bench_plan_cli_writes_the_table(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    import json
+    import subprocess
+    import sys
+
+    res = subprocess.run(
+        [sys.executable, "-m", "footfall", "bench", "plan", "--steps", "5", "--nodes", "3",
+         "--seeds", "0", "--regions", "5", "--out", str(tmp_path)],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    runs = json.loads((tmp_path / "bench_plan.json").read_text())["runs"]
+    assert {r["solver"] for r in runs} == {"scip", "bnb"}
+    assert all(r["status"] == "optimal" and r["check_ok"] for r in runs)
+    objs = [r["objective"] for r in runs]
+    assert objs[0] == pytest.approx(objs[1], rel=2e-3)  # both within the bench's gap of 1e-3
+    table = (tmp_path / "bench_plan.md").read_text()
+    assert "| 5 | 3 | 5 | 1 |" in table and "all agree" in table and "all plans pass" in table
+    bad = subprocess.run(
+        [sys.executable, "-m", "footfall", "bench", "plan", "--steps", "0"],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert bad.returncode == 2 and "steps" in bad.stderr
