@@ -1204,7 +1204,8 @@ class _Search:
         self.failed = False
         self.lost_bound = math.inf
         self.fixed_by_duals = 0
-        self.trace: list[tuple[int, float, float, float]] = []
+        #: (nodes, seconds, incumbent or None, best bound) every 25 nodes
+        self.trace: list[tuple[int, float, float | None, float]] = []
         if options.initial_solution is not None:
             x0 = np.asarray(options.initial_solution, dtype=float)
             if x0.shape == (self.problem.n,):
@@ -1346,7 +1347,8 @@ class _Search:
         while self.heap:
             top = self.heap[0].bound
             if not self.trace or self.nodes >= self.trace[-1][0] + 25:
-                self.trace.append((self.nodes, time.perf_counter() - self.start, self.inc_obj, top))
+                inc = self.inc_obj if math.isfinite(self.inc_obj) else None  # JSON-safe
+                self.trace.append((self.nodes, time.perf_counter() - self.start, inc, top))
             if self.gap_of(top) <= self.options.gap:
                 break
             if time.perf_counter() > self.deadline:
