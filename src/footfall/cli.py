@@ -684,3 +684,60 @@ def walk_cmd(
     console.print(f"wrote {out / 'walk.json'}, walk.png" + (", walk.mp4" if res.video else ""))
     if m["fell"] or not m["reached_goal"]:
         raise typer.Exit(1)
+
+
+# --- bench (issue 5) ---
+bench_app = typer.Typer(help="Benchmarks.", no_args_is_help=True)
+app.add_typer(bench_app, name="bench")
+
+
+@bench_app.command("plan")
+def bench_plan_cmd(
+    steps: str = typer.Option("6,10,15", help="Numbers of footsteps N, comma separated."),
+    nodes: str = typer.Option("5,10", help="Numbers of ALIP nodes K, comma separated."),
+    seeds: str = typer.Option("0,1,2", help="Seeds of the random stepping-stone scenes."),
+    regions: int = typer.Option(8, help="Regions per random scene."),
+    scenes: str = typer.Option("", help="Built-in scenes to add, comma separated."),
+    time_limit_direct: float = typer.Option(60.0, help="Time limit of the direct SCIP model [s]."),
+    time_limit_fast: float = typer.Option(60.0, help="Time limit of the fast planner [s]."),
+    gap: float = typer.Option(1e-3, help="Relative optimality gap of both."),
+    fast_only: bool = typer.Option(False, help="Skip the direct model."),
+    fast_threads: int = typer.Option(2, help="Worker processes of the fast planner."),
+    out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_plan.json/.md."),
+) -> None:
+    """Direct SCIP model vs the fast planner on the same instances: a table of times and gaps."""
+    from footfall.bench import bench_plan, format_table, rows_to_dict
+
+    def ints(field: str, text: str) -> list[int]:
+        vals = parse_floats(field, text)
+        if not vals or any(v != int(v) or v < 1 for v in vals):
+            raise InputError(field, text, "comma-separated positive integers, e.g. 6,10")
+        return [int(v) for v in vals]
+
+    def ints0(field: str, text: str) -> list[int]:
+        vals = parse_floats(field, text)
+        if not vals or any(v != int(v) or v < 0 for v in vals):
+            raise InputError(field, text, "comma-separated integers >= 0, e.g. 0,1,2")
+        return [int(v) for v in vals]
+
+    rows = bench_plan(
+        n_steps=ints("steps", steps),
+        n_nodes=ints("nodes", nodes),
+        seeds=ints0("seeds", seeds),
+        n_regions=regions,
+        scenes=[s for s in scenes.split(",") if s.strip()],
+        time_limit_direct=time_limit_direct,
+        time_limit_fast=time_limit_fast,
+        gap=gap,
+        direct=not fast_only,
+        fast_threads=fast_threads,
+        progress=lambda run: console.print(
+            f"{run.instance} N={run.n_steps} K={run.n_nodes} {run.solver}: {run.status} "
+            f"{run.time:.2f} s obj {run.objective:.6g}"
+        ),
+    )
+    table = format_table(rows)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(out / "bench_plan.json", {"runs": rows_to_dict(rows)})
+    (out / "bench_plan.md").write_text(table + "\n")
+    print(table)

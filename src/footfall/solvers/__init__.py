@@ -1,7 +1,10 @@
 """Optimisation backends behind one interface: build a :class:`MIQCQP`, then :func:`solve` it.
 
 Backends register themselves when their Python package imports: ``scip`` (PySCIPOpt, the default,
-installed with footfall) and ``gurobi`` (optional: ``pip install "footfall[gurobi]"`` and a licence).
+installed with footfall), ``bnb`` (footfall's own branch and bound on convex-hull relaxations with
+Clarabel node solves, installed with footfall; fast on the footstep planner's problems, see
+:mod:`footfall.solvers.bnb`) and ``gurobi`` (optional: ``pip install "footfall[gurobi]"`` and a
+licence).
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ from footfall.solvers.problem import MIQCQP, ProblemBuilder
 KNOWN_BACKENDS = {
     "scip": ("pyscipopt", "pip install pyscipopt (installed with footfall by default)"),
     "gurobi": ("gurobipy", 'pip install "footfall[gurobi]" and a Gurobi licence'),
+    "bnb": ("clarabel", "pip install clarabel (installed with footfall by default)"),
 }
 DEFAULT_SOLVER = "scip"
 
@@ -38,6 +42,10 @@ def _backend(name: str) -> Callable[[MIQCQP, SolverOptions], SolverResult]:
         from footfall.solvers import scip
 
         return scip.solve
+    if name == "bnb":
+        from footfall.solvers import bnb
+
+        return bnb.solve
     from footfall.solvers import gurobi
 
     return gurobi.solve

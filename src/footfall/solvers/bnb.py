@@ -1,0 +1,1423 @@
+"""Branch and bound on convex-hull relaxations, with Clarabel as the node solver.
+
+This backend solves the :class:`~footfall.solvers.problem.MIQCQP` exactly as built (same variables,
+rows, cones, bounds and objective), for problems of the shape the footstep planner builds
+(document 000, eq. 5.11-5.18):
+
+* every integer variable is a binary and belongs to exactly one *choice group*: an equality row
+  ``sum_{z in G} z = 1`` (one region per footstep, eq. 5.12j; one heading segment, eq. 5.12k);
+* every inequality row holds no binary, only binaries (a valid inequality), or one binary ``z`` as a
+  big-M row ``a^T x + M z <= b`` (``M > 0``) whose ``z = 0`` form is implied by the variable bounds
+  (rows of :meth:`ProblemBuilder.add_le_big_m`): "z = 1 implies a^T x <= b - M";
+* binaries appear in no objective row, cone or other equality row.
+
+Anything else raises :class:`UnsupportedProblem` in :func:`analyse`, and :func:`solve` hands the
+problem to SCIP (``stats["fallback"]``).
+
+Relaxation of a node (each group ``G`` may use the members ``Z`` still allowed):
+
+* Hull (Balas' extended formulation). The member rows of ``G`` are written over *forms*
+  ``f = B x_V`` (an orthonormal basis of their row space; for a heading segment: heading and the
+  two step components). Each member ``z`` gets a copy ``f^z`` and ``B x_V = sum_z f^z``,
+  ``a_f^T f^z <= beta z`` (its rows scaled by ``z``), ``z >= 0``; the group row gives ``sum z = 1``.
+  This is the convex hull of the union of the member sets, where big-M only gives a box. A group
+  with one allowed member gets its rows on ``x`` directly; excluded members are fixed to 0.
+  Variables private to a group's rows (the piecewise-linear sin/cos of eq. 5.12g-h) are removed by
+  Fourier-Motzkin elimination (the exact projection) and recovered from the chosen member.
+* Perspective. Objective rows that lie in one group's forms (the horizontal step-length terms of
+  eq. 5.11 in the heading-segment group) are charged ``sum_z w (C f^z - t z)^2 / z`` (rotated
+  second-order cones): equal at integral points, tighter in between.
+* Condensed dynamics. Variables that appear only in equality rows, the objective, their bounds and
+  cones (the ALIP states and torques) are eliminated: their optimal cost is a convex quadratic of
+  the rest, from one KKT solve. Dropping their bounds and cones keeps a lower bound; when a node's
+  recovered point violates one, the node is re-solved with the full model.
+
+Every bound is ``min(primal, dual)`` of a Clarabel solve of a convex problem, so it is valid.
+
+Search: best-first on the bound. A relaxation point that satisfies the rows of one member of every
+group is a feasible point of the MIQCQP (the binaries are then set to those members), so the node
+is solved exactly even when the interior-point weights are spread. Otherwise the group whose nearest
+member is violated most is split where the cumulative weight of its members (in index order, the
+angle order for segments) crosses 1/2 (SOS1 branching). Incumbents come from such nodes, a dive
+from the root, and periodic rounding. With ``threads >= 2`` the children of the best open nodes are
+solved in parallel by forked workers. The search stops when ``(incumbent - bound) / min(|incumbent|,
+|bound|) <= gap`` (SCIP's definition) or at the time limit, returning the best point and an honest
+gap; a node whose solve fails numerically makes the result ``feasible`` at best, never ``optimal``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import heapq
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import NDArray
+
+from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
+from footfall.solvers.problem import MIQCQP
+
+NAME = "bnb"
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+#: a relaxation weight within this of 0 or 1 counts as integral
+INT_TOL = 1e-6
+#: largest violation [problem units] accepted for a solution returned to the caller
+FEAS_TOL = 1e-6
+#: the z = 0 form of a big-M row must be implied by the bounds within this
+REDUNDANT_TOL = 1e-7
+#: also bound every copy by the variable bounds (lb z <= f^z <= ub z); the member rows bound the
+#: footstep groups already, and without these rows node solves are about 20 % faster
+COPY_BOUNDS = False
+#: a member's indicator rows count as satisfied by a relaxation solution within this
+ROW_TOL = 1e-7
+#: try rounding the relaxation solution to an incumbent at every this many nodes (0: never)
+ROUNDING_EVERY = 8
+#: dive from the root relaxation for an early incumbent
+DIVE = True
+#: drop members whose dual bound (node bound + multiplier of z >= 0) reaches the incumbent
+REDUCED_COST_FIXING = False
+#: branching group: "violation" (its nearest member is violated most), "fractional" (smallest
+#: largest weight) or "first" (lowest group index, i.e. step order)
+BRANCH_SELECT = "violation"
+#: split: "sos" (members in index order at the weighted mean) or "nearest" (one member vs rest)
+BRANCH_SPLIT = "sos"
+
+
+class UnsupportedProblem(ValueError):
+    """The problem does not have the choice-group / big-M shape this backend handles."""
+
+
+@dataclass(frozen=True)
+class _Member:
+    """Indicator rows of one binary: ``a^T x <= beta`` when the binary is 1.
+
+    Attributes:
+        var: the binary's index.
+        a_v: rows over the group's variables ``V`` (private variables eliminated), (m, |V|).
+        a_f: the same rows over the group's forms ``f = B x_V``, (m, k).
+        beta: right-hand sides, (m,).
+        orig: the original rows ``(columns, coefficients, rhs)``, to recover private variables.
+    """
+
+    var: int
+    a_v: FloatArray
+    a_f: FloatArray
+    beta: FloatArray
+    orig: tuple[tuple[IntArray, FloatArray, float], ...]
+
+
+@dataclass(frozen=True)
+class _Group:
+    """A choice group ``sum_{z in members} z = 1``.
+
+    Attributes:
+        members: binary variable indices, ascending.
+        variables: ``V``, the continuous variables of the members' rows (private ones removed).
+        basis: ``B`` (k, |V|), orthonormal basis of the row space of every member row over ``V``;
+            the relaxation copies the k forms ``B x_V`` instead of ``x_V``.
+        f_lb, f_ub: bounds of the forms over the variable bounds, (k,).
+        private: variables that appear in this group's rows and nowhere else but their bounds;
+            they are eliminated (Fourier-Motzkin) and recovered from the chosen member.
+        cost_rows: objective rows ``w (F x - t)^2`` that lie in the span of the group's forms
+            (e.g. the horizontal step-length terms of eq. 5.11 in a heading-segment group); the
+            relaxation charges them in perspective form (see :class:`HullRelaxation`).
+        cost_v, cost_f: those rows over ``V`` (m, |V|) and over the forms (m, k).
+        cost_t, cost_w: their targets and weights, (m,).
+    """
+
+    members: tuple[int, ...]
+    variables: IntArray
+    basis: FloatArray
+    f_lb: FloatArray
+    f_ub: FloatArray
+    private: IntArray
+    cost_rows: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    cost_v: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
+    cost_f: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
+    cost_t: FloatArray = field(default_factory=lambda: np.zeros(0))
+    cost_w: FloatArray = field(default_factory=lambda: np.zeros(0))
+
+
+@dataclass
+class _Structure:
+    """The problem split into its static convex part and its choice groups."""
+
+    problem: MIQCQP
+    groups: list[_Group]
+    member: dict[int, _Member]
+    group_of: dict[int, int]
+    plain_le: sp.csr_matrix
+    plain_b: FloatArray
+    assigned: NDArray[np.bool_]  # cost rows charged in perspective form by a group
+
+
+#: eliminate a private variable only when Fourier-Motzkin makes at most this many rows per member
+MAX_FM_ROWS = 8
+#: singular values below this (relative) do not count in a group's row space
+RANK_TOL = 1e-10
+
+
+def _eliminate(
+    rows: list[tuple[dict[int, float], float]], v: int, lb: float, ub: float
+) -> list[tuple[dict[int, float], float]] | None:
+    """Fourier-Motzkin elimination of ``v`` from ``rows`` (each ``sum coef x <= rhs``) given
+    ``lb <= v <= ub``: the exact projection. None when it would make too many rows."""
+    upper = [(r, b) for r, b in rows if r.get(v, 0.0) > 0.0]
+    lower = [(r, b) for r, b in rows if r.get(v, 0.0) < 0.0]
+    rest = [(r, b) for r, b in rows if r.get(v, 0.0) == 0.0]
+    if len(upper) * len(lower) + len(upper) + len(lower) > MAX_FM_ROWS:
+        return None
+    out = list(rest)
+    for r, b in upper:  # v <= (b - r x)/a and v >= lb
+        a = r[v]
+        out.append(({k: c for k, c in r.items() if k != v}, b - a * lb))
+    for r, b in lower:  # v >= (b - r x)/a and v <= ub
+        a = r[v]
+        out.append(({k: c for k, c in r.items() if k != v}, b - a * ub))
+    for ru, bu in upper:
+        for rl, bl in lower:
+            au, al = ru[v], -rl[v]
+            comb: dict[int, float] = {}
+            for k, c in ru.items():
+                if k != v:
+                    comb[k] = comb.get(k, 0.0) + c / au
+            for k, c in rl.items():
+                if k != v:
+                    comb[k] = comb.get(k, 0.0) + c / al
+            out.append((comb, bu / au + bl / al))
+    return out
+
+
+def _drop_redundant(
+    a_v: FloatArray, beta: FloatArray, lb: FloatArray, ub: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Remove rows implied by the box that the bounds and the single-variable rows define.
+
+    Single-variable rows are kept (they bound the member's copies). Removing implied rows leaves
+    the member's set unchanged.
+    """
+    if not len(beta):
+        return a_v, beta
+    lo, hi = lb.copy(), ub.copy()
+    nnz = np.count_nonzero(a_v, axis=1)
+    for j in np.flatnonzero(nnz == 1):
+        c = int(np.flatnonzero(a_v[j])[0])
+        v = a_v[j, c]
+        if v > 0:
+            hi[c] = min(hi[c], beta[j] / v)
+        else:
+            lo[c] = max(lo[c], beta[j] / v)
+    top = np.sum(np.maximum(a_v * lo, a_v * hi), axis=1)
+    keep = (nnz == 1) | ~(top <= beta - REDUNDANT_TOL * np.maximum(1.0, np.abs(beta)))
+    keep &= nnz > 0
+    # a row with no variables left is kept only if it is violated (the member is impossible)
+    empty = (nnz == 0) & (beta < -REDUNDANT_TOL)
+    keep |= empty
+    return a_v[keep], beta[keep]
+
+
+def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
+    """Split ``problem`` into choice groups and indicator rows; raise :class:`UnsupportedProblem`.
+
+    With ``perspective``, objective rows within one group's forms are assigned to that group.
+    """
+    n = problem.n
+    integer = problem.integer
+    if np.any(integer & ((problem.lb < 0.0) | (problem.ub > 1.0))):
+        raise UnsupportedProblem("integer variables must be binaries")
+    a_eq = problem.a_eq.tocsr()
+    groups: list[_Group] = []
+    group_of: dict[int, int] = {}
+    group_rows: list[list[int]] = []
+    for r in range(a_eq.shape[0]):
+        cols = a_eq.indices[a_eq.indptr[r] : a_eq.indptr[r + 1]]
+        vals = a_eq.data[a_eq.indptr[r] : a_eq.indptr[r + 1]]
+        ints = integer[cols]
+        if not np.any(ints):
+            continue
+        if not (np.all(ints) and np.allclose(vals, 1.0) and abs(problem.b_eq[r] - 1.0) < 1e-12):
+            raise UnsupportedProblem(f"equality row {problem.eq_labels[r]!r} mixes binaries")
+        for c in cols:
+            if int(c) in group_of:
+                raise UnsupportedProblem(f"binary {problem.names[c]} is in two choice groups")
+            group_of[int(c)] = len(group_rows)
+        group_rows.append(sorted(int(c) for c in cols))
+    for c in np.flatnonzero(integer):
+        if int(c) not in group_of:
+            raise UnsupportedProblem(f"binary {problem.names[c]} is in no choice group")
+    for mat, what in ((problem.cost_matrix, "objective"),):
+        if mat.shape[0] and np.any(integer[mat.tocsr().indices]):
+            raise UnsupportedProblem(f"binaries in the {what}")
+    for idx, _ in problem.cones:
+        if np.any(integer[idx]):
+            raise UnsupportedProblem("binaries in a cone")
+
+    a_le = problem.a_le.tocsr()
+    plain: list[int] = []
+    ind_rows: dict[int, list[tuple[IntArray, FloatArray, float]]] = {}
+    for r in range(a_le.shape[0]):
+        cols = a_le.indices[a_le.indptr[r] : a_le.indptr[r + 1]]
+        vals = a_le.data[a_le.indptr[r] : a_le.indptr[r + 1]]
+        ints = integer[cols]
+        k = int(np.count_nonzero(ints))
+        if k == 0 or k == len(cols):  # continuous rows, or valid inequalities on binaries only
+            plain.append(r)
+            continue
+        if k > 1 or vals[ints][0] <= 0.0:
+            raise UnsupportedProblem(f"row {problem.le_labels[r]!r} is not a big-M row")
+        z = int(cols[ints][0])
+        big_m = float(vals[ints][0])
+        cc, vv = cols[~ints].astype(np.int64), vals[~ints].astype(float)
+        top = float(np.sum(np.where(vv > 0, vv * problem.ub[cc], vv * problem.lb[cc])))
+        if not math.isfinite(top) or top > problem.b_le[r] + REDUNDANT_TOL * max(1.0, abs(top)):
+            raise UnsupportedProblem(f"row {problem.le_labels[r]!r}: its z = 0 form is not implied")
+        ind_rows.setdefault(z, []).append((cc, vv, float(problem.b_le[r]) - big_m))
+
+    # Where each continuous variable appears outside the indicator rows.
+    used = np.zeros(n, dtype=bool)
+    used[problem.cost_matrix.tocsr().indices] = True
+    used[a_eq.indices] = True
+    used[a_le[plain].indices] = True
+    for idx, _ in problem.cones:
+        used[idx] = True
+    owner: dict[int, set[int]] = {}
+    for g, mem in enumerate(group_rows):
+        for z in mem:
+            for cc, _, _ in ind_rows.get(z, []):
+                for c in cc:
+                    owner.setdefault(int(c), set()).add(g)
+
+    member: dict[int, _Member] = {}
+    for g, mem in enumerate(group_rows):
+        rows_of = {
+            z: [
+                (dict(zip(cc.tolist(), vv.tolist(), strict=True)), bb)
+                for cc, vv, bb in ind_rows.get(z, [])
+            ]
+            for z in mem
+        }
+        cols_all = sorted({int(c) for z in mem for cc, _, _ in ind_rows.get(z, []) for c in cc})
+        private: list[int] = []
+        for c in cols_all:
+            if used[c] or owner[c] != {g}:
+                continue
+            reduced = {z: _eliminate(rows_of[z], c, problem.lb[c], problem.ub[c]) for z in mem}
+            if any(r is None for r in reduced.values()):
+                continue
+            rows_of = {z: r for z, r in reduced.items() if r is not None}
+            private.append(c)
+        variables = np.array([c for c in cols_all if c not in private], dtype=np.int64)
+        for c in variables:
+            if not (math.isfinite(problem.lb[c]) and math.isfinite(problem.ub[c])):
+                raise UnsupportedProblem(f"{problem.names[c]} is in an indicator row but unbounded")
+        where = {int(c): k for k, c in enumerate(variables)}
+        dense: dict[int, tuple[FloatArray, FloatArray]] = {}
+        for z in mem:
+            a_v = np.zeros((len(rows_of[z]), len(variables)))
+            beta = np.zeros(len(rows_of[z]))
+            for j, (row, rhs) in enumerate(rows_of[z]):
+                for c, v in row.items():
+                    a_v[j, where[c]] += v
+                beta[j] = rhs
+            dense[z] = _drop_redundant(a_v, beta, problem.lb[variables], problem.ub[variables])
+        stacked = np.vstack([dense[z][0] for z in mem] + [np.zeros((0, len(variables)))])
+        if stacked.shape[0] and len(variables):
+            _, sv, vt = np.linalg.svd(stacked, full_matrices=False)
+            k = int(np.count_nonzero(sv > RANK_TOL * max(float(sv[0]), 1e-300)))
+            basis = vt[:k]
+        else:
+            basis = np.zeros((0, len(variables)))
+        lbv, ubv = problem.lb[variables], problem.ub[variables]
+        f_lb = np.sum(np.minimum(basis * lbv, basis * ubv), axis=1)
+        f_ub = np.sum(np.maximum(basis * lbv, basis * ubv), axis=1)
+        for z in mem:
+            a_v, beta = dense[z]
+            a_f = a_v @ basis.T
+            if a_v.size and float(np.max(np.abs(a_f @ basis - a_v))) > 1e-9 * max(
+                1.0, float(np.max(np.abs(a_v)))
+            ):
+                raise UnsupportedProblem(
+                    "indicator rows are not in their row space"
+                )  # pragma: no cover
+            member[z] = _Member(var=z, a_v=a_v, a_f=a_f, beta=beta, orig=tuple(ind_rows.get(z, [])))
+        groups.append(
+            _Group(
+                members=tuple(mem),
+                variables=variables,
+                basis=basis,
+                f_lb=f_lb,
+                f_ub=f_ub,
+                private=np.array(private, dtype=np.int64),
+            )
+        )
+
+    assigned = np.zeros(problem.cost_matrix.shape[0], dtype=bool)
+    if perspective:
+        f_csr = problem.cost_matrix.tocsr()
+        for g, grp in enumerate(groups):
+            if grp.basis.shape[0] == 0 or len(grp.members) < 2:
+                continue
+            where = {int(c): k for k, c in enumerate(grp.variables)}
+            c_rows: list[int] = []
+            c_dense: list[FloatArray] = []
+            for j in range(f_csr.shape[0]):
+                if assigned[j]:
+                    continue
+                cc = f_csr.indices[f_csr.indptr[j] : f_csr.indptr[j + 1]]
+                if not all(int(c) in where for c in cc):
+                    continue
+                crow = np.zeros(len(grp.variables))
+                for c, v in zip(cc, f_csr.data[f_csr.indptr[j] : f_csr.indptr[j + 1]], strict=True):
+                    crow[where[int(c)]] += v
+                if np.max(np.abs(crow @ grp.basis.T @ grp.basis - crow)) > 1e-9 * max(
+                    1.0, float(np.max(np.abs(crow)))
+                ):
+                    continue
+                c_rows.append(j)
+                c_dense.append(crow)
+            if c_rows:
+                assigned[c_rows] = True
+                cost_v = np.array(c_dense)
+                groups[g] = dataclasses.replace(
+                    grp,
+                    cost_rows=np.array(c_rows, dtype=np.int64),
+                    cost_v=cost_v,
+                    cost_f=cost_v @ grp.basis.T,
+                    cost_t=problem.cost_target[c_rows],
+                    cost_w=problem.cost_weight[c_rows],
+                )
+    return _Structure(
+        problem=problem,
+        groups=groups,
+        member=member,
+        group_of=group_of,
+        plain_le=a_le[plain],
+        plain_b=problem.b_le[plain],
+        assigned=assigned,
+    )
+
+
+@dataclass
+class _Relaxation:
+    """Result of one node relaxation: ``x`` holds the original variables (condensed ones recovered)."""
+
+    status: str  # "solved", "infeasible", "failed"
+    bound: float = math.inf
+    x: FloatArray | None = None
+    iterations: int = 0
+    #: per variable, the multiplier of ``z >= 0`` for binaries with a choice at the node (else 0):
+    #: any solution of the node with ``z = 1`` costs at least ``bound + zdual[z]`` (the value of a
+    #: convex program is convex in the right-hand side; the multiplier is a subgradient)
+    zdual: FloatArray | None = None
+
+
+class _Coo:
+    """Row blocks collected as COO arrays."""
+
+    def __init__(self) -> None:
+        self.r: list[IntArray] = []
+        self.c: list[IntArray] = []
+        self.v: list[FloatArray] = []
+        self.b: list[FloatArray] = []
+        self.m = 0
+
+    def add(self, rows: IntArray, cols: IntArray, vals: FloatArray, rhs: FloatArray) -> None:
+        self.r.append(np.asarray(rows, dtype=np.int64) + self.m)
+        self.c.append(np.asarray(cols, dtype=np.int64))
+        self.v.append(np.asarray(vals, dtype=float))
+        self.b.append(np.asarray(rhs, dtype=float))
+        self.m += len(rhs)
+
+    def add_csr(self, mat: sp.csr_matrix, rhs: FloatArray) -> None:
+        coo = mat.tocoo()
+        self.add(coo.row, coo.col, coo.data, rhs)
+
+    def copy(self) -> _Coo:
+        out = _Coo()
+        out.r, out.c, out.v, out.b, out.m = [*self.r], [*self.c], [*self.v], [*self.b], self.m
+        return out
+
+
+@dataclass
+class _Base:
+    """The node-independent part of a relaxation over ``n_cols`` columns.
+
+    ``col`` maps original variables to columns (-1: condensed out). For a condensed base the
+    eliminated variables ``y`` are recovered as ``y = y_lin @ x[y_from] + y_off``.
+    """
+
+    n_cols: int
+    col: IntArray
+    eq: _Coo
+    le: _Coo
+    soc: _Coo
+    soc_dims: list[int]
+    p_mat: sp.csc_matrix  # Clarabel's P (upper triangle), n_cols x n_cols
+    q_vec: FloatArray
+    const: float
+    y_idx: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    y_from: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    y_lin: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
+    y_off: FloatArray = field(default_factory=lambda: np.zeros(0))
+
+
+def _cost_pq(
+    f_mat: sp.csr_matrix, target: FloatArray, weight: FloatArray
+) -> tuple[sp.csc_matrix, FloatArray, float]:
+    """``sum w (F x - f)^2`` as Clarabel's ``(1/2) x^T P x + q^T x + const``."""
+    wf = sp.diags(weight) @ f_mat
+    p_mat = sp.triu(2.0 * (f_mat.T @ wf), format="csc")
+    q_vec = -2.0 * np.asarray(wf.T @ target).ravel()
+    return p_mat, q_vec, float(np.sum(weight * target**2))
+
+
+def _full_base(s: _Structure) -> _Base:
+    """All variables, rows, bounds and cones of the problem (binaries' bounds are per node)."""
+    pr = s.problem
+    eq = _Coo()
+    eq.add_csr(pr.a_eq.tocsr(), pr.b_eq)
+    le = _Coo()
+    le.add_csr(s.plain_le, s.plain_b)
+    cont = np.flatnonzero(~pr.integer)
+    fin_u = cont[np.isfinite(pr.ub[cont])]
+    fin_l = cont[np.isfinite(pr.lb[cont])]
+    le.add(np.arange(len(fin_u)), fin_u, np.ones(len(fin_u)), pr.ub[fin_u])
+    le.add(np.arange(len(fin_l)), fin_l, -np.ones(len(fin_l)), -pr.lb[fin_l])
+    soc = _Coo()
+    dims = []
+    for idx, radius in pr.cones:
+        k = len(idx)
+        b = np.zeros(k + 1)
+        b[0] = radius
+        soc.add(np.arange(1, k + 1), idx, -np.ones(k), b)
+        dims.append(k + 1)
+    keep = ~s.assigned
+    p_mat, q_vec, const = _cost_pq(
+        pr.cost_matrix.tocsr()[keep], pr.cost_target[keep], pr.cost_weight[keep]
+    )
+    return _Base(pr.n, np.arange(pr.n, dtype=np.int64), eq, le, soc, dims, p_mat, q_vec, const)
+
+
+def _condensed_base(s: _Structure) -> _Base | None:
+    """Eliminate the variables ``y`` that appear only in equality rows, the objective, bounds and
+    cones (the ALIP states and torques of the planner): ``V(w) = min_y cost`` subject to the
+    equality rows is a convex quadratic of the remaining ``w``, computed once from the KKT system.
+    Dropping the bounds and cones of ``y`` gives a valid lower bound; a point whose recovered ``y``
+    satisfies them is exact. Returns None when nothing can be eliminated or the KKT system is
+    singular (e.g. a zero torque weight).
+    """
+    pr = s.problem
+    n = pr.n
+    keep = np.zeros(n, dtype=bool)
+    keep[pr.integer] = True
+    keep[s.plain_le.indices] = True
+    for grp in s.groups:
+        keep[grp.variables] = True
+        keep[grp.private] = True
+    # a variable in no equality row and no cost row has nothing to determine it: keep it
+    keep[np.asarray(abs(pr.a_eq).sum(axis=0) + abs(pr.cost_matrix).sum(axis=0)).ravel() == 0] = True
+    y_mask = ~keep
+    for idx, _ in pr.cones:
+        if np.any(keep[idx]):
+            return None
+    y_idx = np.flatnonzero(y_mask)
+    w_idx = np.flatnonzero(keep)
+    if len(y_idx) == 0:
+        return None
+    a_eq = pr.a_eq.tocsr()
+    touches_y = np.asarray(abs(a_eq[:, y_idx]).sum(axis=1) > 0).ravel()
+    e_y = a_eq[touches_y][:, y_idx]
+    e_w = a_eq[touches_y][:, w_idx]
+    e_rhs = pr.b_eq[touches_y]
+    f_mat = pr.cost_matrix.tocsr()
+    rows_y = np.asarray(abs(f_mat[:, y_idx]).sum(axis=1) > 0).ravel()
+    f_y = f_mat[rows_y][:, y_idx]
+    f_wy = f_mat[rows_y][:, w_idx]
+    t_y = pr.cost_target[rows_y]
+    wt_y = pr.cost_weight[rows_y]
+    # Parameters that move y: w columns of the y equality rows and of the y cost rows.
+    support = np.flatnonzero(
+        np.asarray(abs(e_w).sum(axis=0)).ravel() + np.asarray(abs(f_wy).sum(axis=0)).ravel()
+    )
+    h = 2.0 * (f_y.T @ sp.diags(wt_y) @ f_y)
+    m_y = e_y.shape[0]
+    kkt = sp.bmat([[h, e_y.T], [e_y, None]], format="csc")
+    ny = len(y_idx)
+    rhs_lin = np.vstack(
+        [
+            -2.0 * (f_y.T @ sp.diags(wt_y) @ f_wy[:, support]).toarray(),
+            -e_w[:, support].toarray(),
+        ]
+    )
+    rhs_off = np.concatenate([2.0 * (f_y.T @ (wt_y * t_y)), e_rhs])
+    try:
+        lu = sp.linalg.splu(kkt)
+        sol = lu.solve(np.column_stack([rhs_lin, rhs_off]))
+    except RuntimeError:
+        return None
+    kkt_res = kkt @ sol - np.column_stack([rhs_lin, rhs_off])
+    if not np.all(np.isfinite(sol)) or float(np.max(np.abs(kkt_res))) > 1e-6 * max(
+        1.0, float(np.max(np.abs(sol)))
+    ):
+        return None
+    y_lin, y_off = sol[:ny, :-1], sol[:ny, -1]
+    del m_y
+    # New cost rows over w: F_y (Y w_S + y0) + F_wy w - t.
+    w_pos = np.full(n, -1, dtype=np.int64)
+    w_pos[w_idx] = np.arange(len(w_idx))
+    f_eff = (f_y @ y_lin) + f_wy[:, support].toarray()
+    t_eff = t_y - f_y @ y_off
+    sq = np.sqrt(wt_y)
+    a_s = sq[:, None] * f_eff
+    t_s = sq * t_eff
+    # other cost rows (only w)
+    other = ~rows_y & ~s.assigned
+    if np.any(rows_y & s.assigned):  # pragma: no cover - assigned rows hold only group variables
+        return None
+    f_o = f_mat[other][:, w_idx]
+    p_o, q_o, c_o = _cost_pq(f_o.tocsr(), pr.cost_target[other], pr.cost_weight[other])
+    nw = len(w_idx)
+    p_s = np.zeros((nw, nw))
+    p_s_sub = 2.0 * (a_s.T @ a_s)
+    p_s[np.ix_(support, support)] = p_s_sub
+    p_mat = sp.triu(p_o + sp.csc_matrix(np.triu(p_s)), format="csc")
+    q_vec = q_o.copy()
+    q_vec[support] += -2.0 * (a_s.T @ t_s)
+    const = c_o + float(t_s @ t_s)
+    # rows over w: equality rows without y, plain le rows, bounds of w
+    eq = _Coo()
+    eq.add_csr(a_eq[~touches_y][:, w_idx].tocsr(), pr.b_eq[~touches_y])
+    le = _Coo()
+    le.add_csr(s.plain_le[:, w_idx].tocsr(), s.plain_b)
+    cont = np.flatnonzero(~pr.integer[w_idx])
+    fin_u = cont[np.isfinite(pr.ub[w_idx][cont])]
+    fin_l = cont[np.isfinite(pr.lb[w_idx][cont])]
+    le.add(np.arange(len(fin_u)), fin_u, np.ones(len(fin_u)), pr.ub[w_idx][fin_u])
+    le.add(np.arange(len(fin_l)), fin_l, -np.ones(len(fin_l)), -pr.lb[w_idx][fin_l])
+    return _Base(
+        nw,
+        w_pos,
+        eq,
+        le,
+        _Coo(),
+        [],
+        p_mat,
+        q_vec,
+        const,
+        y_idx=y_idx,
+        y_from=w_idx[support],
+        y_lin=y_lin,
+        y_off=y_off,
+    )
+
+
+def _cat(parts: list[Any], dtype: Any) -> Any:
+    return np.concatenate(parts) if parts else np.zeros(0, dtype=dtype)
+
+
+@dataclass
+class _Templates:
+    """Per-node pieces of the relaxation over one base, as flat arrays gathered by member mask.
+
+    Members are numbered globally (group after group). Entry arrays carry the owning member
+    (``*_mem``) and a column kind: 0 = the member's copy of form ``loc``, 1 = the member's binary,
+    2 = the member's perspective variable ``t``.
+    """
+
+    base: _Base
+    # static rows of the base, concatenated
+    eq_r: IntArray
+    eq_c: IntArray
+    eq_v: FloatArray
+    eq_b: FloatArray
+    le_r: IntArray
+    le_c: IntArray
+    le_v: FloatArray
+    le_b: FloatArray
+    m_eq: int
+    m_le: int
+    # per member
+    group: IntArray  # group of each member
+    zcol: IntArray  # column of each member's binary
+    k: IntArray  # number of forms of the member's group
+    n_rows: IntArray  # hull rows of the member (copy bounds + its rows)
+    has_cost: NDArray[np.bool_]
+    cost_dim: IntArray  # cone dimension of its perspective term
+    # hull rows (multi-member groups)
+    h_mem: IntArray
+    h_row: IntArray
+    h_kind: IntArray
+    h_loc: IntArray
+    h_val: FloatArray
+    # perspective cones
+    c_mem: IntArray
+    c_row: IntArray
+    c_kind: IntArray
+    c_loc: IntArray
+    c_val: FloatArray
+    # direct rows (single-member groups)
+    d_mem: IntArray
+    d_row: IntArray
+    d_col: IntArray
+    d_val: FloatArray
+    d_nrows: IntArray
+    d_beta: FloatArray  # concatenated in member order
+    d_beta_mem: IntArray
+    # direct cost (single-member groups), upper triangle entries
+    dp_mem: IntArray
+    dp_i: IntArray
+    dp_j: IntArray
+    dp_v: FloatArray
+    dq_mem: IntArray
+    dq_i: IntArray
+    dq_v: FloatArray
+    d_const: FloatArray  # per member
+    # linking rows per group: B x_V - sum f^z = 0
+    l_grp: IntArray
+    l_row: IntArray
+    l_col: IntArray
+    l_val: FloatArray
+
+
+def _templates(s: _Structure, base: _Base) -> _Templates:
+    col = base.col
+    groups: list[int] = []
+    zcol: list[int] = []
+    kk: list[int] = []
+    nrows: list[int] = []
+    has_cost: list[bool] = []
+    cdim: list[int] = []
+    h: tuple[list[Any], ...] = ([], [], [], [], [], [])
+    c: tuple[list[Any], ...] = ([], [], [], [], [], [])
+    d: tuple[list[Any], ...] = ([], [], [], [], [], [], [])
+    dp: tuple[list[Any], ...] = ([], [], [], [])
+    dq: tuple[list[Any], ...] = ([], [], [])
+    dconst: list[float] = []
+    link: tuple[list[Any], ...] = ([], [], [], [])
+    mi = 0
+    for g, grp in enumerate(s.groups):
+        k = grp.basis.shape[0]
+        vcols = col[grp.variables]
+        br, bc = np.nonzero(grp.basis)
+        link[0].append(np.full(len(br), g))
+        link[1].append(br)
+        link[2].append(vcols[bc])
+        link[3].append(grp.basis[br, bc])
+        n_cost = len(grp.cost_rows)
+        if n_cost:
+            sw = 2.0 * np.sqrt(grp.cost_w)
+            cf = sw[:, None] * grp.cost_f
+            cr, cc = np.nonzero(cf)
+            wv = grp.cost_w[:, None] * grp.cost_v
+            pg = np.triu(2.0 * grp.cost_v.T @ wv)
+            pi, pj = np.nonzero(pg)
+            qg = -2.0 * wv.T @ grp.cost_t
+        for z in grp.members:
+            mb = s.member[z]
+            groups.append(g)
+            zcol.append(col[z])
+            kk.append(k)
+            nb = len(mb.beta)
+            nrows.append(2 * k + nb if COPY_BOUNDS else nb)
+            has_cost.append(n_cost > 0)
+            cdim.append(n_cost + 2 if n_cost else 0)
+            # hull rows: f - f_ub z <= 0 ; -f + f_lb z <= 0 ; a_f f - beta z <= 0
+            ar = np.arange(k)
+            rr, cc2 = np.nonzero(mb.a_f)
+            rows = np.r_[ar, ar, ar + k, ar + k, rr + 2 * k, np.arange(nb) + 2 * k]
+            kind = np.r_[np.zeros(k), np.ones(k), np.zeros(k), np.ones(k), np.zeros(len(rr)),
+                         np.ones(nb)].astype(np.int64)  # fmt: skip
+            loc = np.r_[ar, ar, ar, ar, cc2, np.zeros(nb)].astype(np.int64)
+            val = np.r_[np.ones(k), -grp.f_ub, -np.ones(k), grp.f_lb, mb.a_f[rr, cc2], -mb.beta]
+            if not COPY_BOUNDS:
+                keep = rows >= 2 * k
+                rows, kind, loc, val = rows[keep] - 2 * k, kind[keep], loc[keep], val[keep]
+            h[0].append(np.full(len(rows), mi))
+            h[1].append(rows)
+            h[2].append(kind)
+            h[3].append(loc)
+            h[4].append(val)
+            if n_cost:
+                # perspective: ||(2 sqrt(w) (C f^z - t z), t_z - z)|| <= t_z + z
+                rows = np.r_[0, 0, 1, 1, cr + 2, np.arange(n_cost) + 2]
+                kind = np.r_[2, 1, 2, 1, np.zeros(len(cr)), np.ones(n_cost)].astype(np.int64)
+                loc = np.r_[0, 0, 0, 0, cc, np.zeros(n_cost)].astype(np.int64)
+                val = np.r_[-1.0, -1.0, -1.0, 1.0, -cf[cr, cc], sw * grp.cost_t]
+                c[0].append(np.full(len(rows), mi))
+                c[1].append(rows)
+                c[2].append(kind)
+                c[3].append(loc)
+                c[4].append(val)
+            # direct rows
+            rr, cc2 = np.nonzero(mb.a_v)
+            d[0].append(np.full(len(rr), mi))
+            d[1].append(rr)
+            d[2].append(vcols[cc2])
+            d[3].append(mb.a_v[rr, cc2])
+            d[4].append(nb)
+            d[5].append(mb.beta)
+            d[6].append(np.full(nb, mi))
+            if n_cost:
+                lo = np.minimum(vcols[pi], vcols[pj])
+                hi = np.maximum(vcols[pi], vcols[pj])
+                dp[0].append(np.full(len(pi), mi))
+                dp[1].append(lo)
+                dp[2].append(hi)
+                dp[3].append(pg[pi, pj])
+                dq[0].append(np.full(len(vcols), mi))
+                dq[1].append(vcols)
+                dq[2].append(qg)
+                dconst.append(float(np.sum(grp.cost_w * grp.cost_t**2)))
+            else:
+                dconst.append(0.0)
+            mi += 1
+    i64, f64 = np.int64, float
+    return _Templates(
+        base=base,
+        eq_r=_cat(base.eq.r, i64),
+        eq_c=_cat(base.eq.c, i64),
+        eq_v=_cat(base.eq.v, f64),
+        eq_b=_cat(base.eq.b, f64),
+        le_r=_cat(base.le.r, i64),
+        le_c=_cat(base.le.c, i64),
+        le_v=_cat(base.le.v, f64),
+        le_b=_cat(base.le.b, f64),
+        m_eq=base.eq.m,
+        m_le=base.le.m,
+        group=np.array(groups, dtype=i64),
+        zcol=np.array(zcol, dtype=i64),
+        k=np.array(kk, dtype=i64),
+        n_rows=np.array(nrows, dtype=i64),
+        has_cost=np.array(has_cost, dtype=bool),
+        cost_dim=np.array(cdim, dtype=i64),
+        h_mem=_cat(h[0], i64),
+        h_row=_cat(h[1], i64),
+        h_kind=_cat(h[2], i64),
+        h_loc=_cat(h[3], i64),
+        h_val=_cat(h[4], f64),
+        c_mem=_cat(c[0], i64),
+        c_row=_cat(c[1], i64),
+        c_kind=_cat(c[2], i64),
+        c_loc=_cat(c[3], i64),
+        c_val=_cat(c[4], f64),
+        d_mem=_cat(d[0], i64),
+        d_row=_cat(d[1], i64),
+        d_col=_cat(d[2], i64),
+        d_val=_cat(d[3], f64),
+        d_nrows=np.array(d[4], dtype=i64),
+        d_beta=_cat(d[5], f64),
+        d_beta_mem=_cat(d[6], i64),
+        dp_mem=_cat(dp[0], i64),
+        dp_i=_cat(dp[1], i64),
+        dp_j=_cat(dp[2], i64),
+        dp_v=_cat(dp[3], f64),
+        dq_mem=_cat(dq[0], i64),
+        dq_i=_cat(dq[1], i64),
+        dq_v=_cat(dq[2], f64),
+        d_const=np.array(dconst, dtype=f64),
+        l_grp=_cat(link[0], i64),
+        l_row=_cat(link[1], i64),
+        l_col=_cat(link[2], i64),
+        l_val=_cat(link[3], f64),
+    )
+
+
+def _offsets(counts: IntArray, mask: NDArray[np.bool_]) -> IntArray:
+    """Start of each selected item in a packed layout (garbage where not selected)."""
+    c = np.where(mask, counts, 0)
+    return np.cumsum(c) - c
+
+
+class HullRelaxation:
+    """Builds and solves the node relaxation of :mod:`footfall.solvers.bnb` (see module docstring).
+
+    Two bases: ``full`` (every variable, bound and cone: exact at integral nodes) and, when the
+    problem allows it, ``condensed`` (see :func:`_condensed_base`: a lower bound, much smaller).
+    A node's relaxation is assembled from flat templates by masking (no Python loop per member).
+    """
+
+    def __init__(self, structure: _Structure, condense: bool = True) -> None:
+        import clarabel
+
+        self._clarabel = clarabel
+        self.s = structure
+        self.full = _full_base(structure)
+        self.condensed = _condensed_base(structure) if condense else None
+        self._tpl = {id(self.full): _templates(structure, self.full)}
+        if self.condensed is not None:
+            self._tpl[id(self.condensed)] = _templates(structure, self.condensed)
+        n = structure.problem.n
+        self.member_index = np.full(n, -1, dtype=np.int64)
+        order = [z for grp in structure.groups for z in grp.members]
+        self.member_index[order] = np.arange(len(order))
+        self.member_vars = np.array(order, dtype=np.int64)
+        self.n_members = len(order)
+        settings = clarabel.DefaultSettings()
+        settings.verbose = False
+        self._settings = settings
+        self.solves = 0
+        self.solve_time = 0.0
+
+    def recover(self, x: FloatArray) -> FloatArray:
+        """Fill the condensed-out variables of ``x`` (a full-length vector) in place; returns x."""
+        base = self.condensed
+        if base is not None:
+            x[base.y_idx] = base.y_lin @ x[base.y_from] + base.y_off
+        return x
+
+    def solve(self, allowed: tuple[tuple[int, ...], ...], full: bool = False) -> _Relaxation:
+        """Solve the relaxation where group ``g`` may use only the binaries ``allowed[g]``."""
+        base = self.full if full or self.condensed is None else self.condensed
+        t = self._tpl[id(base)]
+        pr = self.s.problem
+        n_groups = len(self.s.groups)
+        sel = np.zeros(self.n_members, dtype=bool)
+        sel[self.member_index[[z for mem in allowed for z in mem]]] = True
+        count = np.bincount(t.group[sel], minlength=n_groups)
+        multi_g = count >= 2
+        multi = sel & multi_g[t.group]
+        single = sel & ~multi
+        excluded = ~sel
+
+        ncol0 = base.n_cols
+        # columns: copies of the forms, then the perspective variables
+        copy_start = ncol0 + _offsets(t.k, multi)
+        n_copies = int(np.sum(t.k[multi]))
+        persp = multi & t.has_cost
+        t_col = ncol0 + n_copies + _offsets(np.ones_like(t.k), persp)
+        ncol = ncol0 + n_copies + int(np.count_nonzero(persp))
+
+        # equalities: static, excluded binaries = 0, linking rows of multi groups
+        ex_cols = t.zcol[excluded]
+        n_ex = len(ex_cols)
+        k_group = np.zeros(n_groups, dtype=np.int64)
+        k_group[t.group] = t.k
+        link_start = t.m_eq + n_ex + _offsets(k_group, multi_g)
+        lm = multi_g[t.l_grp]
+        # copies: -1 at (link_start[g] + j, copy_start[m] + j)
+        cm = np.repeat(np.flatnonzero(multi), t.k[multi])
+        cj = np.arange(len(cm)) - np.repeat(_offsets(t.k, multi)[multi], t.k[multi])
+        eq_r = np.concatenate(
+            [t.eq_r, t.m_eq + np.arange(n_ex), link_start[t.l_grp[lm]] + t.l_row[lm],
+             link_start[t.group[cm]] + cj]
+        )  # fmt: skip
+        eq_c = np.concatenate([t.eq_c, ex_cols, t.l_col[lm], copy_start[cm] + cj])
+        eq_v = np.concatenate([t.eq_v, np.ones(n_ex), t.l_val[lm], -np.ones(len(cm))])
+        m_eq = t.m_eq + n_ex + int(np.sum(k_group[multi_g]))
+        eq_b = np.concatenate([t.eq_b, np.zeros(m_eq - t.m_eq)])
+
+        # inequalities: static, -z <= 0 for multi members, hull rows, direct rows
+        zm = t.zcol[multi]
+        nzm = len(zm)
+        row0 = t.m_le + nzm
+        h_start = row0 + _offsets(t.n_rows, multi)
+        hm = multi[t.h_mem]
+        hmem = t.h_mem[hm]
+        hkind = t.h_kind[hm]
+        h_cols = np.where(hkind == 0, copy_start[hmem] + t.h_loc[hm], t.zcol[hmem])
+        n_h = int(np.sum(t.n_rows[multi]))
+        d_start = row0 + n_h + _offsets(t.d_nrows, single)
+        dm = single[t.d_mem]
+        n_d = int(np.sum(t.d_nrows[single]))
+        le_r = np.concatenate(
+            [t.le_r, t.m_le + np.arange(nzm), h_start[hmem] + t.h_row[hm],
+             d_start[t.d_mem[dm]] + t.d_row[dm]]
+        )  # fmt: skip
+        le_c = np.concatenate([t.le_c, zm, h_cols, t.d_col[dm]])
+        le_v = np.concatenate([t.le_v, -np.ones(nzm), t.h_val[hm], t.d_val[dm]])
+        le_b = np.concatenate([t.le_b, np.zeros(nzm + n_h), t.d_beta[single[t.d_beta_mem]]])
+        m_le = row0 + n_h + n_d
+
+        # cones: static (base) and perspective
+        c_start = _offsets(t.cost_dim, persp)
+        cmask = persp[t.c_mem]
+        cmem = t.c_mem[cmask]
+        ckind = t.c_kind[cmask]
+        c_cols = np.where(
+            ckind == 0,
+            copy_start[cmem] + t.c_loc[cmask],
+            np.where(ckind == 1, t.zcol[cmem], t_col[cmem]),
+        )
+        soc = base.soc
+        soc_r = _cat(soc.r, np.int64)
+        n_pc = int(np.sum(t.cost_dim[persp]))
+        rows = np.concatenate(
+            [
+                eq_r,
+                le_r + m_eq,
+                soc_r + m_eq + m_le,
+                c_start[cmem] + t.c_row[cmask] + m_eq + m_le + soc.m,
+            ]
+        )
+        cols = np.concatenate([eq_c, le_c, _cat(soc.c, np.int64), c_cols])
+        vals = np.concatenate([eq_v, le_v, _cat(soc.v, float), t.c_val[cmask]])
+        b = np.concatenate([eq_b, le_b, _cat(soc.b, float), np.zeros(n_pc)])
+        a_mat = sp.csc_matrix((vals, (rows, cols)), shape=(m_eq + m_le + soc.m + n_pc, ncol))
+
+        pm = base.p_mat
+        p_mat = sp.csc_matrix(
+            (pm.data, pm.indices, np.r_[pm.indptr, np.full(ncol - base.n_cols, pm.nnz)]),
+            shape=(ncol, ncol),
+        )
+        pmask = single[t.dp_mem]
+        if np.any(pmask):
+            p_mat = (
+                p_mat
+                + sp.csc_matrix((t.dp_v[pmask], (t.dp_i[pmask], t.dp_j[pmask])), shape=(ncol, ncol))
+            ).tocsc()
+        q = np.zeros(ncol)
+        q[: base.n_cols] = base.q_vec
+        qmask = single[t.dq_mem]
+        np.add.at(q, t.dq_i[qmask], t.dq_v[qmask])
+        q[t_col[persp]] = 1.0
+        const = base.const + float(np.sum(t.d_const[single]))
+
+        cl = self._clarabel
+        cones: list[Any] = [cl.ZeroConeT(m_eq), cl.NonnegativeConeT(m_le)]
+        cones += [cl.SecondOrderConeT(int(dd)) for dd in base.soc_dims]
+        cones += [cl.SecondOrderConeT(int(dd)) for dd in t.cost_dim[persp]]
+        t0 = time.perf_counter()
+        solver = cl.DefaultSolver(p_mat, q, a_mat, b, cones, self._settings)
+        sol = solver.solve()
+        self.solve_time += time.perf_counter() - t0
+        self.solves += 1
+        status = str(sol.status)
+        if status in ("Solved", "AlmostSolved"):
+            bound = min(float(sol.obj_val), float(sol.obj_val_dual)) + const
+            xs = np.asarray(sol.x)
+            x = np.zeros(pr.n)
+            col = base.col
+            mapped = col >= 0
+            x[mapped] = xs[col[mapped]]
+            if base is self.condensed:
+                self.recover(x)
+            zdual = np.zeros(pr.n)
+            lo = m_eq + t.m_le
+            zdual[self.member_vars[multi]] = np.maximum(np.asarray(sol.z)[lo : lo + nzm], 0.0)
+            return _Relaxation("solved", bound, x, int(sol.iterations), zdual)
+        if status in ("PrimalInfeasible", "AlmostPrimalInfeasible"):
+            return _Relaxation("infeasible", iterations=int(sol.iterations))
+        return _Relaxation("failed", iterations=int(sol.iterations))
+
+
+@dataclass(order=True)
+class _Node:
+    bound: float
+    order: int
+    allowed: tuple[tuple[int, ...], ...] = field(compare=False)
+    x: FloatArray | None = field(compare=False, default=None)
+    depth: int = field(compare=False, default=0)
+    full: bool = field(compare=False, default=False)
+    zdual: FloatArray | None = field(compare=False, default=None)
+
+
+def _weights(x: FloatArray, mem: tuple[int, ...]) -> FloatArray:
+    return np.clip(x[list(mem)], 0.0, 1.0)
+
+
+def _violations(s: _Structure, x: FloatArray, g: int, mem: tuple[int, ...]) -> FloatArray:
+    """Largest violation of each member's indicator rows at ``x``, shape (len(mem),)."""
+    xv = x[s.groups[g].variables]
+    out = np.zeros(len(mem))
+    for k, z in enumerate(mem):
+        mb = s.member[z]
+        if len(mb.beta):
+            out[k] = float(np.max(mb.a_v @ xv - mb.beta))
+    return out
+
+
+def _choice(
+    s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], tol: float
+) -> tuple[tuple[int, ...], ...] | None:
+    """A member per group whose rows ``x`` satisfies within ``tol`` (None if some group has none).
+
+    ``x`` then is a feasible point of the MIQCQP with those binaries set to 1: the relaxation solution
+    is integer feasible even when the IPM spread the weights over several equally good members.
+    """
+    out = []
+    for g, mem in enumerate(allowed):
+        if len(mem) == 1:
+            out.append(mem)
+            continue
+        v = _violations(s, x, g, mem)
+        k = int(np.argmin(v))
+        if v[k] > tol:
+            return None
+        out.append((mem[k],))
+    return tuple(out)
+
+
+def _fix_by_duals(
+    allowed: tuple[tuple[int, ...], ...], member_bound: FloatArray, incumbent: float
+) -> tuple[tuple[int, ...], ...]:
+    """Drop the members whose bound with ``z = 1`` (``member_bound[z]``) reaches the incumbent."""
+    return tuple(
+        mem if len(mem) == 1 else tuple(z for z in mem if member_bound[z] < incumbent)
+        for mem in allowed
+    )
+
+
+def _rounded(x: FloatArray, allowed: tuple[tuple[int, ...], ...]) -> tuple[tuple[int, ...], ...]:
+    return tuple(m if len(m) == 1 else (m[int(np.argmax(_weights(x, m)))],) for m in allowed)
+
+
+def _branch(
+    s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], tol: float
+) -> tuple[tuple[tuple[int, ...], ...], tuple[tuple[int, ...], ...]] | None:
+    """Split a violated group (see ``BRANCH_SELECT``) into two halves (see ``BRANCH_SPLIT``)."""
+    best, best_g = -math.inf, -1
+    for g, mem in enumerate(allowed):
+        if len(mem) < 2:
+            continue
+        viol = _violations(s, x, g, mem)
+        if float(np.min(viol)) <= tol:
+            continue
+        if BRANCH_SELECT == "violation":
+            score = float(np.min(viol))
+        elif BRANCH_SELECT == "fractional":
+            score = 1.0 - float(np.max(_weights(x, mem)))
+        else:  # "first"
+            score = -g
+        if score > best:
+            best, best_g = score, g
+    if best_g < 0:
+        return None
+    mem = allowed[best_g]
+    w = _weights(x, mem)
+    if BRANCH_SPLIT == "sos":
+        centre = float(np.dot(w, np.arange(len(mem)))) / max(float(np.sum(w)), 1e-12)
+        k = min(max(round(centre + 0.5), 1), len(mem) - 1)
+        one, other = mem[:k], mem[k:]
+    else:  # "nearest": the least violated member against the rest
+        z = mem[int(np.argmin(_violations(s, x, best_g, mem)))]
+        one, other = (z,), tuple(m for m in mem if m != z)
+    left = [*allowed]
+    right = [*allowed]
+    left[best_g] = one
+    right[best_g] = other
+    return tuple(left), tuple(right)
+
+
+def _finish(s: _Structure, x: FloatArray, chosen: tuple[tuple[int, ...], ...]) -> FloatArray:
+    """A relaxation solution as a MIQCQP point: the chosen binaries set to 1, the others to 0, and
+    each group's private variables recovered from the chosen member's rows."""
+    pr = s.problem
+    out = x.copy()
+    out[pr.integer] = 0.0
+    for g, mem in enumerate(chosen):
+        z = mem[0]
+        out[z] = 1.0
+        for v in s.groups[g].private:
+            lo, hi = float(pr.lb[v]), float(pr.ub[v])
+            for cc, vv, bb in s.member[z].orig:
+                hit = cc == v
+                if not np.any(hit):
+                    continue
+                a = float(vv[hit][0])
+                rest = float(vv[~hit] @ out[cc[~hit]])
+                if a > 0.0:
+                    hi = min(hi, (bb - rest) / a)
+                else:
+                    lo = max(lo, (bb - rest) / a)
+            out[v] = 0.5 * (lo + hi) if lo <= hi else lo
+    return out
+
+
+def _root_allowed(s: _Structure) -> tuple[tuple[int, ...], ...]:
+    """Members allowed by the binaries' own bounds (a binary fixed to 1 excludes the others)."""
+    pr = s.problem
+    out = []
+    for grp in s.groups:
+        ones = tuple(z for z in grp.members if pr.lb[z] >= 0.5)
+        out.append(ones if ones else tuple(z for z in grp.members if pr.ub[z] >= 0.5))
+    return tuple(out)
+
+
+def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
+    """Solve ``problem`` by branch and bound on hull relaxations (see the module docstring).
+
+    A problem without the choice-group shape is handed to SCIP (``stats["fallback"]`` says why).
+    """
+    start = time.perf_counter()
+    try:
+        structure = analyse(problem)
+    except UnsupportedProblem as exc:
+        from footfall.solvers import scip
+
+        res = scip.solve(problem, options)
+        res.stats["fallback"] = f"bnb cannot take this problem ({exc}); solved by SCIP"
+        return res
+    search = _Search(structure, options, start)
+    return search.run()
+
+
+_WORKER: HullRelaxation | None = None
+
+
+def _work(task: tuple[tuple[tuple[int, ...], ...], bool]) -> _Relaxation:
+    """Solve one node relaxation in a worker process (forked with the relaxation built)."""
+    assert _WORKER is not None
+    allowed, full = task
+    res = _WORKER.solve(allowed, full=full)
+    if res.status == "failed" and not full:
+        res = _WORKER.solve(allowed, full=True)
+    return res
+
+
+def _pool(relax: HullRelaxation, threads: int) -> Any:
+    """A pool of ``threads`` forked workers sharing ``relax`` (None for 1 thread or no fork)."""
+    import multiprocessing as mp
+
+    global _WORKER
+    if threads < 2 or "fork" not in mp.get_all_start_methods():
+        return None
+    _WORKER = relax
+    try:
+        return mp.get_context("fork").Pool(threads)
+    finally:
+        _WORKER = None
+
+
+class _Search:
+    """State of one branch-and-bound run (see the module docstring)."""
+
+    def __init__(self, structure: _Structure, options: SolverOptions, start: float) -> None:
+        self.s = structure
+        self.problem = structure.problem
+        self.options = options
+        self.start = start
+        self.deadline = start + options.time_limit
+        self.relax = HullRelaxation(structure)
+        self.incumbent: FloatArray | None = None
+        self.inc_obj = math.inf
+        self.tried: set[tuple[tuple[int, ...], ...]] = set()
+        self.heap: list[_Node] = []
+        self.nodes = 0
+        self.counter = 0
+        self.failed = False
+        self.lost_bound = math.inf
+        self.fixed_by_duals = 0
+        #: (nodes, seconds, incumbent or None, best bound) every 25 nodes
+        self.trace: list[tuple[int, float, float | None, float]] = []
+        if options.initial_solution is not None:
+            x0 = np.asarray(options.initial_solution, dtype=float)
+            if x0.shape == (self.problem.n,):
+                self.offer(x0.copy())
+
+    # ----------------------------------------------------------------------------- incumbents
+    def offer(self, cand: FloatArray) -> bool:
+        """Take ``cand`` as incumbent if it is feasible and better; True if feasible."""
+        if self.problem.violation(cand) > FEAS_TOL:
+            return False
+        obj = self.problem.objective(cand)
+        if obj < self.inc_obj:
+            self.incumbent, self.inc_obj = cand, obj
+        return True
+
+    def solve_fixed(self, fixed: tuple[tuple[int, ...], ...]) -> None:
+        """One convex solve with every group fixed; the full model if the condensed one is off."""
+        if fixed in self.tried:
+            return
+        self.tried.add(fixed)
+        for full in (False, True):
+            res = self.relax.solve(fixed, full=full)
+            if res.status != "solved" or res.x is None:
+                return
+            if self.offer(_finish(self.s, res.x, fixed)):
+                return
+
+    def dive(self, x: FloatArray, allowed: tuple[tuple[int, ...], ...]) -> None:
+        """Depth-first dive from a relaxation solution: fix the group whose nearest member (least
+        violated rows) is nearest to that member and re-solve, until the relaxation is integral
+        (an incumbent) or hopeless."""
+        cur = allowed
+        for _ in range(2 * len(cur)):
+            if time.perf_counter() > self.deadline:
+                return
+            best_g, best_v, z = -1, math.inf, -1
+            for g, mem in enumerate(cur):
+                if len(mem) > 1:
+                    viol = _violations(self.s, x, g, mem)
+                    k = int(np.argmin(viol))
+                    if viol[k] < best_v:
+                        best_g, best_v, z = g, float(viol[k]), mem[k]
+            if best_g < 0:
+                return
+            mem = cur[best_g]
+            fixed = list(cur)
+            fixed[best_g] = (z,)
+            res = self.relax.solve(tuple(fixed))
+            if res.status != "solved" or res.x is None:
+                rest = list(cur)
+                rest[best_g] = tuple(m for m in mem if m != z)
+                cur = tuple(rest)
+                res = self.relax.solve(cur)
+                if res.status != "solved" or res.x is None:
+                    return
+            else:
+                cur = tuple(fixed)
+            if res.bound >= self.inc_obj:
+                return
+            x = res.x
+            chosen = _choice(self.s, x, cur, ROW_TOL)
+            if chosen is not None:
+                self.solve_fixed(chosen)
+                return
+
+    # ---------------------------------------------------------------------------------- search
+    def gap_of(self, bound: float) -> float:
+        """Relative gap of the incumbent against ``bound`` (SCIP's definition)."""
+        if not math.isfinite(self.inc_obj):
+            return math.inf
+        if self.inc_obj <= bound:
+            return 0.0
+        denom = min(abs(self.inc_obj), abs(bound))
+        return math.inf if denom == 0.0 else (self.inc_obj - bound) / denom
+
+    def evaluate(
+        self,
+        allowed: tuple[tuple[int, ...], ...],
+        parent_bound: float,
+        depth: int,
+        full: bool,
+        res: _Relaxation | None = None,
+    ) -> _Relaxation | None:
+        """Solve a node (unless ``res`` holds its relaxation already); keep it when it may hold a
+        better plan than the incumbent."""
+        if res is None:
+            res = self.relax.solve(allowed, full=full)
+        self.nodes += 1
+        if res.status == "failed" and not full:
+            res = self.relax.solve(allowed, full=True)  # numerical trouble: try the plain model
+            full = True
+        if res.status == "failed":
+            # unsolved node: its parent's bound stays in the reported bound (an honest gap)
+            self.failed = True
+            self.lost_bound = min(self.lost_bound, parent_bound)
+            return None
+        if res.status != "solved" or res.x is None:
+            return None
+        bound = max(res.bound, parent_bound)
+        if bound >= self.inc_obj:
+            return None
+        chosen = _choice(self.s, res.x, allowed, ROW_TOL)
+        if chosen is not None:
+            # The relaxation optimum satisfies one member of every group.
+            if self.offer(_finish(self.s, res.x, chosen)):
+                return None  # exact: the node is solved
+            if not full:  # only the dropped bounds/cones of the condensed variables fail
+                return self.evaluate(allowed, bound, depth, True)
+            self.solve_fixed(chosen)
+            return None
+        heapq.heappush(
+            self.heap, _Node(bound, self.counter, allowed, res.x, depth, full, res.zdual)
+        )
+        self.counter += 1
+        if ROUNDING_EVERY and self.nodes % ROUNDING_EVERY == 0:
+            self.solve_fixed(_rounded(res.x, allowed))
+        return res
+
+    def run(self) -> SolverResult:
+        """Best-first branch and bound; returns the best plan with an honest gap."""
+        root_allowed = _root_allowed(self.s)
+        timed_out = False
+        if all(root_allowed):
+            root = self.evaluate(root_allowed, -math.inf, 0, False)
+            if root is not None and root.x is not None and DIVE:
+                self.dive(root.x, root_allowed)
+        pool = _pool(self.relax, self.options.threads) if self.heap else None
+        try:
+            timed_out = self._loop(pool)
+        finally:
+            if pool is not None:
+                pool.terminate()
+        return self.result(timed_out)
+
+    def _loop(self, pool: Any) -> bool:
+        """The best-first loop; returns True when stopped by the time limit. With a ``pool``, the
+        children of the best ``threads`` open nodes are solved in parallel."""
+        batch = 1 if pool is None else self.options.threads
+        while self.heap:
+            top = self.heap[0].bound
+            if not self.trace or self.nodes >= self.trace[-1][0] + 25:
+                inc = self.inc_obj if math.isfinite(self.inc_obj) else None  # JSON-safe
+                self.trace.append((self.nodes, time.perf_counter() - self.start, inc, top))
+            if self.gap_of(top) <= self.options.gap:
+                break
+            if time.perf_counter() > self.deadline:
+                return True
+            tasks: list[tuple[tuple[tuple[int, ...], ...], _Node]] = []
+            while self.heap and len(tasks) < 2 * batch:
+                node = heapq.heappop(self.heap)
+                if node.bound >= self.inc_obj:
+                    continue
+                assert node.x is not None
+                allowed = node.allowed
+                if REDUCED_COST_FIXING and node.zdual is not None and math.isfinite(self.inc_obj):
+                    allowed = _fix_by_duals(allowed, node.bound + node.zdual, self.inc_obj)
+                    if not all(allowed):
+                        continue  # every member of some group is worse than the incumbent
+                    self.fixed_by_duals += sum(map(len, node.allowed)) - sum(map(len, allowed))
+                split = _branch(self.s, node.x, allowed, ROW_TOL)
+                if split is None:  # pragma: no cover - evaluate() resolved such nodes
+                    continue
+                tasks.extend((child, node) for child in split)
+            if pool is None:
+                for child, node in tasks:
+                    self.evaluate(child, node.bound, node.depth + 1, node.full)
+            else:
+                results = pool.map(_work, [(child, node.full) for child, node in tasks])
+                for (child, node), res in zip(tasks, results, strict=True):
+                    self.evaluate(child, node.bound, node.depth + 1, node.full, res)
+        return False
+
+    def result(self, timed_out: bool) -> SolverResult:
+        """The :class:`SolverResult` of the search so far."""
+        open_bounds = [nd.bound for nd in self.heap if nd.bound < self.inc_obj]
+        best_bound = min([*open_bounds, self.lost_bound], default=self.inc_obj)
+        best_bound = min(best_bound, self.inc_obj)
+        if self.incumbent is None:
+            if timed_out:
+                status = SolveStatus.TIME_LIMIT
+            elif self.failed:
+                status = SolveStatus.ERROR
+            else:
+                status = SolveStatus.INFEASIBLE
+            gap = math.inf
+        else:
+            gap = max(0.0, self.gap_of(best_bound))
+            if gap <= self.options.gap and not self.failed:
+                status = SolveStatus.OPTIMAL
+            elif timed_out:
+                status = SolveStatus.TIME_LIMIT
+            else:
+                status = SolveStatus.FEASIBLE
+        return SolverResult(
+            status=status,
+            x=self.incumbent,
+            objective=self.inc_obj if self.incumbent is not None else math.nan,
+            bound=best_bound if math.isfinite(best_bound) else math.nan,
+            gap=gap,
+            solve_time=time.perf_counter() - self.start,
+            solver=NAME,
+            stats={
+                "raw_status": status.value,
+                "nodes": self.nodes,
+                "relaxations": self.relax.solves,
+                "relaxation_time_s": self.relax.solve_time,
+                "variables": self.problem.n,
+                "integer_variables": self.problem.n_integer,
+                "groups": len(self.s.groups),
+                "members": self.relax.n_members,
+                "condensed": self.relax.condensed is not None,
+                "fixed_by_duals": self.fixed_by_duals,
+                "trace": self.trace,
+            },
+        )

@@ -1,0 +1,183 @@
+"""The fast planner (``bnb`` backend) solves exactly the direct model's problem.
+
+Objective equality against the direct SCIP model on small seeded instances (N = 4..6, K = 3), the
+independent checker on every plan, infeasibility detected by both, and unit checks of the
+relaxation (a valid lower bound, exact at a fixed assignment) and of the fallback.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from footfall.models.biped import BipedParams
+from footfall.planning.check import check_plan
+from footfall.planning.fast import FAST_SOLVER, plan_footsteps_fast
+from footfall.planning.miqcqp import build_footstep_problem, plan_footsteps
+from footfall.planning.plan import PlannerOptions
+from footfall.solvers import ProblemBuilder, SolverOptions, SolveStatus, bnb, solve
+from footfall.solvers.problem import fix_variables
+from footfall.terrain.scene import random_stepping_stones
+
+#: relative optimality gap of both solvers in the equality tests
+GAP = 1e-5
+#: objectives of two runs optimal within GAP agree to this (relative; both gaps plus slack)
+OBJ_RTOL = 3 * GAP
+#: relative slack of a lower bound against the value it bounds
+BOUND_RTOL = 1e-7
+
+ROBOT = BipedParams(n_nodes=3)
+
+# (regions, seed, steps): feasible small instances where SCIP finishes in seconds
+CASES = [(4, 0, 4), (4, 1, 4), (5, 0, 5), (5, 1, 5), (5, 2, 6), (5, 3, 6), (6, 0, 6)]
+
+
+def _scene(regions: int, seed: int):  # type: ignore[no-untyped-def]
+    return random_stepping_stones(seed, regions, robot=ROBOT)
+
+
+@pytest.mark.parametrize(("regions", "seed", "n"), CASES)
+def test_fast_objective_equals_direct(regions: int, seed: int, n: int) -> None:
+    scene = _scene(regions, seed)
+    opts = PlannerOptions(gap=GAP, time_limit=60.0)
+    direct = plan_footsteps(scene, ROBOT, n, opts)
+    fast = plan_footsteps_fast(scene, ROBOT, n, opts)
+    assert direct.status is SolveStatus.OPTIMAL, direct.message
+    assert fast.status is SolveStatus.OPTIMAL, fast.message
+    assert fast.solver == FAST_SOLVER
+    assert fast.objective == pytest.approx(direct.objective, rel=OBJ_RTOL)
+    for plan in (direct, fast):
+        report = check_plan(plan, scene)
+        assert report.ok, report.summary()
+    # the fast plan's proven bound is a valid lower bound on the direct optimum
+    assert fast.bound <= direct.objective * (1 + OBJ_RTOL)
+
+
+def test_infeasible_detected_by_both() -> None:
+    # 5 steps cannot cross this scene, but the variable bounds alone do not show it: both solvers
+    # must prove it.
+    scene = _scene(6, 2)
+    fp = build_footstep_problem(scene, ROBOT, 5)
+    assert not fp.problem.bounds_conflict()
+    res_fast = solve(fp.problem, "bnb", SolverOptions(time_limit=60.0))
+    res_direct = solve(fp.problem, "scip", SolverOptions(time_limit=60.0))
+    assert res_fast.status is SolveStatus.INFEASIBLE
+    assert res_direct.status is SolveStatus.INFEASIBLE
+    plan = plan_footsteps_fast(scene, ROBOT, 5)
+    assert plan.status is SolveStatus.INFEASIBLE
+    assert plan.message.startswith("infeasible")
+    assert not check_plan(plan, scene).ok
+
+
+def test_relaxation_is_a_lower_bound_and_exact_when_fixed() -> None:
+    scene = _scene(5, 0)
+    fp = build_footstep_problem(scene, ROBOT, 5)
+    res = solve(fp.problem, "bnb", SolverOptions(gap=GAP))
+    assert res.status is SolveStatus.OPTIMAL and res.x is not None
+    structure = bnb.analyse(fp.problem)
+    relax = bnb.HullRelaxation(structure)
+    root = relax.solve(bnb._root_allowed(structure))
+    assert root.status == "solved"
+    assert root.bound <= res.objective * (1 + BOUND_RTOL)
+    # every group fixed to the optimal member: condensed and full relaxations give the optimum
+    chosen = tuple(tuple(z for z in grp.members if res.x[z] > 0.5) for grp in structure.groups)
+    for full in (False, True):
+        fixed = relax.solve(chosen, full=full)
+        assert fixed.status == "solved" and fixed.x is not None
+        assert fixed.bound == pytest.approx(res.objective, rel=1e-6)
+
+
+def test_perspective_and_hull_relaxations_agree_on_the_optimum() -> None:
+    scene = _scene(5, 1)
+    fp = build_footstep_problem(scene, ROBOT, 5)
+    structure = bnb.analyse(fp.problem, perspective=False)
+    assert not np.any(structure.assigned)
+    with_p = bnb.analyse(fp.problem, perspective=True)
+    assert np.any(with_p.assigned)  # the horizontal step terms sit in the heading-segment groups
+    plain = bnb.HullRelaxation(structure).solve(bnb._root_allowed(structure))
+    persp = bnb.HullRelaxation(with_p).solve(bnb._root_allowed(with_p))
+    # the perspective relaxation is at least as tight
+    assert persp.bound >= plain.bound * (1 - BOUND_RTOL)
+
+
+def test_fixed_binaries_are_respected() -> None:
+    scene = _scene(5, 0)
+    fp = build_footstep_problem(scene, ROBOT, 5)
+    best = solve(fp.problem, "bnb", SolverOptions(gap=GAP))
+    assert best.x is not None
+    # forbid the optimal region of footstep 1: the optimum can only get worse
+    live = fp.regions[1][fp.regions[1] >= 0]
+    used = int(live[np.argmax(best.x[live])])
+    worse = solve(fix_variables(fp.problem, np.array([used]), np.array([0.0])), "bnb")
+    if worse.status is SolveStatus.OPTIMAL:
+        assert worse.x is not None and worse.x[used] < 0.5
+        assert worse.objective >= best.objective * (1 - OBJ_RTOL)
+    else:
+        assert worse.status is SolveStatus.INFEASIBLE
+
+
+def test_time_limit_returns_an_honest_gap() -> None:
+    scene = random_stepping_stones(0, 8, robot=ROBOT)
+    fp = build_footstep_problem(scene, ROBOT, 10)
+    res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.3, gap=0.0))
+    assert res.status in (SolveStatus.TIME_LIMIT, SolveStatus.OPTIMAL)
+    if res.x is not None:
+        assert fp.problem.violation(res.x) <= bnb.FEAS_TOL
+        assert res.objective == pytest.approx(fp.problem.objective(res.x))
+        assert res.bound <= res.objective * (1 + BOUND_RTOL)
+        expected = (res.objective - res.bound) / min(abs(res.objective), abs(res.bound))
+        assert res.gap == pytest.approx(max(expected, 0.0), abs=1e-12)
+    else:
+        assert math.isinf(res.gap)
+
+
+def test_unsupported_problem_falls_back_to_scip() -> None:
+    b = ProblemBuilder()
+    x = b.add_vars("x", (2,), lb=-1.0, ub=1.0)
+    z = b.add_binaries("z", ())
+    b.add_square({int(x[0]): 1.0, int(z): 1.0}, 1.5, 1.0, "binary in the objective")
+    b.add_le({int(x[0]): 1.0, int(x[1]): 1.0}, 1.0, "plain")
+    prob = b.build()
+    with pytest.raises(bnb.UnsupportedProblem):
+        bnb.analyse(prob)
+    res = solve(prob, "bnb")
+    assert "fallback" in res.stats
+    assert res.status is SolveStatus.OPTIMAL
+    assert res.objective == pytest.approx(0.0, abs=1e-6)
+
+
+def test_parallel_workers_find_the_same_optimum() -> None:
+    scene = random_stepping_stones(1, 8, robot=ROBOT)
+    fp = build_footstep_problem(scene, ROBOT, 8)
+    serial = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=1))
+    parallel = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=2))
+    assert serial.status is parallel.status is SolveStatus.OPTIMAL
+    assert parallel.objective == pytest.approx(serial.objective, rel=OBJ_RTOL)
+    assert parallel.stats["nodes"] > 1  # the search branched, so the workers were used
+
+
+def test_bench_plan_cli_writes_the_table(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    import json
+    import subprocess
+    import sys
+
+    res = subprocess.run(
+        [sys.executable, "-m", "footfall", "bench", "plan", "--steps", "5", "--nodes", "3",
+         "--seeds", "0", "--regions", "5", "--out", str(tmp_path)],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    runs = json.loads((tmp_path / "bench_plan.json").read_text())["runs"]
+    assert {r["solver"] for r in runs} == {"scip", "bnb"}
+    assert all(r["status"] == "optimal" and r["check_ok"] for r in runs)
+    objs = [r["objective"] for r in runs]
+    assert objs[0] == pytest.approx(objs[1], rel=2e-3)  # both within the bench's gap of 1e-3
+    table = (tmp_path / "bench_plan.md").read_text()
+    assert "| 5 | 3 | 5 | 1 |" in table and "all agree" in table and "all plans pass" in table
+    bad = subprocess.run(
+        [sys.executable, "-m", "footfall", "bench", "plan", "--steps", "0"],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert bad.returncode == 2 and "steps" in bad.stderr
