@@ -216,7 +216,10 @@ def plan(
     planner: str = typer.Option("miqcqp", help="miqcqp, kinematic or reactive."),
     time_limit: float = typer.Option(60.0, help="Solver time limit per solve [s]."),
     gap: float = typer.Option(1e-4, help="Relative optimality gap at which to stop."),
-    solver: str = typer.Option("scip", help="Optimisation backend: scip or gurobi."),
+    solver: str = typer.Option(
+        "bnb", help="Backend: bnb (fast exact, default), scip (direct model) or gurobi."
+    ),
+    threads: int = typer.Option(2, help="Worker processes of the bnb backend / solver threads."),
     region_margin: float = typer.Option(
         0.0, help="Keep footsteps this far inside their region [m] (0: point footholds)."
     ),
@@ -233,7 +236,7 @@ def plan(
     if steps is not None and (steps < 1):
         raise InputError("steps", steps, "an integer >= 1")
     options = PlannerOptions(
-        time_limit=time_limit, gap=gap, solver=solver, region_margin=region_margin
+        time_limit=time_limit, gap=gap, solver=solver, threads=threads, region_margin=region_margin
     )
     with console.status(f"planning {sc.name} with {planner} ...") as status:
 

@@ -62,7 +62,9 @@ class PlannerOptions:
     Attributes:
         weights: objective weights (eq. 5.11).
         heading_segments: L, number of sin/cos segments over a full turn (eq. 5.12g-h).
-        solver: backend name (``scip`` default, ``gurobi`` optional).
+        solver: backend name: ``bnb`` (default: footfall's exact branch and bound for this
+            problem, falls back to SCIP for other structures), ``scip`` (the direct model on
+            SCIP), ``gurobi`` (optional).
         time_limit: solver wall-time limit [s].
         gap: relative optimality gap at which the solver stops.
         threads: solver threads.
@@ -76,7 +78,7 @@ class PlannerOptions:
 
     weights: PlannerWeights = field(default_factory=PlannerWeights)
     heading_segments: int = 16
-    solver: str = "scip"
+    solver: str = "bnb"
     time_limit: float = 60.0
     gap: float = 1e-4
     threads: int = 1

@@ -1110,6 +1110,10 @@ def _finish(s: _Structure, x: FloatArray, chosen: tuple[tuple[int, ...], ...]) -
     each group's private variables recovered from the chosen member's rows."""
     pr = s.problem
     out = x.copy()
+    # Variables fixed by their bounds take exactly that value (the node solver returns them only
+    # to its tolerance, e.g. -3e-18 for a 0).
+    fixed = pr.lb == pr.ub
+    out[fixed] = pr.lb[fixed]
     out[pr.integer] = 0.0
     for g, mem in enumerate(chosen):
         z = mem[0]
