@@ -121,7 +121,7 @@ def _one_step(
         for j in range(2):
             b.add_square({int(u[k, j]): 1.0}, 0.0, 1e-4, "torque")
     # The momentum error can be driven to ~0, where only an absolute gap can close.
-    res = solve(b.build(), "scip", SolverOptions(time_limit=10.0, gap=1e-6, abs_gap=1e-8))
+    res = solve(b.build(), "bnb", SolverOptions(time_limit=10.0, gap=1e-6, abs_gap=1e-8))
     if res.x is None:
         return None
     names = scene.terrain.names
