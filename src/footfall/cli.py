@@ -397,9 +397,9 @@ def _positive_int(field: str, value: int) -> int:
 @app.command("simulate")
 def simulate_command(
     scene: str = typer.Option("flat", "--scene", help="Built-in scene name or YAML file."),
-    planner: str = typer.Option("reactive", help="Planner: miqcqp, kinematic or reactive."),
+    planner: str = typer.Option("miqcqp", help="Planner: miqcqp, kinematic or reactive."),
     steps: int | None = typer.Option(
-        None, help="Footsteps N of miqcqp/kinematic (default: geometric lower bound + 2)."
+        None, help="Footsteps N of miqcqp/kinematic (default: the smallest N with a miqcqp plan)."
     ),
     time_limit: float = typer.Option(60.0, "--time-limit", help="Planner time limit [s]."),
     push: float = typer.Option(0.0, help="Push impulse [N s]; 0 for none."),
@@ -498,7 +498,7 @@ def compare_command(
     steps: str | None = typer.Option(
         None,
         help="Footsteps N of miqcqp/kinematic: one number, or per scene 'name=N,name=N' "
-        "(default: geometric lower bound + 2).",
+        "(default: the smallest N with a miqcqp plan).",
     ),
     time_limit: float = typer.Option(60.0, "--time-limit", help="Planner time limit [s]."),
     push_max: float = typer.Option(15.0, help="Push impulses uniform in [0, push_max] [N s]."),

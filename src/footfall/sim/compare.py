@@ -112,21 +112,14 @@ def make_plan(
 ) -> FootstepPlan:
     """Plan ``scene`` with ``planner`` (``miqcqp``, ``kinematic`` or ``reactive``).
 
-    ``n_steps`` (horizon planners only) defaults to the geometric lower bound plus 2.
+    ``n_steps`` (horizon planners only) defaults to the smallest N with a plan
+    (:func:`footfall.planning.plan_min_steps`).
     """
-    from footfall.planning.diagnose import min_steps_lower_bound
-    from footfall.planning.kinematic import plan_kinematic
-    from footfall.planning.miqcqp import plan_footsteps
-    from footfall.planning.reactive import plan_reactive
+    from footfall.planning.run import make_plan as plan_with
 
     if planner not in PLANNERS:
         raise InputError("planner", planner, f"one of {', '.join(PLANNERS)}")
-    if planner == "reactive":
-        return plan_reactive(scene)
-    n = n_steps if n_steps is not None else min_steps_lower_bound(scene, scene.robot) + 2
-    opts = PlannerOptions(time_limit=time_limit)
-    fn = plan_footsteps if planner == "miqcqp" else plan_kinematic
-    return fn(scene, n_steps=n, options=opts)
+    return plan_with(scene, planner, n_steps, PlannerOptions(time_limit=time_limit, threads=2))
 
 
 def cached_plan(
@@ -140,6 +133,11 @@ def cached_plan(
             plan = pickle.load(fh)
         if isinstance(plan, FootstepPlan):
             return plan
+    if planner == "kinematic" and n_steps is None:
+        # Compare like with like: the kinematic planner gets the footstep count of the
+        # full-horizon plan (its own smallest N ignores the torque the dynamics need).
+        full = cached_plan(cache, scene, "miqcqp", None, time_limit)
+        n_steps = full.n_steps if full.has_solution else None
     plan = make_plan(scene, planner, n_steps, time_limit)
     cache.mkdir(parents=True, exist_ok=True)
     with path.open("wb") as fh:
