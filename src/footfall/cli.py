@@ -114,6 +114,7 @@ def demo(out: Path = typer.Option(Path("out/demo"), help="Output folder.")) -> N
     labels = {
         "lip": "LIP walks (document 004)",
         "plans": "footstep plans (document 000)",
+        "closed_loop": "MPC closed loop (document 000 eq. 5.19)",
         "quadruped": "quadruped on a slope in MuJoCo (document 001)",
     }
     with console.status("footfall demo") as status:
@@ -744,3 +745,18 @@ def bench_plan_cmd(
     write_json(out / "bench_plan.json", {"runs": rows_to_dict(rows)})
     (out / "bench_plan.md").write_text(table + "\n")
     print(table)
+
+
+@bench_app.command("quadruped")
+def bench_quadruped_cmd(
+    slope_deg: float = typer.Option(15.0, help="Slope angle [deg]."),
+    body_deg: float = typer.Option(10.0, help="Body angle [deg]."),
+    out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_quadruped.json."),
+) -> None:
+    """Quadruped slope walk: simulated s per wall s vs bare mj_step, and gait-plan time."""
+    from footfall.sim.quadruped_sim import benchmark_quadruped
+
+    result = benchmark_quadruped(slope_deg=slope_deg, body_deg=body_deg)
+    write_json(out / "bench_quadruped.json", result)
+    for key, value in result.items():
+        console.print(f"{key}: {value}")

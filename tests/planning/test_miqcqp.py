@@ -272,3 +272,13 @@ def test_region_margin_keeps_footsteps_inside() -> None:
     assert "region" in check_plan(replace(plan, region_margin=0.2), sc).kinds()
     reactive = plan_reactive(sc, region_margin=margin)
     assert reactive.status is SolveStatus.FEASIBLE and check_plan(reactive, sc).ok
+
+
+def test_reactive_step_limit_counts_the_last_step() -> None:
+    """A limit equal to the steps the walk needs still reaches the goal (the limit is inclusive)."""
+    sc = scene(SHORT_FLAT)
+    free = plan_reactive(sc)
+    exact = plan_reactive(sc, max_steps=free.n_steps)
+    assert exact.status is SolveStatus.FEASIBLE and exact.n_steps == free.n_steps
+    short = plan_reactive(sc, max_steps=free.n_steps - 1)
+    assert short.status is SolveStatus.INFEASIBLE

@@ -167,7 +167,6 @@ def plan_reactive(
     torques: list[FloatArray] = []
     x = np.array(start.alip_state, dtype=float)
     message = ""
-    reached = False
     # Lateral momentum at the end of a step of a periodic gait with the nominal stance width
     # (Gong & Grizzle's ALIP foot placement).
     lx_mag = (
@@ -178,14 +177,15 @@ def plan_reactive(
         * math.sinh(omega * t_ss)
         / (1 + math.cosh(omega * t_ss))
     )
-    while len(feet) <= max_steps:
+
+    def at_goal() -> bool:
+        return len(feet) >= 2 and all(
+            np.linalg.norm(feet[-1 - j][:2] - feet_goal[sides[-1 - j]]) < 1e-6 for j in (0, 1)
+        )
+
+    while not (reached := at_goal()) and len(feet) <= max_steps:
         stance, th, side = feet[-1], headings[-1], sides[-1]
         nxt_side = side.other
-        if len(feet) >= 2 and all(
-            np.linalg.norm(feet[-1 - j][:2] - feet_goal[sides[-1 - j]]) < 1e-6 for j in (0, 1)
-        ):
-            reached = True
-            break
         # Heading: toward the goal position, then the goal heading when close.
         to_goal = scene.goal.position[:2] - stance[:2]
         dist = float(np.linalg.norm(to_goal))

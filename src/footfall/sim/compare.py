@@ -119,6 +119,8 @@ def make_plan(
 
     if planner not in PLANNERS:
         raise InputError("planner", planner, f"one of {', '.join(PLANNERS)}")
+    if planner == "reactive":
+        n_steps = None  # it walks until the goal; N applies to the horizon planners
     return plan_with(scene, planner, n_steps, PlannerOptions(time_limit=time_limit, threads=2))
 
 

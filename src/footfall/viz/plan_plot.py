@@ -27,7 +27,7 @@ def foot_outline(centre: np.ndarray, heading: float, length: float, width: float
 def plot_plan(plan: FootstepPlan, scene: Scene, path: Path, title: str | None = None) -> Path:
     """Top view (regions by height, numbered oriented feet, CoM path) and side view (x, z)."""
     fig, (ax, side) = plt.subplots(
-        2, 1, figsize=(9, 8), gridspec_kw={"height_ratios": [3, 1]}, constrained_layout=True
+        2, 1, figsize=(11, 6.5), gridspec_kw={"height_ratios": [2.2, 1]}, constrained_layout=True
     )
     norm = height_norm(scene.terrain)
     sm = plot_terrain(ax, scene.terrain, norm=norm, labels=False)
@@ -42,14 +42,6 @@ def plot_plan(plan: FootstepPlan, scene: Scene, path: Path, title: str | None = 
     if plan.states.shape[0]:
         com = plan.com_positions().reshape(-1, 2)
         ax.plot(com[:, 0], com[:, 1], "-", color="k", lw=1.2, label="CoM (ALIP nodes)")
-        side.plot(
-            com[:, 0],
-            np.repeat(plan.footsteps[: plan.n_steps, 2], robot.n_nodes) + robot.com_height,
-            ".",
-            color="k",
-            ms=2,
-            label="CoM height",
-        )
     g = scene.goal
     ax.plot(g.position[0], g.position[1], "*", color="gold", mec="k", ms=14, label="goal")
     # Frame the walk, not the whole terrain: footsteps and goal plus a margin.
@@ -71,5 +63,5 @@ def plot_plan(plan: FootstepPlan, scene: Scene, path: Path, title: str | None = 
     )
     side.set_xlabel("x [m]")
     side.set_ylabel("z [m]")
-    fig.colorbar(sm, ax=ax, label="region height z [m]", shrink=0.8)
+    fig.colorbar(sm, ax=ax, label="region height z [m]", shrink=0.9, pad=0.01)
     return save(fig, path)
