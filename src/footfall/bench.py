@@ -102,7 +102,9 @@ class BenchRow:
         """Instances where the two runs contradict each other beyond the gaps: both optimal with
         different objectives, a fast optimum outside a time-limited direct run's [bound,
         incumbent], or one infeasible where the other found a plan."""
-        out = []
+        out: list[str] = []
+        if not self.direct:  # --fast-only: nothing to compare against
+            return out
         for d, f in zip(self.direct, self.fast, strict=True):
             if d.status == f.status == SolveStatus.OPTIMAL.value:
                 tol = max(d.gap, f.gap, 0.0) + AGREE_SLACK

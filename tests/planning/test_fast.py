@@ -176,6 +176,14 @@ def test_bench_plan_cli_writes_the_table(tmp_path) -> None:  # type: ignore[no-u
     assert objs[0] == pytest.approx(objs[1], rel=2e-3)  # both within the bench's gap of 1e-3
     table = (tmp_path / "bench_plan.md").read_text()
     assert "| 5 | 3 | 5 | 1 |" in table and "all agree" in table and "all plans pass" in table
+    fast_only = subprocess.run(
+        [sys.executable, "-m", "footfall", "bench", "plan", "--steps", "5", "--nodes", "3",
+         "--seeds", "0", "--regions", "5", "--fast-only", "--out", str(tmp_path / "fast")],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert fast_only.returncode == 0, fast_only.stderr
+    runs = json.loads((tmp_path / "fast" / "bench_plan.json").read_text())["runs"]
+    assert {r["solver"] for r in runs} == {"bnb"}
     bad = subprocess.run(
         [sys.executable, "-m", "footfall", "bench", "plan", "--steps", "0"],
         capture_output=True, text=True, timeout=60,
