@@ -28,6 +28,7 @@ from footfall._validate import non_negative, positive
 from footfall.errors import FootfallError, InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.sim import biped_names as nm
+from footfall.sim._mjcf import box_inertia, fmt, rod_inertia
 
 FloatArray = NDArray[np.float64]
 
@@ -205,24 +206,6 @@ class BipedModel:
         return self.nominal_hip_height + self.hip_drop
 
 
-def _f(*values: float) -> str:
-    return " ".join(f"{v:.6g}" for v in values)
-
-
-def _box_inertia(mass: float, sx: float, sy: float, sz: float) -> tuple[float, float, float]:
-    return (
-        mass * (sy * sy + sz * sz) / 12.0,
-        mass * (sx * sx + sz * sz) / 12.0,
-        mass * (sx * sx + sy * sy) / 12.0,
-    )
-
-
-def _rod_inertia(mass: float, length: float, radius: float) -> tuple[float, float, float]:
-    """Slender rod along z: inertia about its centre [kg m^2]."""
-    transverse = mass * (3.0 * radius * radius + length * length) / 12.0
-    return transverse, transverse, 0.5 * mass * radius * radius
-
-
 def _joint_range(p: BipedModel, side: Side, index: int) -> tuple[float, float]:
     lo, hi = p.joint_range[index]
     # roll and yaw limits are given for the left leg; the right leg is its mirror image
@@ -234,11 +217,11 @@ def _joint_range(p: BipedModel, side: Side, index: int) -> tuple[float, float]:
 def _leg_xml(p: BipedModel, s: BipedSimSettings, side: Side) -> str:
     y = side.sign * p.hip_width / 2.0
     r = p.corner_radius
-    hl = _f(*_box_inertia(p.hip_link_mass, 0.06, 0.06, 0.06))
-    ti = _f(*_rod_inertia(p.thigh_mass, p.thigh_length, 0.04))
-    si = _f(*_rod_inertia(p.shank_mass, p.shank_length, 0.035))
+    hl = fmt(*box_inertia(p.hip_link_mass, 0.06, 0.06, 0.06))
+    ti = fmt(*rod_inertia(p.thigh_mass, p.thigh_length, 0.04))
+    si = fmt(*rod_inertia(p.shank_mass, p.shank_length, 0.035))
     foot_h = 0.03
-    fi = _f(*_box_inertia(p.foot_mass, p.foot_length, p.foot_width, foot_h))
+    fi = fmt(*box_inertia(p.foot_mass, p.foot_length, p.foot_width, foot_h))
     nocol = 'contype="0" conaffinity="0"'
     col = f'contype="{nm.ROBOT_CONTYPE}" conaffinity="{nm.ROBOT_CONAFFINITY}"'
 
@@ -246,18 +229,18 @@ def _leg_xml(p: BipedModel, s: BipedSimSettings, side: Side) -> str:
         lo, hi = _joint_range(p, side, i)
         return (
             f'<joint name="{nm.joint(side, nm.LEG_JOINTS[i])}" axis="{nm.LEG_JOINT_AXES[i]}" '
-            f'range="{_f(lo, hi)}"/>'
+            f'range="{fmt(lo, hi)}"/>'
         )
 
     corners = "\n".join(
         f'              <geom name="{nm.corner_geom(side, k)}" type="sphere" size="{r:.6g}" '
-        f'pos="{_f(cx * (p.foot_length / 2 - r), cy * (p.foot_width / 2 - r), -p.ankle_height + r)}" '
+        f'pos="{fmt(cx * (p.foot_length / 2 - r), cy * (p.foot_width / 2 - r), -p.ankle_height + r)}" '
         f'material="foot" friction="{s.friction:.6g} 0.02 0.002" {col}/>'
         for k, (cx, cy) in enumerate(nm.FOOT_CORNERS)
     )
     link = nm.link_body
     return f"""
-      <body name="{link(side, "hip_yaw")}" pos="{_f(0.0, y, -p.hip_drop)}">
+      <body name="{link(side, "hip_yaw")}" pos="{fmt(0.0, y, -p.hip_drop)}">
         {jnt(0)}
         <inertial pos="0 0 0" mass="{p.hip_link_mass:.6g}" diaginertia="{hl}"/>
         <body name="{link(side, "hip_roll")}">
@@ -284,7 +267,7 @@ def _leg_xml(p: BipedModel, s: BipedSimSettings, side: Side) -> str:
                   <inertial pos="0 0 {-p.ankle_height + foot_h / 2:.6g}"
                             mass="{p.foot_mass:.6g}" diaginertia="{fi}"/>
                   <geom name="{nm.foot_geom(side)}" type="box"
-                        size="{_f(p.foot_length / 2, p.foot_width / 2, foot_h / 2)}"
+                        size="{fmt(p.foot_length / 2, p.foot_width / 2, foot_h / 2)}"
                         pos="0 0 {-p.ankle_height + foot_h / 2:.6g}" material="foot" {nocol}/>
 {corners}
                   <site name="{nm.sole_site(side)}" pos="0 0 {-p.ankle_height:.6g}" size="0.01"/>
@@ -316,12 +299,12 @@ def biped_mjcf(
     p = params if params is not None else BipedModel()
     s = settings if settings is not None else BipedSimSettings()
     asset_xml, world_xml = terrain
-    pi = _f(*_box_inertia(p.pelvis_mass, *p.pelvis_size))
-    ti = _f(*_box_inertia(p.torso_mass, *p.torso_size))
+    pi = fmt(*box_inertia(p.pelvis_mass, *p.pelvis_size))
+    ti = fmt(*box_inertia(p.torso_mass, *p.torso_size))
     legs = "".join(_leg_xml(p, s, side) for side in (Side.LEFT, Side.RIGHT))
     actuators = "\n    ".join(
         f'<position name="{nm.actuator(side, j)}" joint="{nm.joint(side, j)}" '
-        f'kp="{s.kp:.6g}" kv="{s.kv:.6g}" forcerange="{_f(-s.torque_limit, s.torque_limit)}"/>'
+        f'kp="{s.kp:.6g}" kv="{s.kv:.6g}" forcerange="{fmt(-s.torque_limit, s.torque_limit)}"/>'
         for side in (Side.LEFT, Side.RIGHT)
         for j in nm.LEG_JOINTS
     )
@@ -356,11 +339,11 @@ def biped_mjcf(
       <camera name="{nm.TRACK_CAMERA}" mode="trackcom" pos="0.3 -2.6 0.6"
               xyaxes="1 0 0 0 0.2 1"/>
       <inertial pos="0 0 0" mass="{p.pelvis_mass:.6g}" diaginertia="{pi}"/>
-      <geom name="{nm.PELVIS_GEOM}" type="box" size="{_f(*(c / 2 for c in p.pelvis_size))}"
+      <geom name="{nm.PELVIS_GEOM}" type="box" size="{fmt(*(c / 2 for c in p.pelvis_size))}"
             material="body" {col}/>
       <body name="{nm.TORSO_BODY}" pos="0 0 {p.torso_offset:.6g}">
         <inertial pos="0 0 0" mass="{p.torso_mass:.6g}" diaginertia="{ti}"/>
-        <geom name="{nm.TORSO_GEOM}" type="box" size="{_f(*(c / 2 for c in p.torso_size))}"
+        <geom name="{nm.TORSO_GEOM}" type="box" size="{fmt(*(c / 2 for c in p.torso_size))}"
               material="body" {col}/>
       </body>{legs}
     </body>

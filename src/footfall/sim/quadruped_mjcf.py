@@ -27,6 +27,7 @@ from footfall._validate import non_negative, positive
 from footfall.errors import InputError
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
 from footfall.sim import quadruped_names as nm
+from footfall.sim._mjcf import box_inertia, fmt, rod_inertia
 
 #: joint axes in the parent body frame, in ``JOINT_NAMES`` order (ab/ad about x, pitch/knee about y)
 _JOINT_AXES = ("1 0 0", "0 1 0", "0 1 0")
@@ -60,24 +61,6 @@ class SimSettings:
         object.__setattr__(self, "armature", non_negative("sim.armature", self.armature))
 
 
-def _f(*values: float) -> str:
-    return " ".join(f"{v:.6g}" for v in values)
-
-
-def _box_inertia(mass: float, sx: float, sy: float, sz: float) -> tuple[float, float, float]:
-    return (
-        mass * (sy * sy + sz * sz) / 12.0,
-        mass * (sx * sx + sz * sz) / 12.0,
-        mass * (sx * sx + sy * sy) / 12.0,
-    )
-
-
-def _rod_inertia(mass: float, length: float, radius: float) -> tuple[float, float, float]:
-    """Slender rod along z: inertia about its centre [kg m^2]."""
-    transverse = mass * (3.0 * radius * radius + length * length) / 12.0
-    return transverse, transverse, 0.5 * mass * radius * radius
-
-
 def _quat_about_y(angle: float) -> tuple[float, float, float, float]:
     return math.cos(angle / 2.0), 0.0, math.sin(angle / 2.0), 0.0
 
@@ -88,8 +71,8 @@ def slope_floor_xml(slope: float, foot_radius: float) -> str:
     n = np.array([-math.sin(slope), 0.0, math.cos(slope)])
     pos = -foot_radius * n
     return (
-        f'<geom name="{nm.FLOOR_GEOM}" type="plane" size="40 8 0.1" pos="{_f(*pos)}" '
-        f'quat="{_f(*_quat_about_y(-slope))}" material="ground" '
+        f'<geom name="{nm.FLOOR_GEOM}" type="plane" size="40 8 0.1" pos="{fmt(*pos)}" '
+        f'quat="{fmt(*_quat_about_y(-slope))}" material="ground" '
         f'contype="{nm.GROUND_CONTYPE}" conaffinity="{nm.GROUND_CONAFFINITY}"/>'
     )
 
@@ -114,8 +97,8 @@ def stairs_xml(
         length = (steps - k) * run
         parts.append(
             f'<geom name="{nm.STAIR_GEOM_PREFIX}{k}" type="box" '
-            f'size="{_f(length / 2, width / 2, (top + foot_radius) / 2)}" '
-            f'pos="{_f(x0 + length / 2, 0.0, (top - foot_radius) / 2)}" material="stairs" '
+            f'size="{fmt(length / 2, width / 2, (top + foot_radius) / 2)}" '
+            f'pos="{fmt(x0 + length / 2, 0.0, (top - foot_radius) / 2)}" material="stairs" '
             f'contype="{nm.GROUND_CONTYPE}" conaffinity="{nm.GROUND_CONAFFINITY}"/>'
         )
     return "\n    ".join(parts)
@@ -127,26 +110,26 @@ def _leg_xml(robot: QuadrupedRobot, settings: SimSettings, leg_index: int) -> st
     l1, l2, r = robot.thigh_length, robot.shank_length, robot.foot_radius
     hip = robot.hip_offset(leg)
     thigh_r, shank_r = 0.035, 0.028
-    ti = _rod_inertia(robot.thigh_mass, l1, thigh_r)
-    si = _rod_inertia(robot.shank_mass, l2, shank_r)
+    ti = rod_inertia(robot.thigh_mass, l1, thigh_r)
+    si = rod_inertia(robot.shank_mass, l2, shank_r)
     hi_i = 0.4 * robot.hip_mass * 0.06**2  # solid sphere of radius 6 cm
     nocol = 'contype="0" conaffinity="0"'
     j = [nm.joint(leg, name) for name in JOINT_NAMES]
     return f"""
-      <body name="{nm.hip_body(leg)}" pos="{_f(*hip)}">
-        <joint name="{j[0]}" axis="{_JOINT_AXES[0]}" range="{_f(lo[0], hi[0])}"/>
-        <inertial pos="0 0 0" mass="{robot.hip_mass:.6g}" diaginertia="{_f(hi_i, hi_i, hi_i)}"/>
+      <body name="{nm.hip_body(leg)}" pos="{fmt(*hip)}">
+        <joint name="{j[0]}" axis="{_JOINT_AXES[0]}" range="{fmt(lo[0], hi[0])}"/>
+        <inertial pos="0 0 0" mass="{robot.hip_mass:.6g}" diaginertia="{fmt(hi_i, hi_i, hi_i)}"/>
         <geom type="sphere" size="0.06" material="joint" {nocol}/>
         <body name="{nm.thigh_body(leg)}">
-          <joint name="{j[1]}" axis="{_JOINT_AXES[1]}" range="{_f(lo[1], hi[1])}"/>
+          <joint name="{j[1]}" axis="{_JOINT_AXES[1]}" range="{fmt(lo[1], hi[1])}"/>
           <inertial pos="0 0 {-l1 / 2:.6g}" mass="{robot.thigh_mass:.6g}"
-                    diaginertia="{_f(*ti)}"/>
+                    diaginertia="{fmt(*ti)}"/>
           <geom type="capsule" fromto="0 0 0 0 0 {-l1:.6g}" size="{thigh_r}" material="leg"
                 {nocol}/>
           <body name="{nm.shank_body(leg)}" pos="0 0 {-l1:.6g}">
-            <joint name="{j[2]}" axis="{_JOINT_AXES[2]}" range="{_f(lo[2], hi[2])}"/>
+            <joint name="{j[2]}" axis="{_JOINT_AXES[2]}" range="{fmt(lo[2], hi[2])}"/>
             <inertial pos="0 0 {-l2 / 2:.6g}" mass="{robot.shank_mass:.6g}"
-                      diaginertia="{_f(*si)}"/>
+                      diaginertia="{fmt(*si)}"/>
             <geom type="capsule" fromto="0 0 0 0 0 {-l2:.6g}" size="{shank_r}" material="leg"
                   {nocol}/>
             <geom name="{nm.foot_geom(leg)}" type="sphere" size="{r:.6g}" pos="0 0 {-l2:.6g}"
@@ -175,11 +158,11 @@ def quadruped_mjcf(
         The MJCF document as a string.
     """
     s = settings if settings is not None else SimSettings()
-    bi = _box_inertia(robot.body_mass, robot.body_length, robot.body_width, robot.body_height)
+    bi = box_inertia(robot.body_mass, robot.body_length, robot.body_width, robot.body_height)
     legs = "".join(_leg_xml(robot, s, i) for i in range(len(LEGS)))
     actuators = "\n    ".join(
         f'<position name="{nm.actuator(leg, jn)}" joint={quoteattr(nm.joint(leg, jn))} '
-        f'kp="{s.kp:.6g}" kv="{s.kv:.6g}" forcerange="{_f(-s.torque_limit, s.torque_limit)}"/>'
+        f'kp="{s.kp:.6g}" kv="{s.kv:.6g}" forcerange="{fmt(-s.torque_limit, s.torque_limit)}"/>'
         for leg in LEGS
         for jn in JOINT_NAMES
     )
@@ -213,8 +196,8 @@ def quadruped_mjcf(
       <freejoint name="{nm.ROOT_JOINT}"/>
       <camera name="{nm.TRACK_CAMERA}" mode="trackcom" pos="0.6 -3.2 0.9"
               xyaxes="1 0 0 0 0.25 1"/>
-      <inertial pos="0 0 0" mass="{robot.body_mass:.6g}" diaginertia="{_f(*bi)}"/>
-      <geom name="{nm.TRUNK_GEOM}" type="box" size="{_f(*half)}" material="body"
+      <inertial pos="0 0 0" mass="{robot.body_mass:.6g}" diaginertia="{fmt(*bi)}"/>
+      <geom name="{nm.TRUNK_GEOM}" type="box" size="{fmt(*half)}" material="body"
             contype="{nm.ROBOT_CONTYPE}" conaffinity="{nm.ROBOT_CONAFFINITY}"/>{legs}
     </body>
   </worldbody>

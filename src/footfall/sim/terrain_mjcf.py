@@ -17,10 +17,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from footfall.sim import biped_names as nm
+from footfall.sim._mjcf import fmt as _fmt
 from footfall.terrain.region import Region
 from footfall.terrain.terrain import Terrain
 
 FloatArray = NDArray[np.float64]
+
+
+def _f(*values: float | np.floating) -> str:
+    # 9 digits: tilted region boxes must match their planes to well below 1e-6 m
+    return _fmt(*values, digits=9)
+
 
 #: depth of the terrain solids below the lowest region [m]
 BASE_DEPTH = 0.5
@@ -28,10 +35,6 @@ BASE_DEPTH = 0.5
 RAMP_THICKNESS = 0.3
 #: tolerance [m] / [rad] for recognising rectangles and horizontal edges
 SHAPE_TOL = 1e-9
-
-
-def _f(*values: float | np.floating) -> str:
-    return " ".join(f"{v:.9g}" for v in values)
 
 
 def _rectangle_axes(corners: FloatArray) -> tuple[FloatArray, FloatArray] | None:
