@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+
+from footfall._validate import non_negative, positive
 
 
 def fmt(*values: float | np.floating, digits: int = 6) -> str:
@@ -23,3 +27,31 @@ def rod_inertia(mass: float, length: float, radius: float) -> tuple[float, float
     """Slender rod along z: principal inertia about its centre [kg m^2]."""
     transverse = mass * (3.0 * radius * radius + length * length) / 12.0
     return transverse, transverse, 0.5 * mass * radius * radius
+
+
+@dataclass(frozen=True)
+class SimSettings:
+    """Physics and actuator settings of a generated model (defaults: the 100 kg quadruped).
+
+    Attributes:
+        timestep: physics step [s].
+        kp: position gain of every joint actuator [N m / rad].
+        kv: velocity gain (damping) of every joint actuator [N m s / rad].
+        torque_limit: actuator torque limit [N m].
+        friction: sliding friction coefficient between feet and ground.
+        impratio: ratio of frictional to normal constraint impedance (elliptic cone).
+        armature: rotor inertia added to each joint [kg m^2] (stabilises stiff position control).
+    """
+
+    timestep: float = 0.002
+    kp: float = 6000.0
+    kv: float = 120.0
+    torque_limit: float = 1500.0
+    friction: float = 1.0
+    impratio: float = 10.0
+    armature: float = 0.05
+
+    def __post_init__(self) -> None:
+        for name in ("timestep", "kp", "kv", "torque_limit", "friction", "impratio"):
+            object.__setattr__(self, name, positive(f"sim.{name}", getattr(self, name)))
+        object.__setattr__(self, "armature", non_negative("sim.armature", self.armature))

@@ -28,7 +28,7 @@ from footfall._validate import non_negative, positive
 from footfall.errors import FootfallError, InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.sim import biped_names as nm
-from footfall.sim._mjcf import box_inertia, fmt, rod_inertia
+from footfall.sim._mjcf import SimSettings, box_inertia, fmt, rod_inertia
 
 FloatArray = NDArray[np.float64]
 
@@ -47,31 +47,13 @@ def require_mujoco() -> Any:
 
 
 @dataclass(frozen=True)
-class BipedSimSettings:
-    """Physics and actuator settings of the generated model.
+class BipedSimSettings(SimSettings):
+    """:class:`SimSettings` with gains and limits for the 30 kg biped (see the base for fields)."""
 
-    Attributes:
-        timestep: physics step [s].
-        kp: position gain of every joint servo [N m / rad].
-        kv: velocity gain (damping) of every joint servo [N m s / rad].
-        torque_limit: actuator torque limit [N m].
-        friction: sliding friction coefficient between the feet and the terrain.
-        impratio: frictional to normal constraint impedance ratio (elliptic cone).
-        armature: rotor inertia added to each leg joint [kg m^2] (stabilises stiff servos).
-    """
-
-    timestep: float = 0.002
     kp: float = 5000.0
     kv: float = 100.0
     torque_limit: float = 300.0
-    friction: float = 1.0
-    impratio: float = 10.0
     armature: float = 0.02
-
-    def __post_init__(self) -> None:
-        for name in ("timestep", "kp", "kv", "torque_limit", "friction", "impratio"):
-            object.__setattr__(self, name, positive(f"sim.{name}", getattr(self, name)))
-        object.__setattr__(self, "armature", non_negative("sim.armature", self.armature))
 
 
 @dataclass(frozen=True)

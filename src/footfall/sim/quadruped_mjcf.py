@@ -18,47 +18,18 @@ default pyramidal cone, which ``cone="elliptic" impratio="10"`` stops.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from footfall._validate import non_negative, positive
+from footfall._validate import positive
 from footfall.errors import InputError
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
 from footfall.sim import quadruped_names as nm
-from footfall.sim._mjcf import box_inertia, fmt, rod_inertia
+from footfall.sim._mjcf import SimSettings, box_inertia, fmt, rod_inertia
 
 #: joint axes in the parent body frame, in ``JOINT_NAMES`` order (ab/ad about x, pitch/knee about y)
 _JOINT_AXES = ("1 0 0", "0 1 0", "0 1 0")
-
-
-@dataclass(frozen=True)
-class SimSettings:
-    """Physics and actuator settings of the generated model.
-
-    Attributes:
-        timestep: physics step [s].
-        kp: position gain of every joint actuator [N m / rad].
-        kv: velocity gain (damping) of every joint actuator [N m s / rad].
-        torque_limit: actuator torque limit [N m].
-        friction: sliding friction coefficient between feet and ground.
-        impratio: ratio of frictional to normal constraint impedance (elliptic cone).
-        armature: rotor inertia added to each joint [kg m^2] (stabilises stiff position control).
-    """
-
-    timestep: float = 0.002
-    kp: float = 6000.0
-    kv: float = 120.0
-    torque_limit: float = 1500.0
-    friction: float = 1.0
-    impratio: float = 10.0
-    armature: float = 0.05
-
-    def __post_init__(self) -> None:
-        for name in ("timestep", "kp", "kv", "torque_limit", "friction", "impratio"):
-            object.__setattr__(self, name, positive(f"sim.{name}", getattr(self, name)))
-        object.__setattr__(self, "armature", non_negative("sim.armature", self.armature))
 
 
 def _quat_about_y(angle: float) -> tuple[float, float, float, float]:
