@@ -254,6 +254,8 @@ def test_bad_options() -> None:
         PlannerOptions(time_limit=-1)
     with pytest.raises(InputError, match="heading_segments"):
         PlannerOptions(heading_segments=2)
+    with pytest.raises(InputError, match="threads"):
+        PlannerOptions(threads=0)
     with pytest.raises(InputError, match="solver"):
         PlannerOptions(solver="cplex")
 

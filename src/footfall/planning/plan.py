@@ -91,6 +91,8 @@ class PlannerOptions:
             raise InputError("heading_segments", self.heading_segments, "an integer >= 4")
         object.__setattr__(self, "time_limit", positive("time_limit", self.time_limit))
         object.__setattr__(self, "gap", non_negative("gap", self.gap))
+        if isinstance(self.threads, bool) or not isinstance(self.threads, int) or self.threads < 1:
+            raise InputError("threads", self.threads, "an integer >= 1")
         if self.solver not in KNOWN_BACKENDS:
             raise InputError("solver", self.solver, f"one of {', '.join(KNOWN_BACKENDS)}")
         object.__setattr__(self, "momentum_bound", positive("momentum_bound", self.momentum_bound))
