@@ -226,3 +226,16 @@ def test_flat_walk_of_twenty_steps_reaches_the_goal() -> None:
     for ax in range(2):
         slope = np.polyfit(res.zmp_planned[ok, ax], res.zmp_offset[ok, ax], 1)[0]
         assert COP_SLOPE[0] < slope < COP_SLOPE[1]
+
+
+def test_cli_compare_mujoco_writes_the_table(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    args = ["compare", "--sim", "mujoco", "--scenes", "flat", "--planners", "reactive"]
+    res = CliRunner().invoke(app, [*args, "--trials", "1", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    md = (tmp_path / "compare_mujoco.md").read_text()
+    assert "| flat | reactive | 1 |" in md
+    assert (tmp_path / "compare_mujoco.png").stat().st_size > 0
+    rows = (tmp_path / "compare_mujoco.csv").read_text().splitlines()
+    assert len(rows) == 2 and "zmp_mean_m" in rows[0]
+    bad = CliRunner().invoke(app, [*args, "--sim", "bogus", "--out", str(tmp_path / "x")])
+    assert isinstance(bad.exception, InputError) and bad.exception.field == "sim"

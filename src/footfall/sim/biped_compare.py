@@ -47,13 +47,17 @@ def plan_for_walk(
 
     check_planner_name(planner)
     robot = planner_params(model, base=scene.robot)
-    key = cache_key(scene.name, planner, n_steps, robot)
+    # the sole is not a point: keep its centre half a foot length inside every region, so the
+    # whole sole stands on the block (at the plan's headings, which stay near the scene's)
+    margin = robot.foot_length / 2.0
+    key = cache_key(scene.name, planner, n_steps, robot, margin)
     path = cache_dir / f"plan_{scene.name}_{planner}.json" if cache_dir is not None else None
     if path is not None:
         cached = load_plan(path, robot, key)
         if cached is not None:
             return cached
-    plan = make_plan(scene, planner, n_steps, PlannerOptions(time_limit=time_limit), robot)
+    opts = PlannerOptions(time_limit=time_limit, region_margin=margin)
+    plan = make_plan(scene, planner, n_steps, opts, robot)
     if path is not None and plan.has_solution:
         save_plan(path, plan, scene.name, key)
     return plan
@@ -180,3 +184,83 @@ def compare_table(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
             }
         )
     return out
+
+
+def write_mujoco_outputs(
+    out: Path, rows: Sequence[dict[str, Any]], table: Sequence[dict[str, Any]], header: str
+) -> list[Path]:
+    """Write compare_mujoco.csv (one row per walk), compare_mujoco.md (the table of section 5.5
+    with the verdict on document 000's claim) and compare_mujoco.png; return the paths."""
+    import csv
+
+    out.mkdir(parents=True, exist_ok=True)
+    csv_path = out / "compare_mujoco.csv"
+    fields = list(dict.fromkeys(k for r in rows for k in r))
+    with csv_path.open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields)
+        w.writeheader()
+        w.writerows(rows)
+    md = [
+        "# Planner comparison in MuJoCo (document 000, section 5.5)",
+        "",
+        header,
+        "",
+        "| scene | planner | walks | success | falls | mean ZMP offset [mm] | max ZMP offset [mm] |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in table:
+        if r["walks"] == 0:
+            md.append(f"| {r['scene']} | {r['planner']} | 0 (no plan) | | | | |")
+            continue
+        md.append(
+            f"| {r['scene']} | {r['planner']} | {r['walks']} | {100 * r['success_rate']:.0f}% "
+            f"| {100 * r['fall_rate']:.0f}% | {1000 * r['zmp_mean_m']:.1f} "
+            f"| {1000 * r['zmp_max_m']:.1f} |"
+        )
+    md += ["", "## Document 000's claim", ""]
+    for scene in dict.fromkeys(r["scene"] for r in table):
+        by = {r["planner"]: r for r in table if r["scene"] == scene and r["walks"] > 0}
+        ok = {p: r for p, r in by.items() if r["success_rate"] > 0}
+        if "miqcqp" not in by or len(by) < 2:
+            md.append(f"- {scene}: cannot be judged (no MIQCQP walk or no baseline walked).")
+        elif "miqcqp" not in ok:
+            md.append(
+                f"- {scene}: cannot be judged: no MIQCQP walk reached the goal (each fell or "
+                "stopped short), so its ZMP numbers do not describe walking the plan."
+            )
+        else:
+            ours = by["miqcqp"]["zmp_mean_m"]
+            others = {p: r["zmp_mean_m"] for p, r in by.items() if p != "miqcqp"}
+            verdict = "holds" if all(ours < v for v in others.values()) else "does NOT hold"
+            txt = ", ".join(f"{p} {1000 * v:.1f} mm" for p, v in others.items())
+            md.append(f"- {scene}: the claim {verdict}: miqcqp {1000 * ours:.1f} mm vs {txt}.")
+    md.append("")
+    md_path = out / "compare_mujoco.md"
+    md_path.write_text("\n".join(md))
+    fig_path = out / "compare_mujoco.png"
+    _plot_mujoco_table(table, fig_path)
+    return [csv_path, md_path, fig_path]
+
+
+def _plot_mujoco_table(table: Sequence[dict[str, Any]], path: Path) -> None:
+    from footfall.viz._mpl import plt
+
+    scenes = list(dict.fromkeys(r["scene"] for r in table))
+    fig, axes = plt.subplots(1, len(scenes), figsize=(4.5 * len(scenes), 3.6), squeeze=False)
+    for ax, scene in zip(axes[0], scenes, strict=True):
+        rs = [r for r in table if r["scene"] == scene and r["walks"] > 0]
+        names = [r["planner"] for r in rs]
+        mean = [1000 * r["zmp_mean_m"] for r in rs]
+        mx = [1000 * r["zmp_max_m"] for r in rs]
+        xs = np.arange(len(rs))
+        ax.bar(xs - 0.2, mean, 0.4, label="mean")
+        ax.bar(xs + 0.2, mx, 0.4, label="max")
+        for x, r in zip(xs, rs, strict=True):
+            ax.annotate(f"{100 * r['success_rate']:.0f}% ok", (x, max(mx) * 1.02), ha="center")
+        ax.set_xticks(xs, names)
+        ax.set_ylabel("single-support ZMP offset [mm]")
+        ax.set_title(scene)
+        ax.legend(loc="lower right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

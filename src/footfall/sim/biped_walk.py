@@ -979,7 +979,13 @@ def walk(
     src: FootstepAdjuster = (
         adjuster
         if adjuster is not None
-        else MPCAdjuster(plan, regions, control_dt=dt, stop_steps=opts.stop_steps)
+        else MPCAdjuster(
+            plan,
+            regions,
+            region_margin=plan.robot.foot_length / 2.0,
+            control_dt=dt,
+            stop_steps=opts.stop_steps,
+        )
     )
     n_planned = plan.n_steps
     plan = extend_plan(plan, opts.stop_steps)

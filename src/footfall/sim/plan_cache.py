@@ -22,11 +22,13 @@ from footfall.planning.plan_io import plan_to_dict
 from footfall.solvers.base import SolveStatus
 
 
-def cache_key(scene: str, planner: str, n_steps: int | None, robot: BipedParams) -> str:
+def cache_key(
+    scene: str, planner: str, n_steps: int | None, robot: BipedParams, margin: float = 0.0
+) -> str:
     """A string that changes whenever anything the plan depends on changes."""
     r = robot
     return (
-        f"{scene}|{planner}|N={n_steps}|m={r.mass:.6g}|zH={r.com_height:.6g}|tss={r.t_ss:.6g}|"
+        f"{scene}|{planner}|N={n_steps}|margin={margin:.6g}|m={r.mass:.6g}|zH={r.com_height:.6g}|tss={r.t_ss:.6g}|"
         f"tds={r.t_ds:.6g}|K={r.n_nodes}|umax={r.u_max:.6g}|w={r.stance_width:.6g}|"
         f"reach={np.round(r.reach.vertices, 6).tolist()}"
     )
