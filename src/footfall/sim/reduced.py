@@ -33,6 +33,12 @@ stops at the fall. The state also counts as fallen when it becomes non-finite. S
 *stops* (comes to rest without another step) when after the last footstep the capture point lies in
 the convex hull of the two final soles; ``success = not fell and stopped``.
 
+Engines. The loop runs either in Python (the reference: numpy and the :class:`MPC` class) or
+compiled with numba (:mod:`footfall.sim._reduced_kernel`, the default when numba is installed), which
+mirrors it operation by operation. Both read the same inputs, built once per run (plant matrices,
+noise, push table, the MPC's condensed matrices), and the metrics are computed from their
+trajectories by the same code, so they agree to rounding (tests check 1e-9).
+
 ZMP measure (document 000, section 5.5): the distance of the realised CoP from the stance foot centre
 at every control tick of every single support; mean, RMS and max over the walk and per phase.
 """
@@ -113,7 +119,7 @@ class SimOptions:
         solver: MPC backend, ``newton`` or ``clarabel``.
         engine: how the loop runs: ``python`` (the numpy reference), ``compiled`` (the same loop
             compiled with numba, newton solver only; same trajectories up to rounding, about
-            10-20x faster) or ``auto`` (compiled when numba is installed and the solver is
+            20x faster: ``footfall bench sim``) or ``auto`` (compiled when numba is installed and the solver is
             ``newton``).
     """
 
