@@ -93,8 +93,9 @@ def test_bench_sim_reports_both_engines_and_their_ratio(tmp_path: Path) -> None:
     assert rows[1]["max_com_diff"] <= 1e-9  # the same walk
     table = (tmp_path / "bench_sim.md").read_text()
     assert "x real time" in table and "speed ratio" in table and "| compiled |" in table
-    bad = run("bench", "sim", "--nodes", "1", "--out", str(tmp_path))
-    assert bad.returncode == 2 and "nodes" in bad.stderr + bad.stdout
+    for args, name in ((("--nodes", "1"), "nodes"), (("--runs", "0"), "runs")):
+        bad = run("bench", "sim", *args, "--out", str(tmp_path))
+        assert bad.returncode == 2 and name in bad.stderr + bad.stdout
 
 
 def test_simulate_rejects_an_unknown_engine(tmp_path: Path) -> None:

@@ -226,7 +226,7 @@ class SimMetrics:
     mpc_time_max: float
     sim_time: float
     wall_time: float
-    engine: str = "python"
+    engine: str
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (NaN becomes None)."""
