@@ -11,16 +11,18 @@ the naive baseline: ``pip install cvxpy``; it is imported lazily and is not a de
 3. Naive baseline: the same problem written in CVXPY the obvious way (states as variables, one per
    tick, ``cp.norm(u_j) <= U_max``), built and solved from scratch with Clarabel, on a subsample of
    the recorded ticks; ratio of medians, in the same run.
-4. Simulation speed: simulated time / wall time of whole closed-loop runs (MPC included) at 500 Hz.
+4. Simulation speed: simulated time / wall time of whole closed-loop runs (MPC included) at 500 Hz,
+   for the python (reference) and compiled (numba) engines alternately in the same run, and their
+   ratio (the same table as ``footfall bench sim``).
 """
 
 from __future__ import annotations
 
-import math
 import os
 import statistics
 import sys
 import time
+from dataclasses import replace
 from typing import ClassVar
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -28,9 +30,10 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np
 
 import footfall.sim.reduced as reduced
+from footfall.bench import bench_sim, bench_sim_options, format_sim_table
 from footfall.control import MPC, CondensedMPC, build_mpc
 from footfall.planning.reactive import plan_reactive
-from footfall.sim import Push, SimOptions, simulate
+from footfall.sim import simulate
 from footfall.terrain import builtin_scene
 
 K_NODES = 10
@@ -86,13 +89,9 @@ def main() -> None:
     scene = builtin_scene("flat")
     plan = plan_reactive(scene)
     reduced.MPC = RecordingMPC  # type: ignore[misc]
-    opts = SimOptions(
-        control_rate=RATE,
-        mpc_nodes=K_NODES,
-        noise_pos=0.002,
-        noise_vel=0.02,
-        pushes=(Push(1.0, 10.0, math.pi / 2), Push(3.0, 12.0, 0.3)),
-    )
+    # the disturbed walk of the speed table (noise, two pushes); the recording MPC class is the
+    # python engine's
+    opts = replace(bench_sim_options(RATE), mpc_nodes=K_NODES, engine="python")
     res = simulate(plan, opts, goal=scene.goal.position)
     reduced.MPC = MPC  # type: ignore[misc]
     calls = RecordingMPC.calls
@@ -167,17 +166,10 @@ def main() -> None:
             f"({hard_ratio:.0f}x slower than the MPC's hard cold instances)"
         )
 
-    # 4. simulation speed vs real time (MPC in the loop, default K of the plan and K = 10)
-    for k_nodes in (None, K_NODES):
-        o = SimOptions(control_rate=RATE, mpc_nodes=k_nodes, pushes=(Push(1.0, 10.0, 1.57),))
-        simulate(plan, o)  # build/cache the MPC outside the timing
-        runs = [simulate(plan, o).metrics for _ in range(3)]
-        speed = max(m.sim_time / m.wall_time for m in runs)
-        print(
-            f"reduced simulation at {RATE:g} Hz, MPC K={k_nodes or plan.robot.n_nodes}: "
-            f"{runs[0].sim_time:.1f} s simulated in {min(m.wall_time for m in runs):.3f} s "
-            f"-> {speed:.0f}x real time"
-        )
+    # 4. simulation speed vs real time, both engines in the same run (MPC in the loop, default K of
+    # the plan and K = 10)
+    rows = bench_sim(plan, (None, K_NODES), runs=5, options=bench_sim_options(RATE))
+    print(format_sim_table(rows))
     sys.stdout.flush()
 
 

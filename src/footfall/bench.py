@@ -1,4 +1,5 @@
-"""``footfall bench plan``: the direct SCIP model against the fast planner, same instances, one run.
+"""``footfall bench plan``: the direct SCIP model against the fast planner, same instances, one run;
+``footfall bench sim``: the reduced-order simulation's python and compiled engines, same walk, one run.
 
 Both solve the same MIQCQP (:func:`footfall.planning.miqcqp.build_footstep_problem`, document 000
 eq. 5.11-5.18); only the backend differs (``scip`` vs ``bnb``, see :mod:`footfall.planning.fast`).
@@ -16,7 +17,7 @@ import statistics
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from footfall.models.biped import BipedParams
 from footfall.planning.check import check_plan
@@ -24,6 +25,9 @@ from footfall.planning.miqcqp import plan_footsteps
 from footfall.planning.plan import FootstepPlan, PlannerOptions
 from footfall.solvers.base import SolveStatus
 from footfall.terrain.scene import Scene, builtin_scene, random_stepping_stones
+
+if TYPE_CHECKING:
+    from footfall.sim.reduced import SimOptions
 
 #: relative objective difference above which two optimal runs disagree (beyond both gaps)
 AGREE_SLACK = 1e-6
@@ -309,3 +313,170 @@ def rows_from_dict(runs: Sequence[dict[str, Any]]) -> list[BenchRow]:
         lo, hi = min(counts), max(counts)
         out.append(BenchRow(n, k, str(lo) if lo == hi else f"{lo}-{hi}", len(fast), direct, fast))
     return out
+
+
+# --- reduced-order simulation speed (issue 4) ---
+
+#: engines of the reduced-order simulation, in the order they are run and reported
+SIM_ENGINES = ("python", "compiled")
+
+
+@dataclass(frozen=True)
+class SimSpeed:
+    """Speed of one engine of :func:`footfall.sim.simulate` on one walk, over repeated runs.
+
+    Attributes:
+        engine: ``python`` (reference) or ``compiled``.
+        n_nodes: MPC nodes K (K - 1 torque blocks).
+        control_rate: control rate [Hz].
+        runs: timed runs.
+        sim_time: simulated time of one run [s].
+        wall_median: median wall time of a run [s].
+        wall_best: best wall time of a run [s].
+        mpc_median: median over the runs of the per-run median MPC solve time [s].
+        mpc_p99: median over the runs of the per-run 99th percentile MPC solve time [s].
+        mpc_solves: MPC solves per run.
+        mpc_fallbacks: failed MPC solves per run.
+        fell: the walk fell.
+        max_com_diff: largest CoM difference from the python engine's run [m] (0 for it).
+    """
+
+    engine: str
+    n_nodes: int
+    control_rate: float
+    runs: int
+    sim_time: float
+    wall_median: float
+    wall_best: float
+    mpc_median: float
+    mpc_p99: float
+    mpc_solves: int
+    mpc_fallbacks: int
+    fell: bool
+    max_com_diff: float
+
+    @property
+    def realtime(self) -> float:
+        """Simulated time over the median wall time ("x real time")."""
+        return self.sim_time / self.wall_median
+
+    @property
+    def realtime_best(self) -> float:
+        """Simulated time over the best wall time."""
+        return self.sim_time / self.wall_best
+
+
+def bench_sim_options(control_rate: float = 500.0) -> SimOptions:
+    """The disturbed walk of the benchmark: estimate noise (2 mm, 0.02 m/s) and two pushes, 10 N s
+    sideways at 1 s and 12 N s at 3 s (so the torque discs bind on about a tenth of the ticks)."""
+    from footfall.sim import Push, SimOptions
+
+    return SimOptions(
+        control_rate=control_rate,
+        noise_pos=0.002,
+        noise_vel=0.02,
+        pushes=(Push(1.0, 10.0, math.pi / 2), Push(3.0, 12.0, 0.3)),
+    )
+
+
+def bench_sim(
+    plan: FootstepPlan,
+    n_nodes: Sequence[int | None] = (None, 10),
+    runs: int = 5,
+    options: SimOptions | None = None,
+) -> list[SimSpeed]:
+    """Time both engines of the reduced-order closed loop on ``plan`` in the same run.
+
+    For every K the engines run alternately (python, compiled, python, ...) so that the load of a
+    shared machine hits both alike; one untimed run per engine first builds the MPC and loads the
+    compiled kernel. Speed is simulated time over wall time (MPC, plant and metrics included).
+
+    Args:
+        plan: a footstep plan with states.
+        n_nodes: MPC nodes K to run (None: the plan robot's K).
+        runs: timed runs per engine and K, >= 1.
+        options: simulation options (default :func:`bench_sim_options`); ``engine`` and
+            ``mpc_nodes`` are set by the benchmark.
+
+    Returns:
+        One :class:`SimSpeed` per (K, engine), engines in :data:`SIM_ENGINES` order.
+    """
+    import numpy as np
+
+    from footfall.errors import InputError
+    from footfall.sim import simulate
+
+    if isinstance(runs, bool) or not isinstance(runs, int) or runs < 1:
+        raise InputError("runs", runs, "an integer >= 1")
+    opts0 = bench_sim_options() if options is None else options
+    out: list[SimSpeed] = []
+    for k in n_nodes:
+        base = dataclasses.replace(opts0, mpc_nodes=k)
+        opts = {e: dataclasses.replace(base, engine=e) for e in SIM_ENGINES}
+        first = {e: simulate(plan, o) for e, o in opts.items()}  # warm-up, and the trajectories
+        timed: dict[str, list[Any]] = {e: [] for e in SIM_ENGINES}
+        for _ in range(runs):
+            for e, o in opts.items():
+                timed[e].append(simulate(plan, o).metrics)
+        ref = first[SIM_ENGINES[0]].com
+        for e in SIM_ENGINES:
+            ms = timed[e]
+            com = first[e].com
+            diff = float(np.abs(com - ref).max()) if com.shape == ref.shape else math.inf
+            walls = [m.wall_time for m in ms]
+            out.append(
+                SimSpeed(
+                    engine=e,
+                    n_nodes=plan.robot.n_nodes if k is None else int(k),
+                    control_rate=opts0.control_rate,
+                    runs=runs,
+                    sim_time=ms[0].sim_time,
+                    wall_median=statistics.median(walls),
+                    wall_best=min(walls),
+                    mpc_median=statistics.median(m.mpc_time_median for m in ms),
+                    mpc_p99=statistics.median(m.mpc_time_p99 for m in ms),
+                    mpc_solves=ms[0].mpc_solves,
+                    mpc_fallbacks=ms[0].mpc_fallbacks,
+                    fell=ms[0].fell,
+                    max_com_diff=diff,
+                )
+            )
+    return out
+
+
+def format_sim_table(rows: Sequence[SimSpeed]) -> str:
+    """Markdown table: per K and engine, x real time (median and best run), MPC solve median / p99,
+    failed solves, CoM agreement with the python engine, and the compiled / python speed ratio."""
+    lines = [
+        "| K | engine | simulated [s] | wall median [s] | x real time (median / best) | "
+        "MPC median / p99 [us] | failed solves | max CoM diff [m] | speed ratio |",
+        "|" + "---|" * 9,
+    ]
+    base: dict[int, float] = {}
+    for r in rows:
+        if r.engine == SIM_ENGINES[0]:
+            base[r.n_nodes] = r.realtime
+        ratio = r.realtime / base[r.n_nodes] if r.n_nodes in base else math.nan
+        lines.append(
+            f"| {r.n_nodes} | {r.engine} | {r.sim_time:.2f} | {r.wall_median:.4f} | "
+            f"{r.realtime:.0f}x / {r.realtime_best:.0f}x | "
+            f"{1e6 * r.mpc_median:.1f} / {1e6 * r.mpc_p99:.1f} | {r.mpc_fallbacks}/{r.mpc_solves} | "
+            f"{r.max_com_diff:.1e} | {ratio:.1f}x |"
+        )
+    rate = rows[0].control_rate if rows else math.nan
+    lines.append("")
+    lines.append(
+        f"control rate {rate:g} Hz; x real time = simulated time / wall time of a whole run (MPC, "
+        "plant, metrics); speed ratio = x real time over the python engine's, same run; MPC times "
+        "are per control tick (python: the MPC.solve_theta call; compiled: the compiled solve, "
+        "timed inside the kernel)"
+    )
+    return "\n".join(lines)
+
+
+def sim_speed_to_dict(rows: Sequence[SimSpeed]) -> list[dict[str, Any]]:
+    """JSON-ready form of the rows (with the derived x real time)."""
+    return [
+        {**dataclasses.asdict(r), "realtime": r.realtime, "realtime_best": r.realtime_best}
+        for r in rows
+    ]

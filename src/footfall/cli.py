@@ -414,6 +414,9 @@ def simulate_command(
     com_height_scale: float = typer.Option(1.0, help="True CoM height / model CoM height."),
     rate: float = typer.Option(500.0, help="Control rate [Hz]."),
     seed: int = typer.Option(0, help="Random seed."),
+    engine: str = typer.Option(
+        "auto", help="Loop engine: auto, compiled (numba) or python (reference)."
+    ),
     out: Path = typer.Option(Path("out/simulate"), help="Output folder."),
 ) -> None:
     """Plan a scene, walk it in closed loop (MPC eq. 5.19 on the ALIP plant), write sim.json + figures."""
@@ -437,6 +440,7 @@ def simulate_command(
         else (),
         placement_error=placement_error,
         seed=seed,
+        engine=engine,
     )
     sc = _scene_arg(scene)
     assert isinstance(sc, Scene)
@@ -473,6 +477,7 @@ def simulate_command(
                 "mass_scale": mass_scale,
                 "com_height_scale": com_height_scale,
                 "seed": seed,
+                "engine": m.engine,
             },
             "metrics": m.to_dict(),
             "footsteps": res.footsteps.tolist(),
@@ -806,6 +811,57 @@ def bench_plan_cmd(
     out.mkdir(parents=True, exist_ok=True)
     write_json(out / "bench_plan.json", {"runs": rows_to_dict(rows)})
     (out / "bench_plan.md").write_text(table + "\n")
+    print(table)
+
+
+@bench_app.command("sim")
+def bench_sim_cmd(
+    scene: str = typer.Option("flat", "--scene", help="Built-in scene name or YAML file."),
+    planner: str = typer.Option(
+        "reactive", help="Planner of the walk: miqcqp, kinematic, reactive."
+    ),
+    nodes: str = typer.Option(
+        "plan,10", help="MPC nodes K, comma separated ('plan': the plan robot's K)."
+    ),
+    runs: int = typer.Option(5, help="Timed runs per engine and K."),
+    rate: float = typer.Option(500.0, help="Control rate [Hz]."),
+    out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_sim.json/.md."),
+) -> None:
+    """Reduced-order closed loop (issue 4): x real time of the python and compiled engines.
+
+    The walk has estimate noise and two pushes; the engines run alternately in the same run.
+    """
+    from footfall.bench import bench_sim, bench_sim_options, format_sim_table, sim_speed_to_dict
+    from footfall.planning.plan import check_planner_name
+    from footfall.sim.compare import make_plan
+    from footfall.terrain.scene import Scene
+
+    check_planner_name(planner)
+    k_list: list[int | None] = []
+    for item in (s.strip() for s in nodes.split(",")):
+        if item == "plan":
+            k_list.append(None)
+        elif item.isdigit() and int(item) >= 2:
+            k_list.append(int(item))
+        else:
+            raise InputError(
+                "nodes", nodes, "comma-separated integers >= 2 or 'plan', e.g. plan,10"
+            )
+    sc = _scene_arg(scene)
+    assert isinstance(sc, Scene)
+    plan = make_plan(sc, planner)
+    if not plan.has_solution:
+        from footfall.errors import InfeasibleError
+
+        raise InfeasibleError(f"{planner} found no plan for {sc.name}: {plan.message}")
+    rows = bench_sim(plan, k_list, runs=runs, options=bench_sim_options(rate))
+    table = format_sim_table(rows)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(
+        out / "bench_sim.json",
+        {"scene": sc.name, "planner": planner, "rows": sim_speed_to_dict(rows)},
+    )
+    (out / "bench_sim.md").write_text(table + "\n")
     print(table)
 
 

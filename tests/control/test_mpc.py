@@ -303,3 +303,22 @@ def test_bad_inputs_raise_input_errors(model: CondensedMPC) -> None:
         build_mpc(ROBOT, control_dt=-0.002)
     with pytest.raises(InputError, match="n_nodes"):
         build_mpc(ROBOT, n_nodes=1)
+
+
+def test_padded_matrices_hold_the_per_tick_matrices(model: CondensedMPC) -> None:
+    pad = model.padded
+    assert pad is model.padded  # built once
+    nu = 2 * (model.n_nodes - 1)
+    assert pad.p_scaled.shape == (model.n_ticks, nu, nu) and pad.u_max == ROBOT.u_max
+    for k in range(model.n_ticks):
+        n = 2 * model.n_blocks(k)
+        assert pad.n_b[k] == model.n_blocks(k) and pad.first_block[k] == model.first_block[k]
+        for padded, exact in (
+            (pad.p_scaled[k], model._p_scaled[k]),
+            (pad.q_map[k], model._q_map[k]),
+            (pad.gain[k], model._gain[k]),
+            (pad.d_u[k].T, model._d_u[k].T),
+        ):
+            np.testing.assert_array_equal(padded[:n, : exact.shape[1]], exact)
+            assert not padded[n:].any() and not padded[:, exact.shape[1] :].any()
+        np.testing.assert_array_equal(pad.d_theta[k], model._d_theta[k])

@@ -25,6 +25,8 @@ def test_simulate_writes_metrics_and_figures(tmp_path: Path) -> None:
         "reactive",
         "--push",
         "5",
+        "--engine",
+        "python",
         "--out",
         str(tmp_path),
     )
@@ -32,6 +34,7 @@ def test_simulate_writes_metrics_and_figures(tmp_path: Path) -> None:
     data = json.loads((tmp_path / "sim.json").read_text())
     m = data["metrics"]
     assert m["fell"] is False and m["zmp_offset_max"] >= m["zmp_offset_mean"] > 0
+    assert data["options"]["engine"] == m["engine"] == "python"
     for name in ("sim_top.png", "sim_zmp.png", "sim_torque.png"):
         assert (tmp_path / name).stat().st_size > 0
 
@@ -76,3 +79,25 @@ def test_bad_input_exits_2_with_the_valid_choices(
     r = run(*args, "--out", str(tmp_path))
     assert r.returncode == 2
     assert needle in " ".join((r.stderr + r.stdout).split())
+
+
+def test_bench_sim_reports_both_engines_and_their_ratio(tmp_path: Path) -> None:
+    r = run("bench", "sim", "--runs", "1", "--nodes", "plan", "--out", str(tmp_path))
+    assert r.returncode == 0, r.stderr
+    rows = json.loads((tmp_path / "bench_sim.json").read_text())["rows"]
+    assert [row["engine"] for row in rows] == ["python", "compiled"]
+    for row in rows:
+        assert row["realtime"] == pytest.approx(row["sim_time"] / row["wall_median"])
+        assert row["mpc_solves"] > 0 and row["mpc_fallbacks"] == 0 and not row["fell"]
+        assert 0 < row["mpc_median"] <= row["mpc_p99"]
+    assert rows[1]["max_com_diff"] <= 1e-9  # the same walk
+    table = (tmp_path / "bench_sim.md").read_text()
+    assert "x real time" in table and "speed ratio" in table and "| compiled |" in table
+    for args, name in ((("--nodes", "1"), "nodes"), (("--runs", "0"), "runs")):
+        bad = run("bench", "sim", *args, "--out", str(tmp_path))
+        assert bad.returncode == 2 and name in bad.stderr + bad.stdout
+
+
+def test_simulate_rejects_an_unknown_engine(tmp_path: Path) -> None:
+    bad = run("simulate", "--planner", "reactive", "--engine", "gpu", "--out", str(tmp_path))
+    assert bad.returncode == 2 and "engine" in bad.stderr + bad.stdout

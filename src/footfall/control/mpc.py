@@ -51,6 +51,7 @@ import math
 import time
 from dataclasses import dataclass, field
 from enum import Enum
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -203,6 +204,15 @@ class CondensedMPC:
     _powers: FloatArray = field(repr=False, default_factory=lambda: np.zeros((0, 4, 4)))
     _sums: FloatArray = field(repr=False, default_factory=lambda: np.zeros((0, 4, 2)))
 
+    @cached_property
+    def padded(self) -> PaddedMPC:
+        """The per-tick matrices of the solver stacked into zero-padded arrays (built once).
+
+        The compiled engine (:mod:`footfall.sim._reduced_kernel`) reads these instead of the
+        tuples; they hold exactly the same numbers.
+        """
+        return pad_condensed(self)
+
     def n_blocks(self, k_s: int) -> int:
         """Number of remaining torque blocks at tick ``k_s``."""
         return int(self.block_ticks[k_s].shape[0])
@@ -240,6 +250,62 @@ class CondensedMPC:
         zz = np.asarray(z, dtype=float)
         th = np.asarray(theta, dtype=float)
         return float(0.5 * zz @ self.H[k_s] @ zz + zz @ self.F[k_s] @ th + th @ self.c[k_s] @ th)
+
+
+@dataclass(frozen=True, eq=False)
+class PaddedMPC:
+    """The solver's view of a :class:`CondensedMPC`: per-tick matrices stacked along a first axis
+    of length M and zero-padded to the largest number of torque variables ``NU = 2 (K - 1)``.
+
+    At tick ``k_s`` only the leading ``n_u = 2 n_b[k_s]`` rows / columns are meaningful. Scaled
+    torques ``v = u / U_max`` (the balls of eq. 5.19e have radius 1); the footstep is eliminated.
+
+    Attributes:
+        n_b: remaining torque blocks per tick, shape (M,).
+        first_block: global index of the first remaining block per tick, shape (M,).
+        p_scaled: reduced Hessian in ``v``, shape (M, NU, NU).
+        q_map: linear term of the reduced problem ``q = q_map theta``, shape (M, NU, 10).
+        gain: unconstrained minimiser ``u = gain theta`` [N m], shape (M, NU, 10).
+        d_theta: footstep offset ``d = d_theta theta + d_u u`` [m], shape (M, 2, 10).
+        d_u: shape (M, 2, NU) [m / (N m)].
+        u_max: torque bound U_max [N m].
+    """
+
+    n_b: NDArray[np.int64]
+    first_block: NDArray[np.int64]
+    p_scaled: FloatArray
+    q_map: FloatArray
+    gain: FloatArray
+    d_theta: FloatArray
+    d_u: FloatArray
+    u_max: float
+
+
+def pad_condensed(mdl: CondensedMPC) -> PaddedMPC:
+    """Stack the per-tick solver matrices of ``mdl`` into a :class:`PaddedMPC`."""
+    m = mdl.n_ticks
+    nu = 2 * (mdl.n_nodes - 1)
+    n_b = np.array([mdl.n_blocks(k) for k in range(m)], dtype=np.int64)
+    p_scaled = np.zeros((m, nu, nu))
+    q_map = np.zeros((m, nu, N_THETA))
+    gain = np.zeros((m, nu, N_THETA))
+    d_u = np.zeros((m, 2, nu))
+    for k in range(m):
+        n = 2 * int(n_b[k])
+        p_scaled[k, :n, :n] = mdl._p_scaled[k]
+        q_map[k, :n] = mdl._q_map[k]
+        gain[k, :n] = mdl._gain[k]
+        d_u[k, :, :n] = mdl._d_u[k]
+    return PaddedMPC(
+        n_b=n_b,
+        first_block=np.array(mdl.first_block, dtype=np.int64),
+        p_scaled=p_scaled,
+        q_map=q_map,
+        gain=gain,
+        d_theta=np.array(mdl._d_theta),
+        d_u=d_u,
+        u_max=float(mdl.robot.u_max),
+    )
 
 
 def _check_int(name: str, value: object, lo: int) -> int:
