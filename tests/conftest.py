@@ -1,6 +1,9 @@
 """Shared test settings: named tolerances, headless rendering."""
 
 import os
+from dataclasses import replace
+
+from footfall.planning.plan import FootstepPlan
 
 # MuJoCo picks its GL backend at import; offscreen EGL works headless (tests that render say so).
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -11,3 +14,18 @@ INTEGRATION_TOL = 1e-7
 #: solve_ivp tolerances used as the independent reference
 IVP_RTOL = 1e-11
 IVP_ATOL = 1e-12
+
+
+def first_steps(plan: FootstepPlan, n: int) -> FootstepPlan:
+    """The first ``n`` single supports of ``plan`` (a short walk, fast to simulate); the final
+    state is the plan's state at the start of phase ``n``."""
+    return replace(
+        plan,
+        footsteps=plan.footsteps[: n + 1],
+        headings=plan.headings[: n + 1],
+        sides=plan.sides[: n + 1],
+        regions=plan.regions[: n + 1],
+        states=plan.states[:n],
+        torques=plan.torques[:n],
+        final_state=plan.states[n, 0],
+    )

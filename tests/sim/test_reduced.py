@@ -16,7 +16,7 @@ from footfall.planning.reactive import plan_reactive
 from footfall.sim import Push, SimOptions, simulate
 from footfall.sim.reduced import viability_bounds
 from footfall.terrain import builtin_scene
-from tests.conftest import IVP_ATOL, IVP_RTOL
+from tests.conftest import IVP_ATOL, IVP_RTOL, first_steps
 
 #: plant CoM vs the solve_ivp integration of the CoM dynamics [m]
 PLANT_TOL = 1e-7
@@ -34,17 +34,7 @@ def flat_plan() -> FootstepPlan:
 @pytest.fixture(scope="module")
 def short_plan(flat_plan: FootstepPlan) -> FootstepPlan:
     """The first 3 steps of the flat walk (fast to simulate)."""
-    n = 3
-    return replace(
-        flat_plan,
-        footsteps=flat_plan.footsteps[: n + 1],
-        headings=flat_plan.headings[: n + 1],
-        sides=flat_plan.sides[: n + 1],
-        regions=flat_plan.regions[: n + 1],
-        states=flat_plan.states[:n],
-        torques=flat_plan.torques[:n],
-        final_state=flat_plan.states[n, 0],
-    )
+    return first_steps(flat_plan, 3)
 
 
 def test_plant_matches_solve_ivp_of_the_com_dynamics(short_plan: FootstepPlan) -> None:

@@ -19,6 +19,7 @@ from footfall.planning.plan import FootstepPlan
 from footfall.planning.reactive import plan_reactive
 from footfall.sim import Push, SimOptions, SimResult, simulate
 from footfall.terrain import builtin_scene
+from tests.conftest import first_steps
 
 kernel = pytest.importorskip("footfall.sim._reduced_kernel")
 
@@ -45,17 +46,7 @@ def flat_plan() -> FootstepPlan:
 @pytest.fixture(scope="module")
 def short_plan(flat_plan: FootstepPlan) -> FootstepPlan:
     """The first 3 steps of the flat walk."""
-    n = 3
-    return replace(
-        flat_plan,
-        footsteps=flat_plan.footsteps[: n + 1],
-        headings=flat_plan.headings[: n + 1],
-        sides=flat_plan.sides[: n + 1],
-        regions=flat_plan.regions[: n + 1],
-        states=flat_plan.states[:n],
-        torques=flat_plan.torques[:n],
-        final_state=flat_plan.states[n, 0],
-    )
+    return first_steps(flat_plan, 3)
 
 
 @pytest.fixture(scope="module")

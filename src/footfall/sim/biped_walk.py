@@ -374,12 +374,22 @@ class PlanFollower:
             if norm > self.max_correction:
                 fb *= self.max_correction / norm
             target[:2] = ref_next[:2] + shift + fb
-            if self.limit_reach:
-                target = self._limit_reach(target, stance, phase)
-            target = self._clamp_to_region(target, ref_next, plan.regions[phase + 1])
-        if t >= self.freeze_after * plan.robot.t_ss:
+            target = self._legal(target, ref_next, stance, phase)
+        return self._maybe_freeze(t, phase, target), u
+
+    def _legal(
+        self, target: FloatArray, ref_next: FloatArray, stance: FloatArray, phase: int
+    ) -> FloatArray:
+        """``target`` in the reach trapezoid (with ``limit_reach``) and in its planned region."""
+        if self.limit_reach:
+            target = self._limit_reach(target, stance, phase)
+        return self._clamp_to_region(target, ref_next, self.plan.regions[phase + 1])
+
+    def _maybe_freeze(self, t: float, phase: int, target: FloatArray) -> FloatArray:
+        """Freeze the footstep of ``phase`` once ``t`` passes ``freeze_after`` of T_ss."""
+        if t >= self.freeze_after * self.plan.robot.t_ss:
             self._frozen[phase] = target
-        return target, u
+        return target
 
     def stop_target(
         self, t: float, state: FloatArray, stance: FloatArray, phase: int, u: FloatArray
@@ -489,12 +499,8 @@ class MPCAdjuster(PlanFollower):
             target[:2] = self.stop_target(t, state, stance, phase, u)
         else:
             target = np.array(sol.next_footstep)
-        if self.limit_reach:
-            target = self._limit_reach(target, stance, phase)
-        target = self._clamp_to_region(target, ref_next, plan.regions[phase + 1])
-        if t >= self.freeze_after * plan.robot.t_ss:
-            self._frozen[phase] = target
-        return target, u
+        target = self._legal(target, ref_next, stance, phase)
+        return self._maybe_freeze(t, phase, target), u
 
 
 # ============================================================================= geometry helpers
