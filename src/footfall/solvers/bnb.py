@@ -88,6 +88,9 @@ REDUCED_COST_FIXING = False
 BRANCH_SELECT = "violation"
 #: split: "sos" (members in index order at the weighted mean) or "nearest" (one member vs rest)
 BRANCH_SPLIT = "sos"
+#: strong branching: solve the children of this many best candidate groups and split the one whose
+#: weaker child bound rises most (0 or 1: no strong branching)
+STRONG = 0
 
 
 class UnsupportedProblem(ValueError):
@@ -200,27 +203,34 @@ def _drop_redundant(
 ) -> tuple[FloatArray, FloatArray]:
     """Remove rows implied by the box that the bounds and the single-variable rows define.
 
-    Single-variable rows are kept (they bound the member's copies). Removing implied rows leaves
-    the member's set unchanged.
+    The single-variable rows of one variable and direction are replaced by the tightest of them
+    (they bound the member's copies; e.g. the Fourier-Motzkin rows of the private sin/cos bound the
+    heading less than the segment's own rows do). Removing implied rows leaves the member's set
+    unchanged.
     """
     if not len(beta):
         return a_v, beta
     lo, hi = lb.copy(), ub.copy()
+    has_lo = np.zeros(len(lb), dtype=bool)
+    has_hi = np.zeros(len(lb), dtype=bool)
     nnz = np.count_nonzero(a_v, axis=1)
     for j in np.flatnonzero(nnz == 1):
         c = int(np.flatnonzero(a_v[j])[0])
         v = a_v[j, c]
         if v > 0:
             hi[c] = min(hi[c], beta[j] / v)
+            has_hi[c] = True
         else:
             lo[c] = max(lo[c], beta[j] / v)
+            has_lo[c] = True
     top = np.sum(np.maximum(a_v * lo, a_v * hi), axis=1)
-    keep = (nnz == 1) | ~(top <= beta - REDUNDANT_TOL * np.maximum(1.0, np.abs(beta)))
-    keep &= nnz > 0
+    keep = (nnz > 1) & ~(top <= beta - REDUNDANT_TOL * np.maximum(1.0, np.abs(beta)))
     # a row with no variables left is kept only if it is violated (the member is impossible)
-    empty = (nnz == 0) & (beta < -REDUNDANT_TOL)
-    keep |= empty
-    return a_v[keep], beta[keep]
+    keep |= (nnz == 0) & (beta < -REDUNDANT_TOL)
+    eye = np.eye(len(lb))
+    rows = [a_v[keep], eye[has_hi], -eye[has_lo]]
+    rhs = [beta[keep], hi[has_hi], -lo[has_lo]]
+    return np.vstack(rows), np.concatenate(rhs)
 
 
 def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
@@ -1068,11 +1078,12 @@ def _rounded(x: FloatArray, allowed: tuple[tuple[int, ...], ...]) -> tuple[tuple
     return tuple(m if len(m) == 1 else (m[int(np.argmax(_weights(x, m)))],) for m in allowed)
 
 
-def _branch(
+def _candidates(
     s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], tol: float
-) -> tuple[tuple[tuple[int, ...], ...], tuple[tuple[int, ...], ...]] | None:
-    """Split a violated group (see ``BRANCH_SELECT``) into two halves (see ``BRANCH_SPLIT``)."""
-    best, best_g = -math.inf, -1
+) -> list[int]:
+    """Groups with every member violated at ``x``, best branching candidate first (see
+    ``BRANCH_SELECT``)."""
+    scored: list[tuple[float, int]] = []
     for g, mem in enumerate(allowed):
         if len(mem) < 2:
             continue
@@ -1085,24 +1096,37 @@ def _branch(
             score = 1.0 - float(np.max(_weights(x, mem)))
         else:  # "first"
             score = -g
-        if score > best:
-            best, best_g = score, g
-    if best_g < 0:
-        return None
-    mem = allowed[best_g]
+        scored.append((-score, g))
+    scored.sort()
+    return [g for _, g in scored]
+
+
+def _split(
+    s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], g: int
+) -> tuple[tuple[tuple[int, ...], ...], tuple[tuple[int, ...], ...]]:
+    """Split group ``g`` into two halves (see ``BRANCH_SPLIT``)."""
+    mem = allowed[g]
     w = _weights(x, mem)
     if BRANCH_SPLIT == "sos":
         centre = float(np.dot(w, np.arange(len(mem)))) / max(float(np.sum(w)), 1e-12)
         k = min(max(round(centre + 0.5), 1), len(mem) - 1)
         one, other = mem[:k], mem[k:]
     else:  # "nearest": the least violated member against the rest
-        z = mem[int(np.argmin(_violations(s, x, best_g, mem)))]
+        z = mem[int(np.argmin(_violations(s, x, g, mem)))]
         one, other = (z,), tuple(m for m in mem if m != z)
     left = [*allowed]
     right = [*allowed]
-    left[best_g] = one
-    right[best_g] = other
+    left[g] = one
+    right[g] = other
     return tuple(left), tuple(right)
+
+
+def _branch(
+    s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], tol: float
+) -> tuple[tuple[tuple[int, ...], ...], tuple[tuple[int, ...], ...]] | None:
+    """Split the best violated group (see ``BRANCH_SELECT``) into two halves (``BRANCH_SPLIT``)."""
+    cands = _candidates(s, x, allowed, tol)
+    return _split(s, x, allowed, cands[0]) if cands else None
 
 
 def _finish(s: _Structure, x: FloatArray, chosen: tuple[tuple[int, ...], ...]) -> FloatArray:
@@ -1208,6 +1232,7 @@ class _Search:
         self.failed = False
         self.lost_bound = math.inf
         self.fixed_by_duals = 0
+        self.strong_solves = 0
         #: (nodes, seconds, incumbent or None, best bound) every 25 nodes
         self.trace: list[tuple[int, float, float | None, float]] = []
         if options.initial_solution is not None:
@@ -1369,6 +1394,12 @@ class _Search:
                     if not all(allowed):
                         continue  # every member of some group is worse than the incumbent
                     self.fixed_by_duals += sum(map(len, node.allowed)) - sum(map(len, allowed))
+                if STRONG > 1:
+                    done = self.strong(node, allowed, pool)
+                    if done is not None:
+                        for child, res in done:
+                            self.evaluate(child, node.bound, node.depth + 1, node.full, res)
+                        continue
                 split = _branch(self.s, node.x, allowed, ROW_TOL)
                 if split is None:  # pragma: no cover - evaluate() resolved such nodes
                     continue
@@ -1381,6 +1412,35 @@ class _Search:
                 for (child, node), res in zip(tasks, results, strict=True):
                     self.evaluate(child, node.bound, node.depth + 1, node.full, res)
         return False
+
+    def strong(
+        self, node: _Node, allowed: tuple[tuple[int, ...], ...], pool: Any
+    ) -> list[tuple[tuple[tuple[int, ...], ...], _Relaxation]] | None:
+        """Strong branching over the ``STRONG`` best candidates: the children (with their solved
+        relaxations) of the split whose children bounds rise most (product score)."""
+        assert node.x is not None
+        cands = _candidates(self.s, node.x, allowed, ROW_TOL)[:STRONG]
+        if len(cands) < 2:
+            return None
+        splits = [_split(self.s, node.x, allowed, g) for g in cands]
+        flat = [child for sp_ in splits for child in sp_]
+        if pool is None:
+            results = [self.relax.solve(c, full=node.full) for c in flat]
+        else:
+            results = pool.map(_work, [(c, node.full) for c in flat])
+        self.strong_solves += len(flat) - 2
+        best, best_i = -math.inf, 0
+        for i in range(len(splits)):
+            gains = []
+            for res in results[2 * i : 2 * i + 2]:
+                b = res.bound if res.status == "solved" else math.inf
+                if res.status == "failed":
+                    b = node.bound
+                gains.append(max(min(b, self.inc_obj) - node.bound, 1e-9))
+            score = gains[0] * gains[1]
+            if score > best:
+                best, best_i = score, i
+        return list(zip(splits[best_i], results[2 * best_i : 2 * best_i + 2], strict=True))
 
     def result(self, timed_out: bool) -> SolverResult:
         """The :class:`SolverResult` of the search so far."""
@@ -1422,6 +1482,7 @@ class _Search:
                 "members": self.relax.n_members,
                 "condensed": self.relax.condensed is not None,
                 "fixed_by_duals": self.fixed_by_duals,
+                "strong_solves": self.strong_solves,
                 "trace": self.trace,
             },
         )
