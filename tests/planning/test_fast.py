@@ -189,3 +189,15 @@ def test_bench_plan_cli_writes_the_table(tmp_path) -> None:  # type: ignore[no-u
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert bad.returncode == 2 and "steps" in bad.stderr
+
+
+def test_parallel_time_limit_returns_an_honest_gap() -> None:
+    # the asynchronous search stops with solves (and possibly the dive) in flight
+    scene = random_stepping_stones(0, 8, robot=ROBOT)
+    fp = build_footstep_problem(scene, ROBOT, 10)
+    res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.5, gap=0.0, threads=2))
+    assert res.status in (SolveStatus.TIME_LIMIT, SolveStatus.OPTIMAL)
+    assert res.solve_time < 0.5 + bnb.DRAIN_TIMEOUT
+    if res.x is not None:
+        assert fp.problem.violation(res.x) <= bnb.FEAS_TOL
+        assert res.bound <= res.objective * (1 + BOUND_RTOL)

@@ -91,6 +91,10 @@ BRANCH_SPLIT = "sos"
 #: strong branching: solve the children of this many best candidate groups and split the one whose
 #: weaker child bound rises most (0 or 1: no strong branching)
 STRONG = 0
+#: with threads >= 2, keep the workers busy asynchronously (else: synchronous batches)
+ASYNC = True
+#: at the end of an asynchronous search, wait at most this long [s] for the solves in flight
+DRAIN_TIMEOUT = 10.0
 
 
 class UnsupportedProblem(ValueError):
@@ -1186,7 +1190,57 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
     return search.run()
 
 
+def _dive(
+    relax: HullRelaxation,
+    x: FloatArray,
+    allowed: tuple[tuple[int, ...], ...],
+    cutoff: float,
+    deadline: float,
+    stop: Any = None,
+) -> tuple[tuple[int, ...], ...] | None:
+    """Depth-first dive from a relaxation solution: fix the group whose nearest member (least
+    violated rows) is nearest to that member and re-solve, until the relaxation point satisfies
+    one member per group (returns that assignment) or is hopeless (None): infeasible, or its bound
+    reaches ``cutoff``. Gives up at ``deadline`` or when the shared flag ``stop`` is set."""
+    s = relax.s
+    cur = allowed
+    for _ in range(2 * len(cur)):
+        if time.perf_counter() > deadline or (stop is not None and stop.value):
+            return None
+        best_g, best_v, z = -1, math.inf, -1
+        for g, mem in enumerate(cur):
+            if len(mem) > 1:
+                viol = _violations(s, x, g, mem)
+                k = int(np.argmin(viol))
+                if viol[k] < best_v:
+                    best_g, best_v, z = g, float(viol[k]), mem[k]
+        if best_g < 0:
+            return None
+        mem = cur[best_g]
+        fixed = list(cur)
+        fixed[best_g] = (z,)
+        res = relax.solve(tuple(fixed))
+        if res.status != "solved" or res.x is None:
+            rest = list(cur)
+            rest[best_g] = tuple(m for m in mem if m != z)
+            cur = tuple(rest)
+            res = relax.solve(cur)
+            if res.status != "solved" or res.x is None:
+                return None
+        else:
+            cur = tuple(fixed)
+        if res.bound >= cutoff:
+            return None
+        x = res.x
+        chosen = _choice(s, x, cur, ROW_TOL)
+        if chosen is not None:
+            return chosen
+    return None
+
+
 _WORKER: HullRelaxation | None = None
+#: in a worker: a shared flag the search sets when it ends (see :func:`_pool`)
+_STOP: Any = None
 
 
 def _work(task: tuple[tuple[tuple[int, ...], ...], bool]) -> _Relaxation:
@@ -1199,6 +1253,16 @@ def _work(task: tuple[tuple[tuple[int, ...], ...], bool]) -> _Relaxation:
     return res
 
 
+def _work_dive(
+    task: tuple[FloatArray, tuple[tuple[int, ...], ...], float, float],
+) -> tuple[tuple[tuple[int, ...], ...] | None, _Relaxation | None]:
+    """Dive in a worker process (see :func:`_dive`); returns the assignment it ends at and the
+    condensed relaxation with every group fixed to it."""
+    assert _WORKER is not None
+    chosen = _dive(_WORKER, *task, stop=_STOP)
+    return chosen, None if chosen is None else _WORKER.solve(chosen)
+
+
 def _pool(relax: HullRelaxation, threads: int) -> Any:
     """A pool of ``threads`` forked workers sharing ``relax`` (None for 1 thread or no fork)."""
     import multiprocessing as mp
@@ -1206,11 +1270,17 @@ def _pool(relax: HullRelaxation, threads: int) -> Any:
     global _WORKER
     if threads < 2 or "fork" not in mp.get_all_start_methods():
         return None
+    global _STOP
+    ctx = mp.get_context("fork")
     _WORKER = relax
+    _STOP = ctx.Value("b", 0, lock=False)
     try:
-        return mp.get_context("fork").Pool(threads)
+        pool: Any = ctx.Pool(threads)
+        pool.footfall_stop = _STOP  # set to 1 to end dives early
+        return pool
     finally:
         _WORKER = None
+        _STOP = None
 
 
 class _Search:
@@ -1263,42 +1333,10 @@ class _Search:
                 return
 
     def dive(self, x: FloatArray, allowed: tuple[tuple[int, ...], ...]) -> None:
-        """Depth-first dive from a relaxation solution: fix the group whose nearest member (least
-        violated rows) is nearest to that member and re-solve, until the relaxation is integral
-        (an incumbent) or hopeless."""
-        cur = allowed
-        for _ in range(2 * len(cur)):
-            if time.perf_counter() > self.deadline:
-                return
-            best_g, best_v, z = -1, math.inf, -1
-            for g, mem in enumerate(cur):
-                if len(mem) > 1:
-                    viol = _violations(self.s, x, g, mem)
-                    k = int(np.argmin(viol))
-                    if viol[k] < best_v:
-                        best_g, best_v, z = g, float(viol[k]), mem[k]
-            if best_g < 0:
-                return
-            mem = cur[best_g]
-            fixed = list(cur)
-            fixed[best_g] = (z,)
-            res = self.relax.solve(tuple(fixed))
-            if res.status != "solved" or res.x is None:
-                rest = list(cur)
-                rest[best_g] = tuple(m for m in mem if m != z)
-                cur = tuple(rest)
-                res = self.relax.solve(cur)
-                if res.status != "solved" or res.x is None:
-                    return
-            else:
-                cur = tuple(fixed)
-            if res.bound >= self.inc_obj:
-                return
-            x = res.x
-            chosen = _choice(self.s, x, cur, ROW_TOL)
-            if chosen is not None:
-                self.solve_fixed(chosen)
-                return
+        """Dive from a relaxation solution (see :func:`_dive`) and solve the assignment it ends at."""
+        chosen = _dive(self.relax, x, allowed, self.inc_obj, self.deadline)
+        if chosen is not None:
+            self.solve_fixed(chosen)
 
     # ---------------------------------------------------------------------------------- search
     def gap_of(self, bound: float) -> float:
@@ -1357,13 +1395,21 @@ class _Search:
         """Best-first branch and bound; returns the best plan with an honest gap."""
         root_allowed = _root_allowed(self.s)
         timed_out = False
+        root = None
         if all(root_allowed):
             root = self.evaluate(root_allowed, -math.inf, 0, False)
-            if root is not None and root.x is not None and DIVE:
-                self.dive(root.x, root_allowed)
         pool = _pool(self.relax, self.options.threads) if self.heap else None
+        dive_from = None
+        if root is not None and root.x is not None and DIVE:
+            if pool is not None and ASYNC:
+                dive_from = (root.x, root_allowed)  # one worker dives while the others branch
+            else:
+                self.dive(root.x, root_allowed)
         try:
-            timed_out = self._loop(pool)
+            if pool is None or not ASYNC:
+                timed_out = self._loop(pool)
+            else:
+                timed_out = self._loop_async(pool, dive_from)
         finally:
             if pool is not None:
                 pool.terminate()
@@ -1412,6 +1458,111 @@ class _Search:
                 for (child, node), res in zip(tasks, results, strict=True):
                     self.evaluate(child, node.bound, node.depth + 1, node.full, res)
         return False
+
+    def _loop_async(
+        self, pool: Any, dive_from: tuple[FloatArray, tuple[tuple[int, ...], ...]] | None
+    ) -> bool:
+        """Best-first loop with the node solves in ``pool``, asynchronously: whenever fewer than
+        ``threads`` solves are in flight, the best open node is branched and its children are
+        submitted, so the workers never wait for a batch. A node's bound counts in the global
+        bound until its children's results are in. ``dive_from`` (a relaxation point and its
+        node) starts a dive in one worker. Returns True when stopped by the time limit."""
+        import queue
+
+        done: queue.Queue[tuple[int, Any]] = queue.Queue()
+        #: per task: (kind, assignment, parent node); kind "node", "fixed" or "dive"
+        inflight: dict[int, tuple[str, tuple[tuple[int, ...], ...], _Node | None]] = {}
+        next_id = 0
+
+        def submit(kind: str, task: Any, allowed: Any, node: _Node | None) -> None:
+            nonlocal next_id
+            tid = next_id
+            next_id += 1
+            inflight[tid] = (kind, allowed, node)
+            pool.apply_async(
+                _work_dive if kind == "dive" else _work,
+                (task,),
+                callback=lambda res, tid=tid: done.put((tid, res)),
+                error_callback=lambda exc, tid=tid: done.put((tid, exc)),
+            )
+
+        if dive_from is not None:
+            x0, allowed0 = dive_from
+            submit("dive", (x0, allowed0, self.inc_obj, self.deadline), allowed0, None)
+        try:
+            return self._async_steps(submit, done, inflight)
+        finally:
+            # Let the workers finish their solves before the pool is terminated: a worker killed
+            # while it holds the task queue's lock can hang Pool.terminate.
+            pool.footfall_stop.value = 1
+            for _, _, node in inflight.values():  # their results are dropped: keep the bounds
+                if node is not None:
+                    self.lost_bound = min(self.lost_bound, node.bound)
+            end = time.perf_counter() + DRAIN_TIMEOUT
+            while inflight and time.perf_counter() < end:
+                try:
+                    inflight.pop(done.get(timeout=max(end - time.perf_counter(), 0.0))[0], None)
+                except queue.Empty:
+                    break
+
+    def _async_steps(
+        self,
+        submit: Any,
+        done: Any,
+        inflight: dict[int, tuple[str, tuple[tuple[int, ...], ...], _Node | None]],
+    ) -> bool:
+        """The body of :meth:`_loop_async`."""
+        import queue
+
+        threads = self.options.threads
+        branched = 0
+        while True:
+            while self.heap and len(inflight) < threads:
+                node = heapq.heappop(self.heap)
+                if node.bound >= self.inc_obj:
+                    continue
+                assert node.x is not None
+                split = _branch(self.s, node.x, node.allowed, ROW_TOL)
+                if split is None:  # pragma: no cover - evaluate() resolved such nodes
+                    continue
+                for child in split:
+                    submit("node", (child, node.full), child, node)
+                branched += 1
+                if ROUNDING_EVERY and branched % ROUNDING_EVERY == 0:
+                    fixed = _rounded(node.x, node.allowed)
+                    if fixed not in self.tried:
+                        self.tried.add(fixed)
+                        submit("fixed", (fixed, False), fixed, None)
+            open_nodes = [nd.bound for _, _, nd in inflight.values() if nd is not None]
+            if self.heap:
+                open_nodes.append(self.heap[0].bound)
+            if not open_nodes:
+                return False
+            top = min(open_nodes)
+            if not self.trace or self.nodes >= self.trace[-1][0] + 25:
+                inc = self.inc_obj if math.isfinite(self.inc_obj) else None  # JSON-safe
+                self.trace.append((self.nodes, time.perf_counter() - self.start, inc, top))
+            if self.gap_of(top) <= self.options.gap:
+                return False
+            try:
+                tid, res = done.get(timeout=max(self.deadline - time.perf_counter(), 0.0))
+            except queue.Empty:
+                return True
+            kind, allowed, parent = inflight.pop(tid)
+            if isinstance(res, BaseException):
+                raise res
+            if kind == "dive":
+                allowed, res = res
+                if allowed is None or allowed in self.tried:
+                    continue
+                self.tried.add(allowed)
+            if parent is None:  # every group fixed: a rounding or the end of the dive
+                if res is not None and res.status == "solved" and res.x is not None:
+                    if not self.offer(_finish(self.s, res.x, allowed)):
+                        self.tried.discard(allowed)
+                        self.solve_fixed(allowed)  # the condensed point broke a dropped bound
+                continue
+            self.evaluate(allowed, parent.bound, parent.depth + 1, parent.full, res)
 
     def strong(
         self, node: _Node, allowed: tuple[tuple[int, ...], ...], pool: Any
