@@ -91,6 +91,13 @@ BRANCH_SPLIT = "sos"
 #: strong branching: solve the children of this many best candidate groups and split the one whose
 #: weaker child bound rises most (0 or 1: no strong branching)
 STRONG = 0
+#: Clarabel settings of the node solves. Iterative refinement and equilibration cost about 45 % of
+#: a node solve here (100 node problems of N = 10 and 15: 3.06 s -> 1.68 s, 1885 -> 1503
+#: iterations) and change no status and no bound by more than 1e-7
+CLARABEL_SETTINGS: dict[str, Any] = {
+    "iterative_refinement_enable": False,
+    "equilibrate_enable": False,
+}
 #: with threads >= 2, keep the workers busy asynchronously (else: synchronous batches)
 ASYNC = True
 #: at the end of an asynchronous search, wait at most this long [s] for the solves in flight
@@ -875,6 +882,8 @@ class HullRelaxation:
         self.n_members = len(order)
         settings = clarabel.DefaultSettings()
         settings.verbose = False
+        for key, value in CLARABEL_SETTINGS.items():
+            setattr(settings, key, value)
         self._settings = settings
         self.solves = 0
         self.solve_time = 0.0
