@@ -170,6 +170,10 @@ class _Structure:
     plain_le: sp.csr_matrix
     plain_b: FloatArray
     assigned: NDArray[np.bool_]  # cost rows charged in perspective form by a group
+    #: per group, its members' rows stacked (see :func:`_violations`), built on first use
+    stacked: dict[int, tuple[FloatArray, FloatArray, IntArray, dict[int, int]]] = field(
+        default_factory=dict
+    )
 
 
 #: eliminate a private variable only when Fourier-Motzkin makes at most this many rows per member
@@ -1046,13 +1050,19 @@ def _weights(x: FloatArray, mem: tuple[int, ...]) -> FloatArray:
 
 
 def _violations(s: _Structure, x: FloatArray, g: int, mem: tuple[int, ...]) -> FloatArray:
-    """Largest violation of each member's indicator rows at ``x``, shape (len(mem),)."""
-    xv = x[s.groups[g].variables]
-    out = np.zeros(len(mem))
-    for k, z in enumerate(mem):
-        mb = s.member[z]
-        if len(mb.beta):
-            out[k] = float(np.max(mb.a_v @ xv - mb.beta))
+    """Largest violation of each member's indicator rows at ``x``, shape (len(mem),) (0 for a
+    member without rows)."""
+    if g not in s.stacked:
+        members = s.groups[g].members
+        a = np.vstack([s.member[z].a_v for z in members])
+        beta = np.concatenate([s.member[z].beta for z in members])
+        owner = np.repeat(np.arange(len(members)), [len(s.member[z].beta) for z in members])
+        s.stacked[g] = (a, beta, owner, {z: k for k, z in enumerate(members)})
+    a, beta, owner, pos = s.stacked[g]
+    worst = np.full(len(pos), -np.inf)
+    np.maximum.at(worst, owner, a @ x[s.groups[g].variables] - beta)
+    out = worst[[pos[z] for z in mem]]
+    out[np.isneginf(out)] = 0.0
     return out
 
 
