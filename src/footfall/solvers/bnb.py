@@ -38,9 +38,10 @@ Search: best-first on the bound. A relaxation point that satisfies the rows of o
 group is a feasible point of the MIQCQP (the binaries are then set to those members), so the node
 is solved exactly even when the interior-point weights are spread. Otherwise the group whose nearest
 member is violated most is split where the cumulative weight of its members (in index order, the
-angle order for segments) crosses 1/2 (SOS1 branching). Incumbents come from such nodes, a dive
-from the root, and periodic rounding. With ``threads >= 2`` the children of the best open nodes are
-solved in parallel by forked workers. The search stops when ``(incumbent - bound) / min(|incumbent|,
+angle order for segments) crosses 1/2 (SOS1 branching). Incumbents come from such nodes and a dive
+from the root (periodic rounding is available, off). With ``threads >= 2`` forked workers solve
+the nodes asynchronously: whenever one is free, the best open node is branched and its children
+submitted; the dive runs in a worker meanwhile. The search stops when ``(incumbent - bound) / min(|incumbent|,
 |bound|) <= gap`` (SCIP's definition) or at the time limit, returning the best point and an honest
 gap; a node whose solve fails numerically makes the result ``feasible`` at best, never ``optimal``.
 """
