@@ -878,3 +878,7 @@ def bench_quadruped_cmd(
     write_json(out / "bench_quadruped.json", result)
     for key, value in result.items():
         console.print(f"{key}: {value}")
+
+
+if __name__ == "__main__":  # `python -m footfall.cli` as well as `python -m footfall`
+    main()

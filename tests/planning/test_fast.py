@@ -53,6 +53,11 @@ def test_fast_objective_equals_direct(regions: int, seed: int, n: int) -> None:
         assert report.ok, report.summary()
     # the fast plan's proven bound is a valid lower bound on the direct optimum
     assert fast.bound <= direct.objective * (1 + OBJ_RTOL)
+    # and so is the root relaxation (hull, perspective, tightened member rows, condensed dynamics)
+    structure = bnb.analyse(build_footstep_problem(scene, ROBOT, n, opts).problem)
+    root = bnb.HullRelaxation(structure).solve(bnb._root_allowed(structure))
+    assert root.status == "solved"
+    assert root.bound <= direct.objective * (1 + BOUND_RTOL)
 
 
 def test_infeasible_detected_by_both() -> None:
@@ -189,3 +194,42 @@ def test_bench_plan_cli_writes_the_table(tmp_path) -> None:  # type: ignore[no-u
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert bad.returncode == 2 and "steps" in bad.stderr
+
+
+def test_parallel_time_limit_returns_an_honest_gap() -> None:
+    # the asynchronous search stops with solves (and possibly the dive) in flight
+    scene = random_stepping_stones(0, 8, robot=ROBOT)
+    fp = build_footstep_problem(scene, ROBOT, 10)
+    res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.5, gap=0.0, threads=2))
+    assert res.status in (SolveStatus.TIME_LIMIT, SolveStatus.OPTIMAL)
+    assert res.solve_time < 0.5 + bnb.DRAIN_TIMEOUT
+    if res.x is not None:
+        assert fp.problem.violation(res.x) <= bnb.FEAS_TOL
+        assert res.bound <= res.objective * (1 + BOUND_RTOL)
+
+
+def test_dropping_redundant_member_rows_keeps_the_member_set() -> None:
+    # a member's rows: two upper and two lower bounds on x0 (the loosest as Fourier-Motzkin leaves
+    # them), a row implied by the box, and one that cuts; inside the box the set is unchanged
+    rng = np.random.default_rng(0)
+    lb, ub = np.array([-1.0, -2.0]), np.array([1.0, 2.0])
+    a_v = np.array([[1.0, 0.0], [2.0, 0.0], [-1.0, 0.0], [-0.5, 0.0], [0.1, 0.1], [1.0, 1.0]])
+    beta = np.array([0.5, 3.0, 0.8, 0.2, 5.0, 1.0])
+    a_r, b_r = bnb._drop_redundant(a_v, beta, lb, ub)
+    assert len(b_r) == 3  # x0 <= 0.5, x0 >= -0.4, x0 + x1 <= 1
+    pts = rng.uniform(lb, ub, size=(2000, 2))
+    inside = np.all(pts @ a_v.T <= beta, axis=1)
+    assert np.array_equal(inside, np.all(pts @ a_r.T <= b_r, axis=1))
+
+
+def test_member_violations_are_the_largest_row_violations() -> None:
+    scene = _scene(5, 0)
+    fp = build_footstep_problem(scene, ROBOT, 5)
+    structure = bnb.analyse(fp.problem)
+    x = np.random.default_rng(1).uniform(fp.problem.lb, fp.problem.ub)
+    for g, grp in enumerate(structure.groups):
+        got = bnb._violations(structure, x, g, grp.members[::-1])
+        for k, z in enumerate(grp.members[::-1]):
+            mb = structure.member[z]
+            want = float(np.max(mb.a_v @ x[grp.variables] - mb.beta)) if len(mb.beta) else 0.0
+            assert got[k] == pytest.approx(want, abs=1e-12)

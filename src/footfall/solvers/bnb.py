@@ -38,9 +38,10 @@ Search: best-first on the bound. A relaxation point that satisfies the rows of o
 group is a feasible point of the MIQCQP (the binaries are then set to those members), so the node
 is solved exactly even when the interior-point weights are spread. Otherwise the group whose nearest
 member is violated most is split where the cumulative weight of its members (in index order, the
-angle order for segments) crosses 1/2 (SOS1 branching). Incumbents come from such nodes, a dive
-from the root, and periodic rounding. With ``threads >= 2`` the children of the best open nodes are
-solved in parallel by forked workers. The search stops when ``(incumbent - bound) / min(|incumbent|,
+angle order for segments) crosses 1/2 (SOS1 branching). Incumbents come from such nodes and a dive
+from the root (periodic rounding is available, off). With ``threads >= 2`` forked workers solve
+the nodes asynchronously: whenever one is free, the best open node is branched and its children
+submitted; the dive runs in a worker meanwhile. The search stops when ``(incumbent - bound) / min(|incumbent|,
 |bound|) <= gap`` (SCIP's definition) or at the time limit, returning the best point and an honest
 gap; a node whose solve fails numerically makes the result ``feasible`` at best, never ``optimal``.
 """
@@ -77,8 +78,11 @@ REDUNDANT_TOL = 1e-7
 COPY_BOUNDS = False
 #: a member's indicator rows count as satisfied by a relaxation solution within this
 ROW_TOL = 1e-7
-#: try rounding the relaxation solution to an incumbent at every this many nodes (0: never)
-ROUNDING_EVERY = 8
+#: try rounding the relaxation solution to an incumbent at every this many nodes (0: never). Off:
+#: on N = 10 and 15 (K = 10, seeds 0-3) no rounding ever improved the incumbent (same node
+#: counts), and a rounding whose condensed point breaks a dropped bound is re-solved with the full
+#: model in the main process (N = 15: 683 such solves, 75.6 s -> 45.6 s in total without rounding)
+ROUNDING_EVERY = 0
 #: dive from the root relaxation for an early incumbent
 DIVE = True
 #: drop members whose dual bound (node bound + multiplier of z >= 0) reaches the incumbent
@@ -88,6 +92,20 @@ REDUCED_COST_FIXING = False
 BRANCH_SELECT = "violation"
 #: split: "sos" (members in index order at the weighted mean) or "nearest" (one member vs rest)
 BRANCH_SPLIT = "sos"
+#: strong branching: solve the children of this many best candidate groups and split the one whose
+#: weaker child bound rises most (0 or 1: no strong branching)
+STRONG = 0
+#: Clarabel settings of the node solves. Iterative refinement and equilibration cost about 45 % of
+#: a node solve here (100 node problems of N = 10 and 15: 3.06 s -> 1.68 s, 1885 -> 1503
+#: iterations) and change no status and no bound by more than 1e-7
+CLARABEL_SETTINGS: dict[str, Any] = {
+    "iterative_refinement_enable": False,
+    "equilibrate_enable": False,
+}
+#: with threads >= 2, keep the workers busy asynchronously (else: synchronous batches)
+ASYNC = True
+#: at the end of an asynchronous search, wait at most this long [s] for the solves in flight
+DRAIN_TIMEOUT = 10.0
 
 
 class UnsupportedProblem(ValueError):
@@ -156,6 +174,10 @@ class _Structure:
     plain_le: sp.csr_matrix
     plain_b: FloatArray
     assigned: NDArray[np.bool_]  # cost rows charged in perspective form by a group
+    #: per group, its members' rows stacked (see :func:`_violations`), built on first use
+    stacked: dict[int, tuple[FloatArray, FloatArray, IntArray, dict[int, int]]] = field(
+        default_factory=dict
+    )
 
 
 #: eliminate a private variable only when Fourier-Motzkin makes at most this many rows per member
@@ -200,27 +222,34 @@ def _drop_redundant(
 ) -> tuple[FloatArray, FloatArray]:
     """Remove rows implied by the box that the bounds and the single-variable rows define.
 
-    Single-variable rows are kept (they bound the member's copies). Removing implied rows leaves
-    the member's set unchanged.
+    The single-variable rows of one variable and direction are replaced by the tightest of them
+    (they bound the member's copies; e.g. the Fourier-Motzkin rows of the private sin/cos bound the
+    heading less than the segment's own rows do). Removing implied rows leaves the member's set
+    unchanged.
     """
     if not len(beta):
         return a_v, beta
     lo, hi = lb.copy(), ub.copy()
+    has_lo = np.zeros(len(lb), dtype=bool)
+    has_hi = np.zeros(len(lb), dtype=bool)
     nnz = np.count_nonzero(a_v, axis=1)
     for j in np.flatnonzero(nnz == 1):
         c = int(np.flatnonzero(a_v[j])[0])
         v = a_v[j, c]
         if v > 0:
             hi[c] = min(hi[c], beta[j] / v)
+            has_hi[c] = True
         else:
             lo[c] = max(lo[c], beta[j] / v)
+            has_lo[c] = True
     top = np.sum(np.maximum(a_v * lo, a_v * hi), axis=1)
-    keep = (nnz == 1) | ~(top <= beta - REDUNDANT_TOL * np.maximum(1.0, np.abs(beta)))
-    keep &= nnz > 0
+    keep = (nnz > 1) & ~(top <= beta - REDUNDANT_TOL * np.maximum(1.0, np.abs(beta)))
     # a row with no variables left is kept only if it is violated (the member is impossible)
-    empty = (nnz == 0) & (beta < -REDUNDANT_TOL)
-    keep |= empty
-    return a_v[keep], beta[keep]
+    keep |= (nnz == 0) & (beta < -REDUNDANT_TOL)
+    eye = np.eye(len(lb))
+    rows = [a_v[keep], eye[has_hi], -eye[has_lo]]
+    rhs = [beta[keep], hi[has_hi], -lo[has_lo]]
+    return np.vstack(rows), np.concatenate(rhs)
 
 
 def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
@@ -861,6 +890,8 @@ class HullRelaxation:
         self.n_members = len(order)
         settings = clarabel.DefaultSettings()
         settings.verbose = False
+        for key, value in CLARABEL_SETTINGS.items():
+            setattr(settings, key, value)
         self._settings = settings
         self.solves = 0
         self.solve_time = 0.0
@@ -1023,13 +1054,19 @@ def _weights(x: FloatArray, mem: tuple[int, ...]) -> FloatArray:
 
 
 def _violations(s: _Structure, x: FloatArray, g: int, mem: tuple[int, ...]) -> FloatArray:
-    """Largest violation of each member's indicator rows at ``x``, shape (len(mem),)."""
-    xv = x[s.groups[g].variables]
-    out = np.zeros(len(mem))
-    for k, z in enumerate(mem):
-        mb = s.member[z]
-        if len(mb.beta):
-            out[k] = float(np.max(mb.a_v @ xv - mb.beta))
+    """Largest violation of each member's indicator rows at ``x``, shape (len(mem),) (0 for a
+    member without rows)."""
+    if g not in s.stacked:
+        members = s.groups[g].members
+        a = np.vstack([s.member[z].a_v for z in members])
+        beta = np.concatenate([s.member[z].beta for z in members])
+        owner = np.repeat(np.arange(len(members)), [len(s.member[z].beta) for z in members])
+        s.stacked[g] = (a, beta, owner, {z: k for k, z in enumerate(members)})
+    a, beta, owner, pos = s.stacked[g]
+    worst = np.full(len(pos), -np.inf)
+    np.maximum.at(worst, owner, a @ x[s.groups[g].variables] - beta)
+    out = worst[[pos[z] for z in mem]]
+    out[np.isneginf(out)] = 0.0
     return out
 
 
@@ -1068,11 +1105,12 @@ def _rounded(x: FloatArray, allowed: tuple[tuple[int, ...], ...]) -> tuple[tuple
     return tuple(m if len(m) == 1 else (m[int(np.argmax(_weights(x, m)))],) for m in allowed)
 
 
-def _branch(
+def _candidates(
     s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], tol: float
-) -> tuple[tuple[tuple[int, ...], ...], tuple[tuple[int, ...], ...]] | None:
-    """Split a violated group (see ``BRANCH_SELECT``) into two halves (see ``BRANCH_SPLIT``)."""
-    best, best_g = -math.inf, -1
+) -> list[int]:
+    """Groups with every member violated at ``x``, best branching candidate first (see
+    ``BRANCH_SELECT``)."""
+    scored: list[tuple[float, int]] = []
     for g, mem in enumerate(allowed):
         if len(mem) < 2:
             continue
@@ -1085,24 +1123,37 @@ def _branch(
             score = 1.0 - float(np.max(_weights(x, mem)))
         else:  # "first"
             score = -g
-        if score > best:
-            best, best_g = score, g
-    if best_g < 0:
-        return None
-    mem = allowed[best_g]
+        scored.append((-score, g))
+    scored.sort()
+    return [g for _, g in scored]
+
+
+def _split(
+    s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], g: int
+) -> tuple[tuple[tuple[int, ...], ...], tuple[tuple[int, ...], ...]]:
+    """Split group ``g`` into two halves (see ``BRANCH_SPLIT``)."""
+    mem = allowed[g]
     w = _weights(x, mem)
     if BRANCH_SPLIT == "sos":
         centre = float(np.dot(w, np.arange(len(mem)))) / max(float(np.sum(w)), 1e-12)
         k = min(max(round(centre + 0.5), 1), len(mem) - 1)
         one, other = mem[:k], mem[k:]
     else:  # "nearest": the least violated member against the rest
-        z = mem[int(np.argmin(_violations(s, x, best_g, mem)))]
+        z = mem[int(np.argmin(_violations(s, x, g, mem)))]
         one, other = (z,), tuple(m for m in mem if m != z)
     left = [*allowed]
     right = [*allowed]
-    left[best_g] = one
-    right[best_g] = other
+    left[g] = one
+    right[g] = other
     return tuple(left), tuple(right)
+
+
+def _branch(
+    s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], tol: float
+) -> tuple[tuple[tuple[int, ...], ...], tuple[tuple[int, ...], ...]] | None:
+    """Split the best violated group (see ``BRANCH_SELECT``) into two halves (``BRANCH_SPLIT``)."""
+    cands = _candidates(s, x, allowed, tol)
+    return _split(s, x, allowed, cands[0]) if cands else None
 
 
 def _finish(s: _Structure, x: FloatArray, chosen: tuple[tuple[int, ...], ...]) -> FloatArray:
@@ -1162,7 +1213,57 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
     return search.run()
 
 
+def _dive(
+    relax: HullRelaxation,
+    x: FloatArray,
+    allowed: tuple[tuple[int, ...], ...],
+    cutoff: float,
+    deadline: float,
+    stop: Any = None,
+) -> tuple[tuple[int, ...], ...] | None:
+    """Depth-first dive from a relaxation solution: fix the group whose nearest member (least
+    violated rows) is nearest to that member and re-solve, until the relaxation point satisfies
+    one member per group (returns that assignment) or is hopeless (None): infeasible, or its bound
+    reaches ``cutoff``. Gives up at ``deadline`` or when the shared flag ``stop`` is set."""
+    s = relax.s
+    cur = allowed
+    for _ in range(2 * len(cur)):
+        if time.perf_counter() > deadline or (stop is not None and stop.value):
+            return None
+        best_g, best_v, z = -1, math.inf, -1
+        for g, mem in enumerate(cur):
+            if len(mem) > 1:
+                viol = _violations(s, x, g, mem)
+                k = int(np.argmin(viol))
+                if viol[k] < best_v:
+                    best_g, best_v, z = g, float(viol[k]), mem[k]
+        if best_g < 0:
+            return None
+        mem = cur[best_g]
+        fixed = list(cur)
+        fixed[best_g] = (z,)
+        res = relax.solve(tuple(fixed))
+        if res.status != "solved" or res.x is None:
+            rest = list(cur)
+            rest[best_g] = tuple(m for m in mem if m != z)
+            cur = tuple(rest)
+            res = relax.solve(cur)
+            if res.status != "solved" or res.x is None:
+                return None
+        else:
+            cur = tuple(fixed)
+        if res.bound >= cutoff:
+            return None
+        x = res.x
+        chosen = _choice(s, x, cur, ROW_TOL)
+        if chosen is not None:
+            return chosen
+    return None
+
+
 _WORKER: HullRelaxation | None = None
+#: in a worker: a shared flag the search sets when it ends (see :func:`_pool`)
+_STOP: Any = None
 
 
 def _work(task: tuple[tuple[tuple[int, ...], ...], bool]) -> _Relaxation:
@@ -1175,6 +1276,16 @@ def _work(task: tuple[tuple[tuple[int, ...], ...], bool]) -> _Relaxation:
     return res
 
 
+def _work_dive(
+    task: tuple[FloatArray, tuple[tuple[int, ...], ...], float, float],
+) -> tuple[tuple[tuple[int, ...], ...] | None, _Relaxation | None]:
+    """Dive in a worker process (see :func:`_dive`); returns the assignment it ends at and the
+    condensed relaxation with every group fixed to it."""
+    assert _WORKER is not None
+    chosen = _dive(_WORKER, *task, stop=_STOP)
+    return chosen, None if chosen is None else _WORKER.solve(chosen)
+
+
 def _pool(relax: HullRelaxation, threads: int) -> Any:
     """A pool of ``threads`` forked workers sharing ``relax`` (None for 1 thread or no fork)."""
     import multiprocessing as mp
@@ -1182,11 +1293,17 @@ def _pool(relax: HullRelaxation, threads: int) -> Any:
     global _WORKER
     if threads < 2 or "fork" not in mp.get_all_start_methods():
         return None
+    global _STOP
+    ctx = mp.get_context("fork")
     _WORKER = relax
+    _STOP = ctx.Value("b", 0, lock=False)
     try:
-        return mp.get_context("fork").Pool(threads)
+        pool: Any = ctx.Pool(threads)
+        pool.footfall_stop = _STOP  # set to 1 to end dives early
+        return pool
     finally:
         _WORKER = None
+        _STOP = None
 
 
 class _Search:
@@ -1208,6 +1325,7 @@ class _Search:
         self.failed = False
         self.lost_bound = math.inf
         self.fixed_by_duals = 0
+        self.strong_solves = 0
         #: (nodes, seconds, incumbent or None, best bound) every 25 nodes
         self.trace: list[tuple[int, float, float | None, float]] = []
         if options.initial_solution is not None:
@@ -1238,42 +1356,10 @@ class _Search:
                 return
 
     def dive(self, x: FloatArray, allowed: tuple[tuple[int, ...], ...]) -> None:
-        """Depth-first dive from a relaxation solution: fix the group whose nearest member (least
-        violated rows) is nearest to that member and re-solve, until the relaxation is integral
-        (an incumbent) or hopeless."""
-        cur = allowed
-        for _ in range(2 * len(cur)):
-            if time.perf_counter() > self.deadline:
-                return
-            best_g, best_v, z = -1, math.inf, -1
-            for g, mem in enumerate(cur):
-                if len(mem) > 1:
-                    viol = _violations(self.s, x, g, mem)
-                    k = int(np.argmin(viol))
-                    if viol[k] < best_v:
-                        best_g, best_v, z = g, float(viol[k]), mem[k]
-            if best_g < 0:
-                return
-            mem = cur[best_g]
-            fixed = list(cur)
-            fixed[best_g] = (z,)
-            res = self.relax.solve(tuple(fixed))
-            if res.status != "solved" or res.x is None:
-                rest = list(cur)
-                rest[best_g] = tuple(m for m in mem if m != z)
-                cur = tuple(rest)
-                res = self.relax.solve(cur)
-                if res.status != "solved" or res.x is None:
-                    return
-            else:
-                cur = tuple(fixed)
-            if res.bound >= self.inc_obj:
-                return
-            x = res.x
-            chosen = _choice(self.s, x, cur, ROW_TOL)
-            if chosen is not None:
-                self.solve_fixed(chosen)
-                return
+        """Dive from a relaxation solution (see :func:`_dive`) and solve the assignment it ends at."""
+        chosen = _dive(self.relax, x, allowed, self.inc_obj, self.deadline)
+        if chosen is not None:
+            self.solve_fixed(chosen)
 
     # ---------------------------------------------------------------------------------- search
     def gap_of(self, bound: float) -> float:
@@ -1332,13 +1418,21 @@ class _Search:
         """Best-first branch and bound; returns the best plan with an honest gap."""
         root_allowed = _root_allowed(self.s)
         timed_out = False
+        root = None
         if all(root_allowed):
             root = self.evaluate(root_allowed, -math.inf, 0, False)
-            if root is not None and root.x is not None and DIVE:
-                self.dive(root.x, root_allowed)
         pool = _pool(self.relax, self.options.threads) if self.heap else None
+        dive_from = None
+        if root is not None and root.x is not None and DIVE:
+            if pool is not None and ASYNC:
+                dive_from = (root.x, root_allowed)  # one worker dives while the others branch
+            else:
+                self.dive(root.x, root_allowed)
         try:
-            timed_out = self._loop(pool)
+            if pool is None or not ASYNC:
+                timed_out = self._loop(pool)
+            else:
+                timed_out = self._loop_async(pool, dive_from)
         finally:
             if pool is not None:
                 pool.terminate()
@@ -1369,6 +1463,12 @@ class _Search:
                     if not all(allowed):
                         continue  # every member of some group is worse than the incumbent
                     self.fixed_by_duals += sum(map(len, node.allowed)) - sum(map(len, allowed))
+                if STRONG > 1:
+                    done = self.strong(node, allowed, pool)
+                    if done is not None:
+                        for child, res in done:
+                            self.evaluate(child, node.bound, node.depth + 1, node.full, res)
+                        continue
                 split = _branch(self.s, node.x, allowed, ROW_TOL)
                 if split is None:  # pragma: no cover - evaluate() resolved such nodes
                     continue
@@ -1381,6 +1481,140 @@ class _Search:
                 for (child, node), res in zip(tasks, results, strict=True):
                     self.evaluate(child, node.bound, node.depth + 1, node.full, res)
         return False
+
+    def _loop_async(
+        self, pool: Any, dive_from: tuple[FloatArray, tuple[tuple[int, ...], ...]] | None
+    ) -> bool:
+        """Best-first loop with the node solves in ``pool``, asynchronously: whenever fewer than
+        ``threads`` solves are in flight, the best open node is branched and its children are
+        submitted, so the workers never wait for a batch. A node's bound counts in the global
+        bound until its children's results are in. ``dive_from`` (a relaxation point and its
+        node) starts a dive in one worker. Returns True when stopped by the time limit."""
+        import queue
+
+        done: queue.Queue[tuple[int, Any]] = queue.Queue()
+        #: per task: (kind, assignment, parent node); kind "node", "fixed" or "dive"
+        inflight: dict[int, tuple[str, tuple[tuple[int, ...], ...], _Node | None]] = {}
+        next_id = 0
+
+        def submit(kind: str, task: Any, allowed: Any, node: _Node | None) -> None:
+            nonlocal next_id
+            tid = next_id
+            next_id += 1
+            inflight[tid] = (kind, allowed, node)
+            pool.apply_async(
+                _work_dive if kind == "dive" else _work,
+                (task,),
+                callback=lambda res, tid=tid: done.put((tid, res)),
+                error_callback=lambda exc, tid=tid: done.put((tid, exc)),
+            )
+
+        if dive_from is not None:
+            x0, allowed0 = dive_from
+            submit("dive", (x0, allowed0, self.inc_obj, self.deadline), allowed0, None)
+        try:
+            return self._async_steps(submit, done, inflight)
+        finally:
+            # Let the workers finish their solves before the pool is terminated: a worker killed
+            # while it holds the task queue's lock can hang Pool.terminate.
+            pool.footfall_stop.value = 1
+            for _, _, node in inflight.values():  # their results are dropped: keep the bounds
+                if node is not None:
+                    self.lost_bound = min(self.lost_bound, node.bound)
+            end = time.perf_counter() + DRAIN_TIMEOUT
+            while inflight and time.perf_counter() < end:
+                try:
+                    inflight.pop(done.get(timeout=max(end - time.perf_counter(), 0.0))[0], None)
+                except queue.Empty:
+                    break
+
+    def _async_steps(
+        self,
+        submit: Any,
+        done: Any,
+        inflight: dict[int, tuple[str, tuple[tuple[int, ...], ...], _Node | None]],
+    ) -> bool:
+        """The body of :meth:`_loop_async`."""
+        import queue
+
+        threads = self.options.threads
+        branched = 0
+        while True:
+            while self.heap and len(inflight) < threads:
+                node = heapq.heappop(self.heap)
+                if node.bound >= self.inc_obj:
+                    continue
+                assert node.x is not None
+                split = _branch(self.s, node.x, node.allowed, ROW_TOL)
+                if split is None:  # pragma: no cover - evaluate() resolved such nodes
+                    continue
+                for child in split:
+                    submit("node", (child, node.full), child, node)
+                branched += 1
+                if ROUNDING_EVERY and branched % ROUNDING_EVERY == 0:
+                    fixed = _rounded(node.x, node.allowed)
+                    if fixed not in self.tried:
+                        self.tried.add(fixed)
+                        submit("fixed", (fixed, False), fixed, None)
+            open_nodes = [nd.bound for _, _, nd in inflight.values() if nd is not None]
+            if self.heap:
+                open_nodes.append(self.heap[0].bound)
+            if not open_nodes:
+                return False
+            top = min(open_nodes)
+            if not self.trace or self.nodes >= self.trace[-1][0] + 25:
+                inc = self.inc_obj if math.isfinite(self.inc_obj) else None  # JSON-safe
+                self.trace.append((self.nodes, time.perf_counter() - self.start, inc, top))
+            if self.gap_of(top) <= self.options.gap:
+                return False
+            try:
+                tid, res = done.get(timeout=max(self.deadline - time.perf_counter(), 0.0))
+            except queue.Empty:
+                return True
+            kind, allowed, parent = inflight.pop(tid)
+            if isinstance(res, BaseException):
+                raise res
+            if kind == "dive":
+                allowed, res = res
+                if allowed is None or allowed in self.tried:
+                    continue
+                self.tried.add(allowed)
+            if parent is None:  # every group fixed: a rounding or the end of the dive
+                if res is not None and res.status == "solved" and res.x is not None:
+                    if not self.offer(_finish(self.s, res.x, allowed)):
+                        self.tried.discard(allowed)
+                        self.solve_fixed(allowed)  # the condensed point broke a dropped bound
+                continue
+            self.evaluate(allowed, parent.bound, parent.depth + 1, parent.full, res)
+
+    def strong(
+        self, node: _Node, allowed: tuple[tuple[int, ...], ...], pool: Any
+    ) -> list[tuple[tuple[tuple[int, ...], ...], _Relaxation]] | None:
+        """Strong branching over the ``STRONG`` best candidates: the children (with their solved
+        relaxations) of the split whose children bounds rise most (product score)."""
+        assert node.x is not None
+        cands = _candidates(self.s, node.x, allowed, ROW_TOL)[:STRONG]
+        if len(cands) < 2:
+            return None
+        splits = [_split(self.s, node.x, allowed, g) for g in cands]
+        flat = [child for sp_ in splits for child in sp_]
+        if pool is None:
+            results = [self.relax.solve(c, full=node.full) for c in flat]
+        else:
+            results = pool.map(_work, [(c, node.full) for c in flat])
+        self.strong_solves += len(flat) - 2
+        best, best_i = -math.inf, 0
+        for i in range(len(splits)):
+            gains = []
+            for res in results[2 * i : 2 * i + 2]:
+                b = res.bound if res.status == "solved" else math.inf
+                if res.status == "failed":
+                    b = node.bound
+                gains.append(max(min(b, self.inc_obj) - node.bound, 1e-9))
+            score = gains[0] * gains[1]
+            if score > best:
+                best, best_i = score, i
+        return list(zip(splits[best_i], results[2 * best_i : 2 * best_i + 2], strict=True))
 
     def result(self, timed_out: bool) -> SolverResult:
         """The :class:`SolverResult` of the search so far."""
@@ -1422,6 +1656,7 @@ class _Search:
                 "members": self.relax.n_members,
                 "condensed": self.relax.condensed is not None,
                 "fixed_by_duals": self.fixed_by_duals,
+                "strong_solves": self.strong_solves,
                 "trace": self.trace,
             },
         )
