@@ -12,7 +12,8 @@ Control loop (every ``control_dt``):
 3. **Reference**: the ALIP reference state is advanced by one tick with that torque, exactly
    (zero-order hold, eq. 5.5), after blending it toward the measured state by ``com_feedback``.
    In double support the contact point moves linearly to the new foot (the model behind the reset
-   map, eq. 5.8-5.10). The CoM height follows the footstep heights smoothly.
+   map, eq. 5.8-5.10). The CoM height lies on the planes through z_H above consecutive
+   footsteps (:class:`CoMHeight`), on which the horizontal motion is exactly the ALIP's.
 4. **Whole body**: differential inverse kinematics with ``mink`` (one QP per iteration, solved by
    ``daqp``) tracks the CoM, both sole poses (stance: where it stands; swing: a trajectory that
    rises above every region it passes over before moving, see :func:`swing_reference`) and an
@@ -555,45 +556,135 @@ def foot_rotation(normal: ArrayLike, heading: float) -> FloatArray:
 
 
 def swing_reference(
-    tau: float, start: FloatArray, target: FloatArray, apex: float
+    tau: float,
+    start: FloatArray,
+    target: FloatArray,
+    apex: float,
+    rise: float = 0.35,
+    descend: float = 0.65,
 ) -> tuple[FloatArray, float]:
     """Swing sole position (3,) [m] at phase share ``tau`` and the horizontal progress in [0, 1].
 
-    The sole rises to ``apex`` in the first ``SWING_RISE`` of the swing, moves horizontally during
-    ``SWING_MOVE`` and descends in the last part, so it crosses every step edge at the apex
-    height; every profile is a quintic smoothstep (zero velocity at lift-off and touchdown).
+    The sole rises to ``apex`` in the first ``rise`` share of the swing, moves horizontally during
+    ``SWING_MOVE`` and descends from the ``descend`` share on, so it crosses every step edge at
+    the apex height; every profile is a quintic smoothstep (zero velocity at lift-off and
+    touchdown).
     """
     s_h = smoothstep((tau - SWING_MOVE[0]) / (SWING_MOVE[1] - SWING_MOVE[0]))
-    if tau < SWING_RISE:
-        z = start[2] + (apex - start[2]) * smoothstep(tau / SWING_RISE)
-    elif tau < SWING_DESCEND:
+    if tau < rise:
+        z = start[2] + (apex - start[2]) * smoothstep(tau / rise)
+    elif tau < descend:
         z = apex
     else:
-        z = apex + (target[2] - apex) * smoothstep((tau - SWING_DESCEND) / (1.0 - SWING_DESCEND))
+        z = apex + (target[2] - apex) * smoothstep((tau - descend) / (1.0 - descend))
     xy = start[:2] + (target[:2] - start[:2]) * s_h
     return np.array([xy[0], xy[1], z]), s_h
 
 
-#: swing phase shares: rise until, horizontal motion between, descent from
-SWING_RISE = 0.35
+def swing_shares(rise_height: float, fall_height: float, t_ss: float) -> tuple[float, float]:
+    """Rise-until and descend-from shares of a swing that lifts the sole by ``rise_height`` and
+    lowers it by ``fall_height`` [m] in ``t_ss`` [s].
+
+    Each vertical motion takes at least ``SWING_SHARES[0]`` of the swing (the sole must clear the
+    ground before it moves, else it scuffs) and longer when its quintic profile's peak
+    acceleration ``5.77 h / T^2`` would exceed ``SWING_ACC_MAX``, up to half the swing (a swing
+    leg lifted 0.2 m within 0.14 s unloaded the stance foot on the discrete steps).
+    """
+    lo, hi = SWING_SHARES
+
+    def share(h: float) -> float:
+        need = math.sqrt(QUINTIC_PEAK_ACC * max(h, 0.0) / SWING_ACC_MAX) / t_ss
+        return min(max(need, lo), hi)
+
+    return share(rise_height), 1.0 - share(fall_height)
+
+
+#: the horizontal swing motion runs between these shares of the swing
 SWING_MOVE = (0.1, 0.9)
-SWING_DESCEND = 0.65
+#: shortest and longest share of the swing for the rise (and for the descent)
+SWING_SHARES = (0.35, 0.5)
+#: peak vertical acceleration of the swing sole the shares aim at [m/s^2] (a 0.05 m rise in
+#: 0.35 x 0.4 s needs 15)
+SWING_ACC_MAX = 15.0
+#: peak acceleration of the quintic smoothstep over a unit distance and duration
+QUINTIC_PEAK_ACC = 10.0 / math.sqrt(3.0)
 
 
 def terrain_height_along(
-    regions: tuple[Region, ...], start: FloatArray, target: FloatArray, half_length: float
+    regions: tuple[Region, ...],
+    start: FloatArray,
+    target: FloatArray,
+    half_length: float,
+    half_width: float,
 ) -> float:
-    """Highest region surface under the segment start -> target (extended by a half foot) [m]."""
+    """Highest region surface under the sole swept from ``start`` to ``target`` [m].
+
+    The swept area is approximated by the segment start -> target extended by ``half_length``
+    at both ends (heel behind the start, toe beyond the target) and widened by ``half_width``
+    on both sides: a region counts when a sample of the extended segment lies within
+    ``half_width`` of it. (Widening by the half length as well counted blocks the toe never
+    reaches: a step onto a block 0.08 m before a higher one swung 0.15 m too high, and the swing
+    leg's acceleration lifted the stance foot off its block.)
+    """
     d = target[:2] - start[:2]
     length = float(np.linalg.norm(d))
     u = d / length if length > 1e-9 else np.zeros(2)
-    pts = [start[:2] + u * s for s in np.linspace(-half_length, length + half_length, 16)]
+    n_samples = max(16, math.ceil((length + 2.0 * half_length) / 0.01) + 1)
+    pts = start[:2] + np.outer(np.linspace(-half_length, length + half_length, n_samples), u)
     best = max(float(start[2]), float(target[2]))
-    for p in pts:
-        for r in regions:
-            if float(r.signed_distance(p)) <= half_length:
-                best = max(best, float(r.height_at(p)))
+    for r in regions:
+        near = np.asarray(r.signed_distance(pts)) <= half_width
+        if np.any(near):
+            best = max(best, float(np.max(r.height_at(pts[near]))))
     return best
+
+
+class CoMHeight:
+    """CoM height reference over the footsteps: the 3-D linear inverted pendulum's constraint planes.
+
+    The CoM moves on the planes through the points ``P_j + (0, 0, z_H)`` above consecutive
+    footsteps: between footsteps ``j`` and ``j + 1`` the plane rises with gradient
+    ``g_j = (z_{j+1} - z_j) d_j / |d_j|^2`` (``d_j`` the horizontal step), level across it. Every
+    plane used while standing on ``P_j`` (the one from the previous step behind the foot, the one
+    to the next step ahead of it) passes through ``z_j + z_H`` above the stance foot, so the
+    horizontal CoM motion is exactly the pendulum of height ``z_H`` of eq. (5.1) (Kajita et al.,
+    2001: on such a plane the leg force along foot -> CoM adds no horizontal acceleration the ALIP
+    does not have), and consecutive supports share the plane between their feet, so the height is
+    continuous through double support. The kink above each footstep is rounded over
+    ``+-kink`` [m] of progress, where the CoM is nearly above the foot and the vertical
+    acceleration of the rounding hardly pushes it horizontally.
+
+    A height that rises in *time* (from one mid single support to the next) pushes the CoM forward
+    whenever it rises ahead of the stance foot: on the discrete steps the walking speed grew from
+    0.62 to 1.0 m/s within two step-ups and the robot fell.
+    """
+
+    def __init__(self, footsteps: FloatArray, z_h: float, kink: float = 0.05) -> None:
+        p = np.asarray(footsteps, dtype=float)
+        self.points = p
+        self.z_h = float(z_h)
+        self.kink = float(kink)
+        n = p.shape[0]
+        self.grad = np.zeros((n + 1, 2))  # grad[j + 1]: plane from footstep j to j + 1
+        for j in range(n - 1):
+            d = p[j + 1, :2] - p[j, :2]
+            d2 = float(d @ d)
+            if d2 > 1e-6:
+                self.grad[j + 1] = (p[j + 1, 2] - p[j, 2]) * d / d2
+        self.ahead = np.zeros((n, 2))  # walking direction through each footstep
+        for j in range(n):
+            d = p[min(j + 1, n - 1), :2] - p[max(j - 1, 0), :2]
+            norm = float(np.linalg.norm(d))
+            self.ahead[j] = d / norm if norm > 1e-6 else 0.0
+
+    def __call__(self, support: int, c_xy: ArrayLike) -> float:
+        """Reference CoM height [m] while standing on footstep ``support`` (0..N; in double
+        support the footstep being stepped onto) with the horizontal CoM at ``c_xy`` (2,) [m]."""
+        j = min(max(support, 0), self.points.shape[0] - 1)
+        r = np.asarray(c_xy, dtype=float)[:2] - self.points[j, :2]
+        w = smoothstep((float(r @ self.ahead[j]) + self.kink) / (2.0 * self.kink))
+        slope = (1.0 - w) * self.grad[j] + w * self.grad[j + 1]
+        return float(self.points[j, 2]) + self.z_h + float(slope @ r)
 
 
 # ============================================================================= the simulator
@@ -1056,32 +1147,16 @@ def walk(
     ds_aug = np.zeros(10)
     swing_start = foot_pos[stance_side.other].copy()
     swing_rot0 = foot_rot[stance_side.other].copy()
-    apex = 0.0
+    apex, rise, descend = 0.0, SWING_SHARES[0], 1.0 - SWING_SHARES[0]
     cur_phase = -1
     stop_from = np.zeros(2)
     stop_vel = np.zeros(2)
     fell, fall_time = False, math.nan
     push_force = np.zeros(3)
 
-    def height_ref(t: float) -> float:
-        """CoM height [m]: z_H above the stance sole, blended between footstep heights from the
-        middle of one single support to the middle of the next."""
-        zs = plan.footsteps[:, 2]
-        if t < t_walk0 + 0.5 * t_ss:
-            return (
-                float(
-                    zs[0]
-                    if t >= opts.settle_time
-                    else 0.5 * (scene.start.left[2] + scene.start.right[2])
-                )
-                + z_h
-            )
-        u = (t - t_walk0 - 0.5 * t_ss) / t_step
-        i = math.floor(u)
-        if i >= n:
-            return float(zs[n]) + z_h
-        frac = smoothstep(u - i)
-        return float(zs[i] + (zs[i + 1] - zs[i]) * frac) + z_h
+    # CoM height over the footsteps (constraint planes of the 3-D LIPM); standing: over the feet
+    height = CoMHeight(plan.footsteps, z_h)
+    z_stand = 0.5 * (scene.start.left[2] + scene.start.right[2]) + z_h
 
     ankle_mode = {sd: False for sd in sim.sides}
     ankle_u = np.zeros(2)
@@ -1096,12 +1171,14 @@ def walk(
         contacts, body_hit = sim.contacts()
 
         # ---------------------------------------------------------------- schedule
+        c_next = com[:2] + vel[:2] * dt  # where the CoM will be when the references apply
         if t < t_walk0:
             # settle, then move the CoM over the first stance foot (the plan starts there at rest)
             mid = 0.5 * (scene.start.left + scene.start.right)
             s = smoothstep((t - opts.settle_time) / opts.shift_time)
             target_xy = mid[:2] + (start_stance[:2] - mid[:2]) * s
-            com_ref = np.array([target_xy[0], target_xy[1], height_ref(t)])
+            z_ref = z_stand + (height(0, target_xy) - z_stand) * s
+            com_ref = np.array([target_xy[0], target_xy[1], z_ref])
             # the standing CoM sits forward of the feet midpoint by the model's offset; keep it
             com_ref[:2] += (com0[:2] - mid[:2]) * (1.0 - s)
             targets_now = {sd: (foot_pos[sd], foot_rot[sd]) for sd in sim.sides}
@@ -1130,8 +1207,12 @@ def walk(
                         swing_start,
                         plan.footsteps[i + 1],
                         robot.foot_length / 2,
+                        robot.foot_width / 2,
                     )
                     + opts.swing_clearance
+                )
+                rise, descend = swing_shares(
+                    apex - float(swing_start[2]), apex - float(plan.footsteps[i + 1][2]), t_ss
                 )
             stance = foot_pos[stance_side]
             swing_side = stance_side.other
@@ -1157,7 +1238,7 @@ def walk(
                 ankle_u = u
                 x_ref = ad_tick @ x_ref + bd_tick @ u
                 tau = min(1.0, (tp + dt) / t_ss)
-                pos, s_h = swing_reference(tau, swing_start, nxt, apex)
+                pos, s_h = swing_reference(tau, swing_start, nxt, apex, rise, descend)
                 rot1 = foot_rotation(normals[i + 1], plan.headings[i + 1])
                 rot = _blend_rot(swing_rot0, rot1, s_h)
                 targets_now = {stance_side: (stance, foot_rot[stance_side]), swing_side: (pos, rot)}
@@ -1179,7 +1260,8 @@ def walk(
                     swing_side: (targets[i], foot_rot[swing_side]),
                 }
                 yaw = float(0.5 * (plan.headings[i] + plan.headings[i + 1]))
-            com_ref = np.array([ref_xy[0], ref_xy[1], height_ref(t + dt)])
+            support = i if tp < t_ss else i + 1
+            com_ref = np.array([ref_xy[0], ref_xy[1], height(support, c_next)])
             if k + 1 < n_ticks and t + dt >= t_end_steps - 1e-9:
                 # the stop starts from the measured CoM motion: the reference may have drifted
                 stop_from = com[:2].copy()
@@ -1198,7 +1280,7 @@ def walk(
             h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
             h01 = -2 * s**3 + 3 * s**2
             xy = h00 * stop_from + h10 * opts.stop_time * stop_vel + h01 * mid[:2]
-            com_ref = np.array([xy[0], xy[1], height_ref(t + dt)])
+            com_ref = np.array([xy[0], xy[1], height(n, c_next)])
             targets_now = {sd: (foot_pos[sd], foot_rot[sd]) for sd in sim.sides}
             yaw = float(plan.headings[n])
 
