@@ -32,6 +32,12 @@ Relaxation of a node (each group ``G`` may use the members ``Z`` still allowed):
   the rest, from one KKT solve. Dropping their bounds and cones keeps a lower bound; when a node's
   recovered point violates one, the node is re-solved with the full model.
 
+* Links (``LINKS``, off: tighter but dearer per node, see ``benchmarks/RESULTS.md``). Two groups
+  coupled by a plain row (the heading rate, eq. 5.12e, between the segment groups of consecutive
+  steps) keep only the member pairs that row allows on the members' boxes; the group weights must
+  be the marginals of weights on those pairs, written as prefix rows when the pairs form a
+  staircase (:func:`_staircase`), and children drop the members left without a partner.
+
 Every bound is ``min(primal, dual)`` of a Clarabel solve of a convex problem, so it is valid.
 
 Search: best-first on the bound. A relaxation point that satisfies the rows of one member of every
