@@ -18,7 +18,7 @@ from footfall.planning.fast import FAST_SOLVER, plan_footsteps_fast
 from footfall.planning.miqcqp import build_footstep_problem, plan_footsteps
 from footfall.planning.plan import PlannerOptions
 from footfall.solvers import ProblemBuilder, SolverOptions, SolveStatus, bnb, solve
-from footfall.solvers.problem import fix_variables
+from footfall.solvers.problem import MIQCQP, fix_variables
 from footfall.terrain.scene import random_stepping_stones
 
 #: relative optimality gap of both solvers in the equality tests
@@ -233,3 +233,124 @@ def test_member_violations_are_the_largest_row_violations() -> None:
             mb = structure.member[z]
             want = float(np.max(mb.a_v @ x[grp.variables] - mb.beta)) if len(mb.beta) else 0.0
             assert got[k] == pytest.approx(want, abs=1e-12)
+
+
+def _link_structure(
+    monkeypatch: pytest.MonkeyPatch, problem: MIQCQP, staircase: bool = True
+) -> bnb._Structure:
+    monkeypatch.setattr(bnb, "LINKS", True)
+    monkeypatch.setattr(bnb, "STAIRCASE", staircase)
+    return bnb.analyse(problem)
+
+
+def test_link_pairs_are_exactly_the_rate_feasible_segment_pairs(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    scene = random_stepping_stones(0, 8, robot=ROBOT)
+    fp = build_footstep_problem(scene, ROBOT, 8)
+    monkeypatch.setattr(bnb, "LINK_MIN_DROP", 0.0)
+    structure = _link_structure(monkeypatch, fp.problem)
+    pr, br, tmax = fp.problem, fp.breakpoints, ROBOT.theta_max
+    by_groups = {link.groups: link for link in structure.compat}
+    checked = 0
+    for i in range(1, fp.n_steps):
+        seg_i = [int(z) for z in fp.segments[i] if z >= 0]
+        seg_j = [int(z) for z in fp.segments[i + 1] if z >= 0]
+        if len(seg_i) < 2 or len(seg_j) < 2:
+            continue
+        link = by_groups[(structure.group_of[seg_i[0]], structure.group_of[seg_j[0]])]
+
+        def box(step: int, z: int) -> tuple[float, float]:
+            ell = int(np.flatnonzero(fp.segments[step] == z)[0])
+            t = int(fp.theta[step])
+            return max(br[ell], pr.lb[t]), min(br[ell + 1], pr.ub[t])
+
+        want = set()
+        for a in seg_i:
+            lo_a, hi_a = box(i, a)
+            for b in seg_j:
+                lo_b, hi_b = box(i + 1, b)
+                # some theta_i in a and theta_{i+1} in b with |theta_{i+1} - theta_i| <= theta_max
+                if lo_b - hi_a <= tmax + 1e-9 and lo_a - hi_b <= tmax + 1e-9:
+                    want.add((a, b))
+        assert {(int(a), int(b)) for a, b in link.pairs} == want
+        assert len(want) < len(seg_i) * len(seg_j)
+        # a staircase: written as prefix rows, not as pair weights
+        assert link.groups in {(g, g2) for g, _, g2, _ in structure.prefix_rows}
+        assert link.groups not in {lk.groups for lk in structure.links}
+        checked += 1
+    assert checked >= 3
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_linked_relaxation_is_tighter_and_below_the_optimum(
+    monkeypatch: pytest.MonkeyPatch, seed: int
+) -> None:
+    scene = random_stepping_stones(seed, 8, robot=ROBOT)
+    fp = build_footstep_problem(scene, ROBOT, 8)
+    best = solve(fp.problem, "bnb", SolverOptions(gap=GAP))
+    assert best.status is SolveStatus.OPTIMAL
+    plain_s = bnb.analyse(fp.problem)
+    plain = bnb.HullRelaxation(plain_s).solve(bnb._root_allowed(plain_s))
+    bounds = []
+    for staircase in (True, False):  # prefix rows and pair weights: the same polytope
+        linked_s = _link_structure(monkeypatch, fp.problem, staircase)
+        linked = bnb.HullRelaxation(linked_s).solve(bnb._root_allowed(linked_s))
+        assert linked.status == plain.status == "solved"
+        assert linked.bound >= plain.bound * (1 - BOUND_RTOL)
+        assert linked.bound <= best.objective * (1 + BOUND_RTOL)
+        bounds.append(linked.bound)
+    assert bounds[0] == pytest.approx(bounds[1], rel=1e-5)
+    # with every group fixed to the optimum the links change nothing
+    chosen = tuple(tuple(z for z in grp.members if best.x[z] > 0.5) for grp in linked_s.groups)
+    fixed = bnb.HullRelaxation(linked_s).solve(chosen)
+    assert fixed.bound == pytest.approx(best.objective, rel=1e-6)
+
+
+@pytest.mark.parametrize(("regions", "seed", "n"), CASES[:4])
+def test_linked_search_finds_the_same_optimum(
+    monkeypatch: pytest.MonkeyPatch, regions: int, seed: int, n: int
+) -> None:
+    fp = build_footstep_problem(_scene(regions, seed), ROBOT, n)
+    plain = solve(fp.problem, "bnb", SolverOptions(gap=GAP))
+    monkeypatch.setattr(bnb, "LINKS", True)
+    linked = solve(fp.problem, "bnb", SolverOptions(gap=GAP))
+    assert plain.status is linked.status is SolveStatus.OPTIMAL
+    assert linked.objective == pytest.approx(plain.objective, rel=OBJ_RTOL)
+
+
+def test_propagation_drops_only_members_without_a_compatible_partner(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    fp = build_footstep_problem(random_stepping_stones(0, 8, robot=ROBOT), ROBOT, 10)
+    structure = _link_structure(monkeypatch, fp.problem)
+    root = bnb._root_allowed(structure)
+    # pin footstep 5 to its first live segment
+    z5 = int(fp.segments[5][fp.segments[5] >= 0][0])
+    g5 = structure.group_of[z5]
+    pinned = tuple((z5,) if g == g5 else mem for g, mem in enumerate(root))
+    out = bnb._propagate(structure, pinned)
+    assert out is not None
+    assert sum(map(len, out)) < sum(map(len, pinned))
+    # partners of each member in the other group of each link, both directions
+    partners: dict[tuple[int, int], set[int]] = {}
+    for link in structure.compat:
+        g1, g2 = link.groups
+        for a, b in link.pairs:
+            partners.setdefault((int(a), g2), set()).add(int(b))
+            partners.setdefault((int(b), g1), set()).add(int(a))
+    links_of = {g: [lk.groups[1 - k] for lk in structure.compat for k in (0, 1)
+                    if lk.groups[k] == g] for g in range(len(root))}  # fmt: skip
+    for g, mem in enumerate(pinned):
+        assert set(out[g]) <= set(mem)
+        for a in out[g]:  # every member left has a partner left in every linked group
+            assert all(partners.get((a, h), set()) & set(out[h]) for h in links_of[g])
+        for a in set(mem) - set(out[g]):  # every member dropped has none in some linked group
+            assert not all(partners.get((a, h), set()) & set(out[h]) for h in links_of[g])
+    # pinning two footsteps to incompatible segments leaves no node
+    z6 = int(fp.segments[6][fp.segments[6] >= 0][-1])  # the live segment farthest from z5
+    g6 = structure.group_of[z6]
+    clash = tuple((z6,) if g == g6 else mem for g, mem in enumerate(pinned))
+    link56 = next(lk for lk in structure.compat if lk.groups == (g5, g6))
+    assert (z5, z6) not in {(int(a), int(b)) for a, b in link56.pairs}
+    assert bnb._propagate(structure, clash) is None

@@ -32,6 +32,12 @@ Relaxation of a node (each group ``G`` may use the members ``Z`` still allowed):
   the rest, from one KKT solve. Dropping their bounds and cones keeps a lower bound; when a node's
   recovered point violates one, the node is re-solved with the full model.
 
+* Links (``LINKS``, off: tighter but dearer per node, see ``benchmarks/RESULTS.md``). Two groups
+  coupled by a plain row (the heading rate, eq. 5.12e, between the segment groups of consecutive
+  steps) keep only the member pairs that row allows on the members' boxes; the group weights must
+  be the marginals of weights on those pairs, written as prefix rows when the pairs form a
+  staircase (:func:`_staircase`), and children drop the members left without a partner.
+
 Every bound is ``min(primal, dual)`` of a Clarabel solve of a convex problem, so it is valid.
 
 Search: best-first on the bound. A relaxation point that satisfies the rows of one member of every
@@ -90,6 +96,8 @@ REDUCED_COST_FIXING = False
 #: branching group: "violation" (its nearest member is violated most), "fractional" (smallest
 #: largest weight) or "first" (lowest group index, i.e. step order)
 BRANCH_SELECT = "violation"
+#: drop the members of a child that no compatible member pair of its links reaches
+PROPAGATE = True
 #: split: "sos" (members in index order at the weighted mean) or "nearest" (one member vs rest)
 BRANCH_SPLIT = "sos"
 #: strong branching: solve the children of this many best candidate groups and split the one whose
@@ -102,6 +110,12 @@ CLARABEL_SETTINGS: dict[str, Any] = {
     "iterative_refinement_enable": False,
     "equilibrate_enable": False,
 }
+#: couple groups linked by plain rows through weights on their compatible member pairs
+LINKS = False
+#: keep a link only when its rows rule out at least this share of the member pairs
+LINK_MIN_DROP = 0.25
+#: write a staircase link as prefix rows on its binaries instead of pair weights
+STAIRCASE = True
 #: with threads >= 2, keep the workers busy asynchronously (else: synchronous batches)
 ASYNC = True
 #: at the end of an asynchronous search, wait at most this long [s] for the solves in flight
@@ -163,6 +177,20 @@ class _Group:
     cost_w: FloatArray = field(default_factory=lambda: np.zeros(0))
 
 
+@dataclass(frozen=True)
+class _Link:
+    """Two choice groups coupled by plain rows, and the member pairs those rows allow.
+
+    Attributes:
+        groups: the two group indices ``(g1, g2)``.
+        pairs: binaries ``(z1, z2)`` of the compatible member pairs, (P, 2); a pair is dropped only
+            when the plain rows between the groups cannot hold on the box both members imply.
+    """
+
+    groups: tuple[int, int]
+    pairs: IntArray
+
+
 @dataclass
 class _Structure:
     """The problem split into its static convex part and its choice groups."""
@@ -174,6 +202,12 @@ class _Structure:
     plain_le: sp.csr_matrix
     plain_b: FloatArray
     assigned: NDArray[np.bool_]  # cost rows charged in perspective form by a group
+    #: compatible member pairs of groups linked by plain rows (see :func:`_links`)
+    links: list[_Link] = field(default_factory=list)
+    #: every link (also those written as prefix rows), for :func:`_propagate`
+    compat: list[_Link] = field(default_factory=list)
+    #: staircase links as prefix rows ``(g, k, g', k')`` (see :func:`_staircase`)
+    prefix_rows: list[tuple[int, int, int, int]] = field(default_factory=list)
     #: per group, its members' rows stacked (see :func:`_violations`), built on first use
     stacked: dict[int, tuple[FloatArray, FloatArray, IntArray, dict[int, int]]] = field(
         default_factory=dict
@@ -422,7 +456,7 @@ def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
                     cost_t=problem.cost_target[c_rows],
                     cost_w=problem.cost_weight[c_rows],
                 )
-    return _Structure(
+    out = _Structure(
         problem=problem,
         groups=groups,
         member=member,
@@ -431,6 +465,141 @@ def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
         plain_b=problem.b_le[plain],
         assigned=assigned,
     )
+    if LINKS:
+        zero: list[int] = []
+        out.compat = _links(out)
+        for link in out.compat:
+            spec = _staircase(out, link) if STAIRCASE else None
+            if spec is None:
+                out.links.append(link)
+            else:
+                out.prefix_rows += spec[0]
+                zero += spec[1]
+        if zero:  # members without a compatible partner: z <= 0, a row on binaries only
+            rows = sp.csr_matrix(
+                (np.ones(len(zero)), (np.arange(len(zero)), zero)), shape=(len(zero), n)
+            )
+            out.plain_le = sp.vstack([out.plain_le, rows], format="csr")
+            out.plain_b = np.concatenate([out.plain_b, np.zeros(len(zero))])
+    return out
+
+
+def _staircase(
+    s: _Structure, link: _Link
+) -> tuple[list[tuple[int, int, int, int]], list[int]] | None:
+    """The link's flow condition as prefix rows, when the compatible pairs form a staircase; None
+    otherwise.
+
+    Staircase: in member order, each member of either group is compatible with a contiguous run
+    of the other group's members, and the runs move forward with the member (heading segments of
+    consecutive steps under the heading rate, eq. 5.12e). Weights ``z1``, ``z2`` (each summing to
+    1) are then the marginals of weights on the compatible pairs exactly when every prefix of one
+    group fits into the members its prefix reaches: ``sum_{a <= k} z1_a <= sum_{b <= hi1(k)} z2_b``
+    and the same with the groups swapped (an interval of members splits into a prefix and a suffix,
+    and a suffix condition is the other group's prefix condition).
+
+    Returns:
+        Rows ``(g, k, g', k')``: prefix ``k`` of group ``g`` <= prefix ``k'`` of group ``g'``
+        (prefix ``k``: the sum of the first ``k + 1`` members' binaries), and the binaries of the
+        members with no compatible partner (fixed to 0).
+    """
+    mem = [s.groups[g].members for g in link.groups]
+    pos = [{z: k for k, z in enumerate(m)} for m in mem]
+    adj = np.zeros((len(mem[0]), len(mem[1])), dtype=bool)
+    for z1, z2 in link.pairs:
+        adj[pos[0][int(z1)], pos[1][int(z2)]] = True
+    rows: list[tuple[int, int, int, int]] = []
+    zero: list[int] = []
+    for side, a_mat in ((0, adj), (1, adj.T)):
+        prev_lo, prev_hi = -1, -1
+        reach = -1  # furthest partner of the prefix so far
+        for k in range(a_mat.shape[0]):
+            hits = np.flatnonzero(a_mat[k])
+            if not len(hits):
+                zero.append(mem[side][k])
+                continue
+            lo, hi = int(hits[0]), int(hits[-1])
+            if hi - lo + 1 != len(hits) or lo < prev_lo or hi < prev_hi:
+                return None
+            prev_lo, prev_hi = lo, hi
+            reach = max(reach, hi)
+            if reach < len(mem[1 - side]) - 1:
+                rows.append((link.groups[side], k, link.groups[1 - side], reach))
+    return rows, zero
+
+
+def _member_box(s: _Structure, g: int, z: int) -> tuple[FloatArray, FloatArray]:
+    """Bounds of the group's variables when ``z = 1``: the variable bounds tightened by the
+    member's single-variable rows (lower, upper), each (|V|,)."""
+    grp = s.groups[g]
+    lo = s.problem.lb[grp.variables].copy()
+    hi = s.problem.ub[grp.variables].copy()
+    mb = s.member[z]
+    nnz = np.count_nonzero(mb.a_v, axis=1)
+    for j in np.flatnonzero(nnz == 1):
+        c = int(np.flatnonzero(mb.a_v[j])[0])
+        v = float(mb.a_v[j, c])
+        if v > 0:
+            hi[c] = min(hi[c], mb.beta[j] / v)
+        else:
+            lo[c] = max(lo[c], mb.beta[j] / v)
+    return lo, hi
+
+
+def _links(s: _Structure) -> list[_Link]:
+    """Member pairs of two groups that the plain rows between them allow.
+
+    A plain row whose variables all lie in the variables of two groups ``g1 != g2`` (e.g. the
+    heading rate of eq. 5.12e between the segment groups of consecutive steps) couples them: the
+    pair ``(z1, z2)`` is incompatible when the row's smallest activity over the box that ``z1``
+    and ``z2`` imply exceeds its right-hand side. The relaxation then requires the weights of the
+    two groups to be the marginals of weights on the compatible pairs (a transportation flow),
+    which every integral point satisfies with one pair at weight 1.
+    """
+    pr = s.problem
+    a = s.plain_le.tocsr()
+    in_groups: dict[int, set[int]] = {}
+    for g, grp in enumerate(s.groups):
+        if len(grp.members) < 2:
+            continue
+        for c in grp.variables:
+            in_groups.setdefault(int(c), set()).add(g)
+    rows_of: dict[tuple[int, int], list[int]] = {}
+    for r in range(a.shape[0]):
+        cols = a.indices[a.indptr[r] : a.indptr[r + 1]]
+        if len(cols) < 2:
+            continue
+        cover = [in_groups.get(int(c), set()) for c in cols]
+        if any(not cv for cv in cover):
+            continue
+        for g1 in cover[0] | cover[1]:
+            for g2 in cover[0] | cover[1]:
+                if g1 < g2 and all(g1 in cv or g2 in cv for cv in cover):
+                    rows_of.setdefault((g1, g2), []).append(r)
+    links = []
+    for (g1, g2), rows in sorted(rows_of.items()):
+        v1, v2 = s.groups[g1].variables, s.groups[g2].variables
+        cols = np.union1d(v1, v2)
+        pos1, pos2 = np.searchsorted(cols, v1), np.searchsorted(cols, v2)
+        sub = a[rows][:, cols].toarray()
+        rhs = s.plain_b[rows]
+        boxes2 = [_member_box(s, g2, z2) for z2 in s.groups[g2].members]
+        pairs = []
+        for z1 in s.groups[g1].members:
+            lo1, hi1 = _member_box(s, g1, z1)
+            for z2, (lo2, hi2) in zip(s.groups[g2].members, boxes2, strict=True):
+                lo, hi = pr.lb[cols].copy(), pr.ub[cols].copy()
+                lo[pos1], hi[pos1] = np.maximum(lo[pos1], lo1), np.minimum(hi[pos1], hi1)
+                lo[pos2], hi[pos2] = np.maximum(lo[pos2], lo2), np.minimum(hi[pos2], hi2)
+                low = np.sum(np.minimum(sub * lo, sub * hi), axis=1)
+                if np.all(lo <= hi + FEAS_TOL) and np.all(
+                    low <= rhs + FEAS_TOL * np.maximum(1.0, np.abs(rhs))
+                ):
+                    pairs.append((z1, z2))
+        n_all = len(s.groups[g1].members) * len(s.groups[g2].members)
+        if len(pairs) <= (1.0 - LINK_MIN_DROP) * n_all:
+            links.append(_Link((g1, g2), np.array(pairs, dtype=np.int64).reshape(-1, 2)))
+    return links
 
 
 @dataclass
@@ -532,6 +701,44 @@ def _full_base(s: _Structure) -> _Base:
         pr.cost_matrix.tocsr()[keep], pr.cost_target[keep], pr.cost_weight[keep]
     )
     return _Base(pr.n, np.arange(pr.n, dtype=np.int64), eq, le, soc, dims, p_mat, q_vec, const)
+
+
+def _with_prefix(s: _Structure, base: _Base) -> _Base:
+    """``base`` with the prefix columns of the staircase links (see :func:`_staircase`): per group
+    in a prefix row, ``P_k = sum_{j <= k} z_j`` as a chain ``P_k - P_{k-1} - z_k = 0`` (sparse,
+    where the sums written out would be dense rows), and the rows ``P_{g,k} - P_{g',k'} <= 0``."""
+    if not s.prefix_rows:
+        return base
+    used = sorted({g for g, _, _, _ in s.prefix_rows} | {g for _, _, g, _ in s.prefix_rows})
+    start: dict[int, int] = {}
+    n_cols = base.n_cols
+    eq, le = base.eq.copy(), base.le.copy()
+    for g in used:
+        mem = s.groups[g].members
+        start[g] = n_cols
+        cols = n_cols + np.arange(len(mem))
+        zc = base.col[list(mem)]
+        r = np.arange(len(mem))
+        eq.add(
+            np.r_[r, r[1:], r],
+            np.r_[cols, cols[:-1], zc],
+            np.r_[np.ones(len(mem)), -np.ones(len(mem) - 1), -np.ones(len(mem))],
+            np.zeros(len(mem)),
+        )
+        n_cols += len(mem)
+    pr = np.array(s.prefix_rows, dtype=np.int64).reshape(-1, 4)
+    m = len(pr)
+    left = np.array([start[int(g)] for g in pr[:, 0]]) + pr[:, 1]
+    right = np.array([start[int(g)] for g in pr[:, 2]]) + pr[:, 3]
+    le.add(np.r_[np.arange(m), np.arange(m)], np.r_[left, right], np.r_[np.ones(m), -np.ones(m)],
+           np.zeros(m))  # fmt: skip
+    pm = base.p_mat
+    p_mat = sp.csc_matrix(
+        (pm.data, pm.indices, np.r_[pm.indptr, np.full(n_cols - base.n_cols, pm.nnz)]),
+        shape=(n_cols, n_cols),
+    )
+    q_vec = np.r_[base.q_vec, np.zeros(n_cols - base.n_cols)]
+    return dataclasses.replace(base, n_cols=n_cols, eq=eq, le=le, p_mat=p_mat, q_vec=q_vec)
 
 
 def _condensed_base(s: _Structure) -> _Base | None:
@@ -877,8 +1084,9 @@ class HullRelaxation:
 
         self._clarabel = clarabel
         self.s = structure
-        self.full = _full_base(structure)
-        self.condensed = _condensed_base(structure) if condense else None
+        self.full = _with_prefix(structure, _full_base(structure))
+        condensed = _condensed_base(structure) if condense else None
+        self.condensed = None if condensed is None else _with_prefix(structure, condensed)
         self._tpl = {id(self.full): _templates(structure, self.full)}
         if self.condensed is not None:
             self._tpl[id(self.condensed)] = _templates(structure, self.condensed)
@@ -888,6 +1096,25 @@ class HullRelaxation:
         self.member_index[order] = np.arange(len(order))
         self.member_vars = np.array(order, dtype=np.int64)
         self.n_members = len(order)
+        # link flows: one marginal row per (link, side, member), one weight column per pair
+        lr_mem: list[IntArray] = []
+        p_r: list[IntArray] = []
+        p_m: list[IntArray] = []
+        n_lr = 0
+        for link in structure.links:
+            m1 = self.member_index[list(structure.groups[link.groups[0]].members)]
+            m2 = self.member_index[list(structure.groups[link.groups[1]].members)]
+            lr_mem += [m1, m2]
+            # marginal row of each pair's members: position of the member in its side's block
+            pm = self.member_index[link.pairs]
+            p_m.append(pm)
+            r1 = n_lr + np.searchsorted(m1, pm[:, 0])
+            r2 = n_lr + len(m1) + np.searchsorted(m2, pm[:, 1])
+            p_r.append(np.column_stack([r1, r2]))
+            n_lr += len(m1) + len(m2)
+        self.lr_mem = _cat(lr_mem, np.int64)
+        self.p_r = np.vstack([*p_r, np.zeros((0, 2), dtype=np.int64)])
+        self.p_m = np.vstack([*p_m, np.zeros((0, 2), dtype=np.int64)])
         settings = clarabel.DefaultSettings()
         settings.verbose = False
         for key, value in CLARABEL_SETTINGS.items():
@@ -942,6 +1169,19 @@ class HullRelaxation:
         eq_c = np.concatenate([t.eq_c, ex_cols, t.l_col[lm], copy_start[cm] + cj])
         eq_v = np.concatenate([t.eq_v, np.ones(n_ex), t.l_val[lm], -np.ones(len(cm))])
         m_eq = t.m_eq + n_ex + int(np.sum(k_group[multi_g]))
+        # link flows: sum_{pairs of z} w - z = 0 per (link, side, allowed member), w >= 0
+        lrsel = sel[self.lr_mem]
+        renum = m_eq + np.cumsum(lrsel) - 1
+        psel = sel[self.p_m[:, 0]] & sel[self.p_m[:, 1]]
+        n_w = int(np.count_nonzero(psel))
+        w_col = ncol + np.arange(n_w)
+        ncol += n_w
+        eq_r = np.concatenate(
+            [eq_r, renum[self.p_r[psel, 0]], renum[self.p_r[psel, 1]], renum[lrsel]]
+        )
+        eq_c = np.concatenate([eq_c, w_col, w_col, t.zcol[self.lr_mem[lrsel]]])
+        eq_v = np.concatenate([eq_v, np.ones(2 * n_w), -np.ones(int(np.count_nonzero(lrsel)))])
+        m_eq += int(np.count_nonzero(lrsel))
         eq_b = np.concatenate([t.eq_b, np.zeros(m_eq - t.m_eq)])
 
         # inequalities: static, -z <= 0 for multi members, hull rows, direct rows
@@ -959,12 +1199,14 @@ class HullRelaxation:
         n_d = int(np.sum(t.d_nrows[single]))
         le_r = np.concatenate(
             [t.le_r, t.m_le + np.arange(nzm), h_start[hmem] + t.h_row[hm],
-             d_start[t.d_mem[dm]] + t.d_row[dm]]
+             d_start[t.d_mem[dm]] + t.d_row[dm], row0 + n_h + n_d + np.arange(n_w)]
         )  # fmt: skip
-        le_c = np.concatenate([t.le_c, zm, h_cols, t.d_col[dm]])
-        le_v = np.concatenate([t.le_v, -np.ones(nzm), t.h_val[hm], t.d_val[dm]])
-        le_b = np.concatenate([t.le_b, np.zeros(nzm + n_h), t.d_beta[single[t.d_beta_mem]]])
-        m_le = row0 + n_h + n_d
+        le_c = np.concatenate([t.le_c, zm, h_cols, t.d_col[dm], w_col])
+        le_v = np.concatenate([t.le_v, -np.ones(nzm), t.h_val[hm], t.d_val[dm], -np.ones(n_w)])
+        le_b = np.concatenate(
+            [t.le_b, np.zeros(nzm + n_h), t.d_beta[single[t.d_beta_mem]], np.zeros(n_w)]
+        )
+        m_le = row0 + n_h + n_d + n_w
 
         # cones: static (base) and perspective
         c_start = _offsets(t.cost_dim, persp)
@@ -1105,6 +1347,12 @@ def _rounded(x: FloatArray, allowed: tuple[tuple[int, ...], ...]) -> tuple[tuple
     return tuple(m if len(m) == 1 else (m[int(np.argmax(_weights(x, m)))],) for m in allowed)
 
 
+def _sos_point(w: FloatArray) -> int:
+    """Where an SOS split of weights ``w`` (members in index order) cuts: at the weighted mean."""
+    centre = float(np.dot(w, np.arange(len(w)))) / max(float(np.sum(w)), 1e-12)
+    return min(max(round(centre + 0.5), 1), len(w) - 1)
+
+
 def _candidates(
     s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], tol: float
 ) -> list[int]:
@@ -1135,8 +1383,7 @@ def _split(
     mem = allowed[g]
     w = _weights(x, mem)
     if BRANCH_SPLIT == "sos":
-        centre = float(np.dot(w, np.arange(len(mem)))) / max(float(np.sum(w)), 1e-12)
-        k = min(max(round(centre + 0.5), 1), len(mem) - 1)
+        k = _sos_point(w)
         one, other = mem[:k], mem[k:]
     else:  # "nearest": the least violated member against the rest
         z = mem[int(np.argmin(_violations(s, x, g, mem)))]
@@ -1148,12 +1395,41 @@ def _split(
     return tuple(left), tuple(right)
 
 
+def _propagate(
+    s: _Structure, allowed: tuple[tuple[int, ...], ...]
+) -> tuple[tuple[int, ...], ...] | None:
+    """Drop the members without a compatible allowed partner in some linked group (see
+    :func:`_links`), until nothing changes; None when a group is left without members (no
+    integral point of the node exists). Removes only members that no feasible point uses."""
+    cur = [set(m) for m in allowed]
+    changed = True
+    while changed:
+        changed = False
+        for link in s.compat:
+            g1, g2 = link.groups
+            keep1 = {int(a) for a, b in link.pairs if a in cur[g1] and b in cur[g2]}
+            keep2 = {int(b) for a, b in link.pairs if a in cur[g1] and b in cur[g2]}
+            if keep1 != cur[g1] or keep2 != cur[g2]:
+                cur[g1], cur[g2] = keep1, keep2
+                changed = True
+                if not keep1:
+                    return None
+    return tuple(m if len(m) == len(c) else tuple(z for z in m if z in c)
+                 for m, c in zip(allowed, cur, strict=True))  # fmt: skip
+
+
 def _branch(
     s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], tol: float
-) -> tuple[tuple[tuple[int, ...], ...], tuple[tuple[int, ...], ...]] | None:
-    """Split the best violated group (see ``BRANCH_SELECT``) into two halves (``BRANCH_SPLIT``)."""
+) -> tuple[tuple[tuple[int, ...], ...], ...] | None:
+    """Split the best violated group (see ``BRANCH_SELECT``) into two halves (``BRANCH_SPLIT``);
+    with links, each child is reduced by :func:`_propagate` (a child left empty is dropped)."""
     cands = _candidates(s, x, allowed, tol)
-    return _split(s, x, allowed, cands[0]) if cands else None
+    if not cands:
+        return None
+    children = _split(s, x, allowed, cands[0])
+    if not (PROPAGATE and s.compat):
+        return children
+    return tuple(c for c in (_propagate(s, a) for a in children) if c is not None)
 
 
 def _finish(s: _Structure, x: FloatArray, chosen: tuple[tuple[int, ...], ...]) -> FloatArray:
