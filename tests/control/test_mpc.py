@@ -113,12 +113,21 @@ def test_condensed_cost_matches_cost_of_a_simulation(model: CondensedMPC, k_s: i
     assert model.cost(k_s, z, theta) == pytest.approx(j, rel=COST_RTOL)
 
 
-def reference_solve(model: CondensedMPC, k_s: int, theta: np.ndarray) -> tuple[float, np.ndarray]:
+def reference_solve(
+    model: CondensedMPC,
+    k_s: int,
+    theta: np.ndarray,
+    limits: tuple[float, float] | None = None,
+    polygon: tuple[np.ndarray, np.ndarray] | None = None,
+) -> tuple[float, np.ndarray]:
     """Sparse SOCP of eq. (5.19) (states as variables, one per tick) solved by Clarabel.
 
     Variables: u blocks (2 n_b), d (2), x_{k_s+1..M} (4 T), x_next (4). Written from the
-    equations, not from the condensed matrices.
+    equations, not from the condensed matrices. ``limits`` = ellipse semi-axes (U_x, U_y);
+    default the ball U_max. ``polygon`` = ``(a, b)``: the footstep offset ``d`` (from a stance
+    foot at the origin) must satisfy ``a d <= b``.
     """
+    lim = (ROBOT.u_max, ROBOT.u_max) if limits is None else limits
     n_b = model.n_blocks(k_s)
     t_n = model.n_ticks - k_s
     n_u, iu_d = 2 * n_b, 2 * n_b
@@ -164,21 +173,31 @@ def reference_solve(model: CondensedMPC, k_s: int, theta: np.ndarray) -> tuple[f
         rows_eq.append(r)
         b_eq.append(0.0)
     rows_c, b_c = [], []
-    for j in range(n_b):  # (U_max, u_j) in the second-order cone (5.19e)
+    for j in range(n_b):  # (1, u_jx / U_x, u_jy / U_y) in the second-order cone (5.19e)
         rows_c.append(np.zeros(n))
-        b_c.append(ROBOT.u_max)
+        b_c.append(1.0)
         for i in range(2):
             r = np.zeros(n)
-            r[2 * j + i] = -1.0
+            r[2 * j + i] = -1.0 / lim[i]
             rows_c.append(r)
             b_c.append(0.0)
-    a = sparse.csc_matrix(np.array(rows_eq + rows_c))
-    b = np.array(b_eq + b_c)
+    rows_p, b_p = [], []
+    if polygon is not None:
+        for a_row, b_row in zip(*polygon, strict=True):
+            r = np.zeros(n)
+            r[iu_d : iu_d + 2] = a_row
+            rows_p.append(r)
+            b_p.append(b_row)
+    a = sparse.csc_matrix(np.array(rows_eq + rows_p + rows_c))
+    b = np.array(b_eq + b_p + b_c)
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.tol_gap_abs = settings.tol_gap_rel = 1e-10
     settings.tol_feas = 1e-10
-    cones = [clarabel.ZeroConeT(len(b_eq))] + [clarabel.SecondOrderConeT(3)] * n_b
+    cones = [clarabel.ZeroConeT(len(b_eq))]
+    if rows_p:
+        cones.append(clarabel.NonnegativeConeT(len(rows_p)))
+    cones += [clarabel.SecondOrderConeT(3)] * n_b
     sol = clarabel.DefaultSolver(
         sparse.triu(sparse.csc_matrix(p)).tocsc(), q, a, b, cones, settings
     ).solve()
@@ -206,6 +225,100 @@ def test_solution_is_feasible_and_optimal_against_a_sparse_reference(
     cost = model.cost(k_s, z, theta)
     assert cost <= ref_cost * (1 + OPTIMALITY_RTOL) + 1e-9
     np.testing.assert_allclose(z[:-2], z_ref[:-2], atol=TORQUE_ATOL)
+
+
+@pytest.mark.parametrize("solver", ["newton", "clarabel"])
+def test_elliptic_torque_bound_matches_the_sparse_reference(solver: str) -> None:
+    """With semi-axes (U_max, 2.5 U_max) the solution lies in the ellipse, some torques on its
+    boundary beyond U_max along u_y, and is the sparse reference's optimum."""
+    lim = (ROBOT.u_max, 2.5 * ROBOT.u_max)
+    model = build_mpc(ROBOT, MPCWeights(), RATE_DT, torque_limits=lim)
+    rng = np.random.default_rng(5)
+    beyond_ball = 0
+    for seed in range(6):
+        theta = random_theta(rng, scale=3.0)
+        k_s = int(rng.integers(0, model.n_ticks))
+        sol = MPC(model, solver=solver).solve(
+            k_s, theta[:4], np.zeros(3), np.array([*theta[4:6], 0.0]), theta[6:]
+        )
+        assert sol.status is MPCStatus.OPTIMAL, seed
+        scaled = np.hypot(sol.torques[:, 0] / lim[0], sol.torques[:, 1] / lim[1])
+        assert np.all(scaled <= 1.0 + BALL_TOL / ROBOT.u_max)
+        beyond_ball += int(np.sum(np.abs(sol.torques[:, 1]) > ROBOT.u_max * 1.05))
+        z = np.concatenate([sol.torques.ravel(), sol.next_footstep[:2]])
+        ref_cost, z_ref = reference_solve(model, k_s, theta, lim)
+        assert model.cost(k_s, z, theta) <= ref_cost * (1 + OPTIMALITY_RTOL) + 1e-9
+        np.testing.assert_allclose(z[:-2], z_ref[:-2], atol=TORQUE_ATOL * 2.5)
+    assert beyond_ball > 0, "no torque used the longer axis of the ellipse"
+
+
+def test_footstep_polygon_that_holds_the_free_optimum_changes_nothing(
+    model: CondensedMPC,
+) -> None:
+    rng = np.random.default_rng(21)
+    theta = random_theta(rng, scale=1.0)
+    args = (12, theta[:4], np.zeros(3), np.array([*theta[4:6], 0.0]), theta[6:])
+    free = MPC(model).solve(*args)
+    # a 1 m square around the free footstep
+    a = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
+    c = free.next_footstep[:2]
+    b = np.array([c[0] + 0.5, 0.5 - c[0], c[1] + 0.5, 0.5 - c[1]])
+    inside = MPC(model).solve_in_polygon(*args, a, b)
+    np.testing.assert_array_equal(inside.torques, free.torques)
+    np.testing.assert_array_equal(inside.next_footstep, free.next_footstep)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_footstep_polygon_is_respected_and_torques_compensate(seed: int) -> None:
+    """A polygon that cuts the free footstep off: the result lies in it, in the torque ellipse,
+    is the sparse reference's optimum, and its torques differ from the free solution's."""
+    lim = (ROBOT.u_max, 2.0 * ROBOT.u_max)
+    model = build_mpc(ROBOT, MPCWeights(), RATE_DT, torque_limits=lim)
+    rng = np.random.default_rng(100 + seed)
+    theta = random_theta(rng, scale=1.5)
+    k_s = int(rng.integers(0, model.n_ticks // 2))
+    stance = np.array([0.3, -0.2, 0.05])
+    ref = np.array([stance[0] + theta[4], stance[1] + theta[5], 0.1])
+    args = (k_s, theta[:4], stance, ref, theta[6:])
+    free = MPC(model).solve(*args)
+    # half-planes through a point 3 cm short of the free footstep, plus a far box
+    normal = rng.normal(size=2)
+    normal /= np.linalg.norm(normal)
+    cut = free.next_footstep[:2] - 0.03 * normal
+    a = np.vstack([normal, np.eye(2), -np.eye(2)])
+    b = np.concatenate([[normal @ cut], stance[:2] + 2.0, 2.0 - stance[:2]])
+    sol = MPC(model).solve_in_polygon(*args, a, b)
+    assert sol.status is MPCStatus.OPTIMAL and not sol.fallback and sol.message == ""
+    assert np.all(a @ sol.next_footstep[:2] <= b + 1e-6)
+    assert normal @ sol.next_footstep[:2] == pytest.approx(normal @ cut, abs=1e-6)  # active
+    scaled = np.hypot(sol.torques[:, 0] / lim[0], sol.torques[:, 1] / lim[1])
+    assert np.all(scaled <= 1.0 + 1e-9)
+    assert sol.next_footstep[2] == pytest.approx(0.1)
+    z = np.concatenate([sol.torques.ravel(), sol.next_footstep[:2] - stance[:2]])
+    ref_cost, z_ref = reference_solve(model, k_s, theta, lim, (a, b - a @ stance[:2]))
+    assert model.cost(k_s, z, theta) <= ref_cost * (1 + OPTIMALITY_RTOL) + 1e-9
+    # the cost is the strict check; two interior-point solutions of a problem this flat in the
+    # torques (R = 1e-3) agree to ~1e-4 of U_y in them
+    np.testing.assert_allclose(z[:-2], z_ref[:-2], atol=1e-4 * lim[1])
+    np.testing.assert_allclose(z[-2:], z_ref[-2:], atol=1e-5)
+    assert np.abs(sol.torques[0] - free.torques[0]).max() > 1e-3
+
+
+def test_empty_footstep_polygon_returns_the_free_solution_with_a_message(
+    model: CondensedMPC,
+) -> None:
+    rng = np.random.default_rng(4)
+    theta = random_theta(rng)
+    args = (0, theta[:4], np.zeros(3), np.array([*theta[4:6], 0.0]), theta[6:])
+    free = MPC(model).solve(*args)
+    a = np.array([[1.0, 0.0], [-1.0, 0.0]])
+    b = np.array([-1.0, -1.0])  # x <= -1 and x >= 1
+    sol = MPC(model).solve_in_polygon(*args, a, b)
+    np.testing.assert_array_equal(sol.next_footstep, free.next_footstep)
+    assert "polygon" in sol.message
+    for bad_a, bad_b in ((np.zeros((2, 3)), np.zeros(2)), (np.zeros((2, 2)), np.zeros(3))):
+        with pytest.raises(InputError):
+            MPC(model).solve_in_polygon(*args, bad_a, bad_b)
 
 
 def test_torque_bound_is_a_disc_not_a_box(model: CondensedMPC) -> None:
@@ -303,13 +416,16 @@ def test_bad_inputs_raise_input_errors(model: CondensedMPC) -> None:
         build_mpc(ROBOT, control_dt=-0.002)
     with pytest.raises(InputError, match="n_nodes"):
         build_mpc(ROBOT, n_nodes=1)
+    for bad in ((1.0,), (1.0, -2.0), (1.0, float("nan")), "ab"):
+        with pytest.raises(InputError, match="torque_limits"):
+            build_mpc(ROBOT, torque_limits=bad)  # type: ignore[arg-type]
 
 
 def test_padded_matrices_hold_the_per_tick_matrices(model: CondensedMPC) -> None:
     pad = model.padded
     assert pad is model.padded  # built once
     nu = 2 * (model.n_nodes - 1)
-    assert pad.p_scaled.shape == (model.n_ticks, nu, nu) and pad.u_max == ROBOT.u_max
+    assert pad.p_scaled.shape == (model.n_ticks, nu, nu) and np.all(pad.u_limits == ROBOT.u_max)
     for k in range(model.n_ticks):
         n = 2 * model.n_blocks(k)
         assert pad.n_b[k] == model.n_blocks(k) and pad.first_block[k] == model.first_block[k]

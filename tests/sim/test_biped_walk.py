@@ -19,6 +19,7 @@ from footfall.planning import make_plan  # noqa: E402
 from footfall.sim.biped_model import planner_params  # noqa: E402
 from footfall.sim.biped_walk import (  # noqa: E402
     BipedSim,
+    MPCAdjuster,
     PlanFollower,
     Push,
     WalkOptions,
@@ -26,9 +27,10 @@ from footfall.sim.biped_walk import (  # noqa: E402
     ankle_joint_torque,
     project_to_polygon,
     sole_cop,
+    sole_torque_limits,
     walk,
 )
-from footfall.terrain import Goal, builtin_scene  # noqa: E402
+from footfall.terrain import Goal, Region, builtin_scene  # noqa: E402
 
 #: exact arithmetic of the CoP formula
 COP_TOL = 1e-12
@@ -170,6 +172,39 @@ def test_corrected_footsteps_stay_in_the_reach_trapezoid(short_walk) -> None:  #
         rot = np.array([[np.cos(th), np.sin(th)], [-np.sin(th), np.cos(th)]])
         q = rot @ (target - stance)[:2]  # in the stance foot's heading frame
         assert robot.reach.contains(q, plan.sides[phase], tol=1e-9)
+
+
+def test_mpc_adjuster_keeps_the_footstep_in_its_region_and_the_cop_on_the_sole(short_walk) -> None:  # type: ignore[no-untyped-def]
+    scene, plan, _ = short_walk
+    robot = plan.robot
+    lim = sole_torque_limits(robot)
+    weight = robot.mass * robot.g
+    # the ellipse's semi-axes put the CoP at 0.8 of the half sole width / length
+    assert lim[0] / weight == pytest.approx(0.8 * robot.foot_width / 2)
+    assert lim[1] / weight == pytest.approx(0.8 * robot.foot_length / 2)
+    # a region that ends just past the planned footstep 2: a fast forward state wants it further
+    p2 = plan.footsteps[2]
+    margin = robot.foot_length / 2
+    short = Region.from_height(
+        plan.regions[2],
+        float(p2[2]),
+        [[-1.0, -1.0], [p2[0] + margin + 0.01, -1.0], [p2[0] + margin + 0.01, 1.0], [-1.0, 1.0]],
+    )
+    regions = {r.name: r for r in scene.terrain.regions} | {short.name: short}
+    adj = MPCAdjuster(plan, regions, region_margin=margin, torque_limits=lim)
+    assert np.array_equal(adj.mpc.model.u_limits, lim)
+    state = robot.alip().state_from_velocity(np.array([0.0, 0.0]), np.array([0.9, 0.0]))
+    stance = np.array(plan.footsteps[1])
+    target, u = adj.update(0.0, state, stance, 1)
+    assert float(short.signed_distance(target[:2])) <= -margin + 1e-6
+    assert np.hypot(u[0] / lim[0], u[1] / lim[1]) <= 1.0 + 1e-9
+    # the footstep is at the region's limit, so the ankle pushes back harder than when the
+    # footstep may move freely (CoP ahead: u_y < 0 in the ALIP convention)
+    free = MPCAdjuster(
+        plan, regions, region_margin=margin, torque_limits=lim, footstep_in_region=False
+    )
+    _, u_free = free.update(0.0, state, stance, 1)
+    assert u[1] < u_free[1] - 0.1
 
 
 def test_stop_target_leaves_the_capture_point_midway(short_walk) -> None:  # type: ignore[no-untyped-def]

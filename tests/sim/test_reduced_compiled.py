@@ -188,7 +188,7 @@ class CompiledMPC:
             pad.p_scaled,
             pad.d_theta,
             pad.d_u,
-            pad.u_max,
+            pad.u_limits,
             DUAL_TOL,
             MAX_NEWTON_ITER,
             self.mem,
@@ -201,9 +201,12 @@ class CompiledMPC:
         return torque, foot, bool(failed)
 
 
+@pytest.mark.parametrize("ellipse", [False, True])
 def test_compiled_mpc_tick_matches_solve_theta_with_warm_starts_and_fallbacks(
-    model: CondensedMPC,
+    model: CondensedMPC, ellipse: bool
 ) -> None:
+    if ellipse:  # the torque ellipse of the MuJoCo walker (U_y = 2 U_x)
+        model = build_mpc(ROBOT, MPCWeights(), 0.004, torque_limits=(ROBOT.u_max, 2 * ROBOT.u_max))
     rng = np.random.default_rng(2)
     mzh = ROBOT.mass * ROBOT.com_height
     ps = np.array([0.1, -0.05, 0.02])

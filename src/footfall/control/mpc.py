@@ -13,6 +13,11 @@ measured ALIP state, the controller optimises the remaining ankle torques ``u_{i
               x_{k_s} = x_measured                                                (5.19d)
               ||u_k||_2 <= U_max                                                  (5.19e)
 
+Beyond the document, (5.19e) may be an ellipse ``(u_x / U_x)^2 + (u_y / U_y)^2 <= 1`` (argument
+``torque_limits`` of :func:`build_mpc`): a rectangular sole allows a larger pitch torque ``u_y``
+(CoP along the foot) than roll torque ``u_x`` (CoP across it). ``U_x = U_y = U_max`` is the
+document's ball and the default.
+
 ``x_k^ref`` is the zero-torque ("natural") trajectory from the measured state, so
 ``x_k - x_k^ref`` depends on the torques only: the tracking term is a torque-shaping term whose
 Hessian does not depend on the measurement.
@@ -35,7 +40,8 @@ dynamics; it is kept at the reference height.
 
 Solver (an exact equivalent of the SOC constraint). The footstep is unconstrained, so it is
 eliminated in closed form; what is left is a strictly convex QP in the torque blocks with one 2-D
-Euclidean ball per block (eq. 5.19e as ``1/2 (||u_j||^2 - U_max^2) <= 0``, not a box). It is solved
+Euclidean ball per block (eq. 5.19e as ``1/2 (||u_j||^2 - U_max^2) <= 0``, not a box; an ellipse
+becomes a ball in the scaled torques ``v = S^-1 u``, ``S = diag(U_x, U_y)``). It is solved
 exactly through its dual: for multipliers ``lambda >= 0`` the minimiser is
 ``u(lambda) = -(P + Lambda)^-1 q`` and the concave dual is maximised by a projected Newton method
 (Bertsekas 1982) with an Armijo search, warm-started from the previous tick's multipliers. Slater's
@@ -49,7 +55,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import Enum
 from functools import cached_property
 from typing import Any
@@ -79,6 +85,10 @@ SOLVERS = ("newton", "clarabel")
 DUAL_TOL = 1e-9
 #: projected Newton iteration limit (a well-posed instance takes fewer than 15)
 MAX_NEWTON_ITER = 50
+#: a footstep this far [m] outside its polygon still counts as inside (solver tolerance)
+POLYGON_TOL = 1e-7
+#: Clarabel gap and feasibility tolerance of the footstep-polygon solve
+POLYGON_GAP_TOL = 1e-10
 
 
 class MPCStatus(str, Enum):
@@ -195,7 +205,9 @@ class CondensedMPC:
     H: tuple[FloatArray, ...]
     F: tuple[FloatArray, ...]
     c: tuple[FloatArray, ...]
-    # Reduced problem in the scaled torques u / U_max with the footstep eliminated (see solve).
+    #: semi-axes (U_x, U_y) [N m] of the torque bound (eq. 5.19e; equal = the document's ball)
+    u_limits: FloatArray = field(default_factory=lambda: np.zeros(2))
+    # Reduced problem in the scaled torques S^-1 u with the footstep eliminated (see solve).
     _p_scaled: tuple[FloatArray, ...] = field(repr=False, default=())
     _q_map: tuple[FloatArray, ...] = field(repr=False, default=())
     _gain: tuple[FloatArray, ...] = field(repr=False, default=())
@@ -258,7 +270,8 @@ class PaddedMPC:
     of length M and zero-padded to the largest number of torque variables ``NU = 2 (K - 1)``.
 
     At tick ``k_s`` only the leading ``n_u = 2 n_b[k_s]`` rows / columns are meaningful. Scaled
-    torques ``v = u / U_max`` (the balls of eq. 5.19e have radius 1); the footstep is eliminated.
+    torques ``v = S^-1 u``, ``S = diag(U_x, U_y)`` per block (the balls or ellipses of eq. 5.19e
+    have radius 1); the footstep is eliminated.
 
     Attributes:
         n_b: remaining torque blocks per tick, shape (M,).
@@ -268,7 +281,7 @@ class PaddedMPC:
         gain: unconstrained minimiser ``u = gain theta`` [N m], shape (M, NU, 10).
         d_theta: footstep offset ``d = d_theta theta + d_u u`` [m], shape (M, 2, 10).
         d_u: shape (M, 2, NU) [m / (N m)].
-        u_max: torque bound U_max [N m].
+        u_limits: torque bound semi-axes (U_x, U_y) [N m], shape (2,).
     """
 
     n_b: NDArray[np.int64]
@@ -278,7 +291,7 @@ class PaddedMPC:
     gain: FloatArray
     d_theta: FloatArray
     d_u: FloatArray
-    u_max: float
+    u_limits: FloatArray
 
 
 def pad_condensed(mdl: CondensedMPC) -> PaddedMPC:
@@ -304,7 +317,7 @@ def pad_condensed(mdl: CondensedMPC) -> PaddedMPC:
         gain=gain,
         d_theta=np.array(mdl._d_theta),
         d_u=d_u,
-        u_max=float(mdl.robot.u_max),
+        u_limits=np.array(mdl.u_limits, dtype=float),
     )
 
 
@@ -319,6 +332,7 @@ def build_mpc(
     weights: MPCWeights | None = None,
     control_dt: float = 0.002,
     n_nodes: int | None = None,
+    torque_limits: ArrayLike | None = None,
 ) -> CondensedMPC:
     """Build the condensed MPC of eq. (5.19) for every tick of a single support.
 
@@ -328,6 +342,9 @@ def build_mpc(
         control_dt: requested control period [s]; the used period is ``T_ss / M`` with
             ``M = round(T_ss / control_dt)`` so that a single support is a whole number of ticks.
         n_nodes: K, nodes of the torque blocking (default ``robot.n_nodes``); K - 1 blocks.
+        torque_limits: semi-axes ``(U_x, U_y)`` [N m] of the torque ellipse
+            ``(u_x / U_x)^2 + (u_y / U_y)^2 <= 1``; default ``(U_max, U_max)``, the ball of
+            eq. (5.19e).
 
     Returns:
         The precomputed :class:`CondensedMPC`.
@@ -354,7 +371,7 @@ def build_mpc(
     for n in range(1, m + 1):
         powers[n] = ad @ powers[n - 1]
         sums[n] = sums[n - 1] + powers[n - 1] @ bd
-    u_max = robot.u_max
+    u_lim = _torque_limits(robot, torque_limits)
 
     proto = CondensedMPC(
         robot=robot,
@@ -378,6 +395,7 @@ def build_mpc(
         H=(),
         F=(),
         c=(),
+        u_limits=u_lim,
         _powers=powers,
         _sums=sums,
     )
@@ -425,9 +443,10 @@ def build_mpc(
         p_red = h_uu - h_ud @ h_dd_inv @ h_ud.T
         p_red = 0.5 * (p_red + p_red.T)
         f_red = f[:n_u] - h_ud @ h_dd_inv @ f[n_u:]
-        # Scaled torques v = u / U_max put the balls at radius 1 (better-conditioned multipliers).
-        p_sc.append(u_max**2 * p_red)
-        q_map.append(u_max * f_red)
+        # Scaled torques v = S^-1 u put the balls at radius 1 (better-conditioned multipliers).
+        scale = np.tile(u_lim, n_u // 2)
+        p_sc.append(scale[:, None] * p_red * scale[None, :])
+        q_map.append(scale[:, None] * f_red)
         gains.append(-np.linalg.solve(p_red, f_red))
         d_th.append(-h_dd_inv @ f[n_u:])
         d_u.append(-h_dd_inv @ h_ud.T)
@@ -445,6 +464,19 @@ def build_mpc(
     ):
         object.__setattr__(proto, name, tuple(val))
     return proto
+
+
+def _torque_limits(robot: BipedParams, torque_limits: ArrayLike | None) -> FloatArray:
+    """Checked ``(U_x, U_y)`` [N m]; ``None`` gives the ball ``(U_max, U_max)`` of eq. (5.19e)."""
+    if torque_limits is None:
+        return np.array([robot.u_max, robot.u_max], dtype=float)
+    try:
+        lim = np.asarray(torque_limits, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("torque_limits", torque_limits, "two numbers (U_x, U_y) [N m]") from None
+    if lim.shape != (2,) or not np.all(np.isfinite(lim)) or np.any(lim <= 0.0):
+        raise InputError("torque_limits", torque_limits, "two finite numbers (U_x, U_y) > 0 [N m]")
+    return lim
 
 
 @dataclass(frozen=True)
@@ -652,6 +684,111 @@ class MPC:
         theta = np.concatenate([x, pr[:2] - ps[:2], xr])
         return self.solve_theta(k_s, theta, ps, pr, t0)
 
+    def solve_in_polygon(
+        self,
+        k_s: int,
+        x_measured: ArrayLike,
+        p_stance: ArrayLike,
+        p_next_ref: ArrayLike,
+        x_next_ref: ArrayLike,
+        a: ArrayLike,
+        b: ArrayLike,
+    ) -> MPCSolution:
+        """Eq. (5.19) with the next footstep also kept in the polygon ``a p_{i+1}[:2] <= b``.
+
+        Beyond the document: document 000 leaves foothold regions and reach to the planner and
+        its MPC moves the footstep freely. A walker that then clamps the footstep into its
+        region throws away the correction the MPC counted on, and the ankle torque it chose
+        assumed that correction. With the polygon in the problem the torques compensate for
+        what the footstep cannot do. When the unconstrained optimum (:meth:`solve`) already
+        lies in the polygon it is returned unchanged (it is then optimal here too); otherwise
+        the condensed problem with the footstep as a variable, the torque balls and the
+        polygon rows is solved with Clarabel (a conic interior point method).
+
+        Args:
+            k_s, x_measured, p_stance, p_next_ref, x_next_ref: as for :meth:`solve`.
+            a: outward edge normals (E, 2) of the footstep polygon.
+            b: offsets (E,) [m] (world frame, like ``p_stance``).
+
+        Returns:
+            The :class:`MPCSolution`. If the constrained solve fails (e.g. an empty polygon), the
+            unconstrained solution with a ``message`` saying why.
+        """
+        aa = np.asarray(a, dtype=float)
+        bb = np.asarray(b, dtype=float)
+        if aa.ndim != 2 or aa.shape[1] != 2 or aa.shape[0] < 1 or not np.all(np.isfinite(aa)):
+            raise InputError("a", aa.tolist(), "finite edge normals of shape (E, 2), E >= 1")
+        if bb.shape != (aa.shape[0],) or not np.all(np.isfinite(bb)):
+            raise InputError("b", bb.tolist(), f"finite offsets of shape ({aa.shape[0]},)")
+        sol = self.solve(k_s, x_measured, p_stance, p_next_ref, x_next_ref)
+        if sol.fallback or np.all(aa @ sol.next_footstep[:2] <= bb + POLYGON_TOL):
+            return sol
+        t0 = time.perf_counter()
+        mdl = self.model
+        k_s = int(k_s)
+        ps = np.asarray(p_stance, dtype=float)
+        pr = np.asarray(p_next_ref, dtype=float)
+        theta = np.concatenate(
+            [np.asarray(x_measured, float), pr[:2] - ps[:2], np.asarray(x_next_ref, float)]
+        )
+        n_u = 2 * mdl.n_blocks(k_s)
+        # z = T [v; d] with v = S^-1 u: the balls have radius 1 as in the other backends
+        scale = np.concatenate([np.tile(mdl.u_limits, n_u // 2), np.ones(2)])
+        p = scale[:, None] * mdl.H[k_s] * scale[None, :]
+        q = scale * (mdl.F[k_s] @ theta)
+        try:
+            import clarabel
+            from scipy import sparse
+
+            n = n_u + 2
+            rows = [np.hstack([np.zeros((aa.shape[0], n_u)), aa])]  # a d <= b - a p_i
+            rhs = [bb - aa @ ps[:2]]
+            for j in range(n_u // 2):  # (1, v_j) in the second-order cone
+                blk = np.zeros((3, n))
+                blk[1, 2 * j] = blk[2, 2 * j + 1] = -1.0
+                rows.append(blk)
+                rhs.append(np.array([1.0, 0.0, 0.0]))
+            settings = clarabel.DefaultSettings()
+            settings.verbose = False
+            # the torques are nearly free along some directions (R is small): solve to the
+            # accuracy of the Newton backend, not Clarabel's default 1e-8 relative gap
+            settings.tol_gap_abs = settings.tol_gap_rel = POLYGON_GAP_TOL
+            settings.tol_feas = POLYGON_GAP_TOL
+            cones = [clarabel.NonnegativeConeT(aa.shape[0])]
+            cones += [clarabel.SecondOrderConeT(3)] * (n_u // 2)
+            res = clarabel.DefaultSolver(
+                sparse.triu(sparse.csc_matrix(p), format="csc"),
+                q,
+                sparse.csc_matrix(np.vstack(rows)),
+                np.concatenate(rhs),
+                cones,
+                settings,
+            ).solve()
+        except (ValueError, RuntimeError) as exc:  # pragma: no cover - solver internals
+            return replace(sol, message=f"footstep polygon solve failed: {exc}")
+        if str(res.status) not in ("Solved", "AlmostSolved"):
+            return replace(
+                sol, message=f"footstep polygon solve: {res.status} (polygon empty?); unconstrained"
+            )
+        z = np.asarray(res.x, dtype=float)
+        vb = z[:n_u].reshape(-1, 2)
+        vb = vb / np.maximum(np.linalg.norm(vb, axis=1), 1.0)[:, None]
+        d = z[n_u:]
+        duals = np.asarray(res.z, dtype=float)[aa.shape[0] :].reshape(-1, 3)[:, 0]
+        out = MPCSolution(
+            k_s=k_s,
+            torques=vb * mdl.u_limits,
+            block_ticks=mdl.block_ticks[k_s],
+            next_footstep=np.array([ps[0] + d[0], ps[1] + d[1], pr[2]]),
+            status=MPCStatus.OPTIMAL,
+            fallback=False,
+            solve_time=sol.solve_time + time.perf_counter() - t0,
+            iterations=int(res.iterations),
+            multipliers=duals,
+        )
+        self._last = out
+        return out
+
     def solve_theta(
         self,
         k_s: int,
@@ -710,15 +847,15 @@ class MPC:
         self, k_s: int, theta: FloatArray, lam0: FloatArray | None
     ) -> tuple[FloatArray, FloatArray, int, bool]:
         mdl = self.model
-        u_max = mdl.robot.u_max
+        u_lim = mdl.u_limits
         u = mdl._gain[k_s] @ theta
-        ub = u.reshape(-1, 2)
-        if np.einsum("ij,ij->i", ub, ub).max() <= u_max**2:
+        vb = u.reshape(-1, 2) / u_lim
+        if np.einsum("ij,ij->i", vb, vb).max() <= 1.0:
             # No ball active: the unconstrained minimiser is optimal (all multipliers zero).
-            return u, np.zeros(ub.shape[0]), 0, True
+            return u, np.zeros(vb.shape[0]), 0, True
         q = mdl._q_map[k_s] @ theta
         v, lam, iters, ok = solve_ball_qp(mdl._p_scaled[k_s], q, lam0)
-        return u_max * v, lam, iters, ok
+        return (v.reshape(-1, 2) * u_lim).ravel(), lam, iters, ok
 
     def _solve_clarabel(
         self, k_s: int, theta: FloatArray
@@ -757,7 +894,7 @@ class MPC:
         vb = vb / np.maximum(np.linalg.norm(vb, axis=1), 1.0)[:, None]
         z = np.asarray(res.z, dtype=float).reshape(n_b, 3)
         # The SOC multiplier z_0 of block j equals lambda_j ||v_j|| = lambda_j on the sphere.
-        return mdl.robot.u_max * vb.ravel(), z[:, 0], int(res.iterations), ok
+        return (vb * mdl.u_limits).ravel(), z[:, 0], int(res.iterations), ok
 
     def _fallback(
         self, k_s: int, ps: FloatArray, pr: FloatArray, t0: float, message: str

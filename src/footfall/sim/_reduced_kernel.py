@@ -342,7 +342,7 @@ def mpc_step(
     p_scaled: np.ndarray,
     d_theta: np.ndarray,
     d_u: np.ndarray,
-    u_max: float,
+    u_limits: np.ndarray,
     tol: float,
     max_iter: int,
     mem: np.ndarray,
@@ -359,7 +359,7 @@ def mpc_step(
         theta: ``[x_measured (4), d_ref (2), x_next_ref (4)]`` (10,).
         ps: stance footstep p_i (3,) [m].
         pr: planned next footstep (3,) [m].
-        n_b_all .. u_max: the fields of :class:`footfall.control.mpc.PaddedMPC`.
+        n_b_all .. u_limits: the fields of :class:`footfall.control.mpc.PaddedMPC`.
         tol, max_iter: Newton tolerance and iteration limit.
         mem: integer memory (:data:`MEM_SIZE`,) kept across ticks: last good tick (-1: none),
             solve and fallback counters, iterations of this solve.
@@ -397,9 +397,11 @@ def mpc_step(
                 acc += g[i, c] * theta[c]
             u[i] = acc
         for b in range(n_b):
-            nrm2 = u[2 * b] * u[2 * b] + u[2 * b + 1] * u[2 * b + 1]
+            vx = u[2 * b] / u_limits[0]
+            vy = u[2 * b + 1] / u_limits[1]
+            nrm2 = vx * vx + vy * vy
             worst = nrm2 if nrm2 > worst else worst
-        if worst > u_max * u_max:
+        if worst > 1.0:
             # A torque disc is active: the dual Newton method on the scaled problem.
             qm = q_map[k_s]
             q = np.empty(n)
@@ -420,7 +422,7 @@ def mpc_step(
             else:
                 total = 0.0
                 for i in range(n):
-                    u[i] *= u_max
+                    u[i] *= u_limits[i % 2]
                     total += u[i]
                 failed = not math.isfinite(total)
     if failed:
@@ -497,7 +499,7 @@ def walk(
     p_scaled: np.ndarray,
     d_theta: np.ndarray,
     d_u: np.ndarray,
-    u_max: float,
+    u_limits: np.ndarray,
     tol: float,
     max_iter: int,
     plant: tuple[
@@ -535,7 +537,7 @@ def walk(
         p_refs: planned next footstep of each phase (n, 3) [m].
         x_refs: planned state after each phase's reset (n, 4).
         cos_h, sin_h: cosine and sine of each phase's stance heading (n,).
-        n_b_all .. u_max: :class:`footfall.control.mpc.PaddedMPC` fields; tol, max_iter: Newton.
+        n_b_all .. u_limits: :class:`footfall.control.mpc.PaddedMPC` fields; tol, max_iter: Newton.
         plant: true-plant matrices ``(Ad_tick (4, 4), Bd_tick (4, 2), Ad_sub, Bd_sub,
             Ad_ds_tick (8, 8), Ad_ds_sub (8, 8), Bd_ds_sub (8, 2))``.
         push_tab: push torque per tick row and sub-step (rows, n_sub, 2) [N m]; push_any and
@@ -608,7 +610,7 @@ def walk(
                 p_scaled,
                 d_theta,
                 d_u,
-                u_max,
+                u_limits,
                 tol,
                 max_iter,
                 mem,

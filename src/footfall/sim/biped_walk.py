@@ -41,10 +41,16 @@ from footfall._validate import finite_vector, non_negative, positive
 from footfall.control.mpc import MPC, MPCWeights, build_mpc
 from footfall.errors import FootfallError, InputError
 from footfall.models.alip import ALIP
-from footfall.models.biped import Side
+from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import FootstepPlan
 from footfall.sim import biped_names as nm
-from footfall.sim.biped_model import BipedModel, BipedSimSettings, biped_mjcf, require_mujoco
+from footfall.sim.biped_model import (
+    U_MAX_FOOT_SHARE,
+    BipedModel,
+    BipedSimSettings,
+    biped_mjcf,
+    require_mujoco,
+)
 from footfall.sim.terrain_mjcf import terrain_xml
 from footfall.terrain.region import Region
 from footfall.terrain.scene import Scene
@@ -470,17 +476,27 @@ class MPCAdjuster(PlanFollower):
             from the goal; at 0.9 it reached it with a 0.014 m mean footstep error.
         capture_stop: off: the MPC's terminal term (Q_f toward the plan's final state at rest)
             places the last footstep.
+        torque_limits: semi-axes ``(U_x, U_y)`` [N m] of the MPC's torque ellipse
+            (:func:`footfall.control.mpc.build_mpc`); None = the plan's ``U_max`` ball
+            (eq. 5.19e). :func:`walk` passes :func:`sole_torque_limits`.
+        footstep_in_region: solve the MPC with the next footstep kept in its planned region
+            (``region_margin`` inside, :meth:`footfall.control.mpc.MPC.solve_in_polygon`)
+            instead of clamping the document's unconstrained footstep afterwards, so the ankle
+            torque makes up for a correction the region does not allow.
     """
 
     control_dt: float = 0.01
     freeze_after: float = 0.9
     weights: MPCWeights = field(default_factory=MPCWeights)
     capture_stop: bool = False
+    torque_limits: tuple[float, float] | None = None
+    footstep_in_region: bool = True
     mpc: MPC = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        self.mpc = MPC(build_mpc(self.plan.robot, self.weights, self.control_dt))
+        mdl = build_mpc(self.plan.robot, self.weights, self.control_dt, None, self.torque_limits)
+        self.mpc = MPC(mdl)
 
     def update(
         self, t: float, state: FloatArray, stance: FloatArray, phase: int
@@ -491,7 +507,14 @@ class MPCAdjuster(PlanFollower):
         k_s = min(max(round(t / mdl.control_dt), 0), mdl.n_ticks - 1)
         ref_next = np.array(plan.footsteps[phase + 1])
         x_next = plan.states[phase + 1, 0] if phase + 1 < plan.n_steps else plan.final_state
-        sol = self.mpc.solve(k_s, state, stance, ref_next, x_next)
+        region = self.regions.get(plan.regions[phase + 1])
+        if self.footstep_in_region and region is not None and phase not in self._frozen:
+            a, b = region.halfspaces()
+            sol = self.mpc.solve_in_polygon(
+                k_s, state, stance, ref_next, x_next, a, b - self.region_margin
+            )
+        else:
+            sol = self.mpc.solve(k_s, state, stance, ref_next, x_next)
         u = np.array(sol.torques[0])
         if phase in self._frozen:
             return self._frozen[phase], u
@@ -502,6 +525,18 @@ class MPCAdjuster(PlanFollower):
             target = np.array(sol.next_footstep)
         target = self._legal(target, ref_next, stance, phase)
         return self._maybe_freeze(t, phase, target), u
+
+
+def sole_torque_limits(robot: BipedParams) -> tuple[float, float]:
+    """Ankle torque semi-axes ``(U_x, U_y)`` [N m] that keep the CoP on the sole.
+
+    ``U_MAX_FOOT_SHARE`` of the weight times half the sole width (roll torque ``u_x`` moves the
+    CoP across the foot) and half the sole length (pitch torque ``u_y`` moves it along). The
+    planner keeps the document's smaller ball ``U_max`` (a cost on torque as much as a limit);
+    the walker's MPC may use the sole's length.
+    """
+    weight = U_MAX_FOOT_SHARE * robot.mass * robot.g
+    return (weight * robot.foot_width / 2.0, weight * robot.foot_length / 2.0)
 
 
 # ============================================================================= geometry helpers
@@ -1082,6 +1117,7 @@ def walk(
             region_margin=plan.robot.foot_length / 2.0,
             control_dt=dt,
             stop_steps=opts.stop_steps,
+            torque_limits=sole_torque_limits(plan.robot),
         )
     )
     n_planned = plan.n_steps

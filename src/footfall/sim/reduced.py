@@ -648,7 +648,7 @@ def _walk_compiled(w: _Walk) -> _Trace:
         pad.p_scaled,
         pad.d_theta,
         pad.d_u,
-        pad.u_max,
+        pad.u_limits,
         DUAL_TOL,
         MAX_NEWTON_ITER,
         (w.ad_t, w.bd_t, w.ad_s, w.bd_s, w.ad_ds, w.ad_dss, w.bd_dss),
