@@ -193,11 +193,12 @@ def test_mpc_adjuster_keeps_the_footstep_in_its_region_and_the_cop_on_the_sole(s
     regions = {r.name: r for r in scene.terrain.regions} | {short.name: short}
     adj = MPCAdjuster(plan, regions, region_margin=margin, torque_limits=lim)
     assert np.array_equal(adj.mpc.model.u_limits, lim)
-    state = robot.alip().state_from_velocity(np.array([0.0, 0.0]), np.array([0.9, 0.0]))
+    state = robot.alip().state_from_velocity(np.array([0.0, 0.0]), np.array([0.5, 0.0]))
     stance = np.array(plan.footsteps[1])
     target, u = adj.update(0.0, state, stance, 1)
     assert float(short.signed_distance(target[:2])) <= -margin + 1e-6
-    assert np.hypot(u[0] / lim[0], u[1] / lim[1]) <= 1.0 + 1e-9
+    u_sole = in_sole_frame(u, float(plan.headings[1]))
+    assert np.hypot(u_sole[0] / lim[0], u_sole[1] / lim[1]) <= 1.0 + 1e-9
     # the footstep is at the region's limit, so the ankle pushes back harder than when the
     # footstep may move freely (CoP ahead: u_y < 0 in the ALIP convention)
     free = MPCAdjuster(
@@ -205,6 +206,29 @@ def test_mpc_adjuster_keeps_the_footstep_in_its_region_and_the_cop_on_the_sole(s
     )
     _, u_free = free.update(0.0, state, stance, 1)
     assert u[1] < u_free[1] - 0.1
+
+
+def in_sole_frame(u: np.ndarray, heading: float) -> np.ndarray:
+    """World-frame ankle torque (2,) as (roll, pitch) about the axes of a sole at ``heading``."""
+    c, s = np.cos(heading), np.sin(heading)
+    return np.array([[c, s], [-s, c]]) @ u
+
+
+@pytest.mark.parametrize("heading", [0.0, 0.7, np.pi / 2])
+def test_mpc_adjuster_torque_ellipse_lies_along_the_stance_sole(short_walk, heading: float) -> None:  # type: ignore[no-untyped-def]
+    """A large velocity error along the sole saturates the torque beyond U_x along the sole's
+    axis, never outside the ellipse in the sole's frame, whatever the heading."""
+    _, plan, _ = short_walk
+    robot = plan.robot
+    lim = sole_torque_limits(robot)
+    turned = replace(plan, headings=np.full_like(plan.headings, heading))
+    adj = MPCAdjuster(turned, {}, torque_limits=lim, footstep_in_region=False)
+    along = np.array([np.cos(heading), np.sin(heading)])
+    state = robot.alip().state_from_velocity(np.zeros(2), -0.8 * along)  # moving backwards
+    _, u = adj.update(0.0, state, np.array(plan.footsteps[1]), 1)
+    u_foot = in_sole_frame(u, heading)
+    assert np.hypot(u_foot[0] / lim[0], u_foot[1] / lim[1]) <= 1.0 + 1e-9
+    assert abs(u_foot[1]) > 1.5 * lim[0]  # pitch torque beyond the short semi-axis
 
 
 def test_stop_target_leaves_the_capture_point_midway(short_walk) -> None:  # type: ignore[no-untyped-def]

@@ -507,24 +507,46 @@ class MPCAdjuster(PlanFollower):
         k_s = min(max(round(t / mdl.control_dt), 0), mdl.n_ticks - 1)
         ref_next = np.array(plan.footsteps[phase + 1])
         x_next = plan.states[phase + 1, 0] if phase + 1 < plan.n_steps else plan.final_state
+        # Solve in the stance foot's heading frame: the ALIP and the cost are isotropic, so this
+        # changes nothing but the orientation of the torque ellipse, whose long axis must lie
+        # along the sole.
+        rot = _rot2(float(plan.headings[phase]))
+        rot4 = np.kron(np.eye(2), rot)
         region = self.regions.get(plan.regions[phase + 1])
+        args = (
+            k_s,
+            rot4.T @ state,
+            _rotate_xy(rot.T, stance),
+            _rotate_xy(rot.T, ref_next),
+            rot4.T @ x_next,
+        )
         if self.footstep_in_region and region is not None and phase not in self._frozen:
             a, b = region.halfspaces()
-            sol = self.mpc.solve_in_polygon(
-                k_s, state, stance, ref_next, x_next, a, b - self.region_margin
-            )
+            sol = self.mpc.solve_in_polygon(*args, a @ rot, b - self.region_margin)
         else:
-            sol = self.mpc.solve(k_s, state, stance, ref_next, x_next)
-        u = np.array(sol.torques[0])
+            sol = self.mpc.solve(*args)
+        u = rot @ sol.torques[0]
         if phase in self._frozen:
             return self._frozen[phase], u
         if self.capture_stop and phase == plan.n_steps - 1:
             target = np.array(ref_next)
             target[:2] = self.stop_target(t, state, stance, phase, u)
         else:
-            target = np.array(sol.next_footstep)
+            target = _rotate_xy(rot, sol.next_footstep)
         target = self._legal(target, ref_next, stance, phase)
         return self._maybe_freeze(t, phase, target), u
+
+
+def _rot2(theta: float) -> FloatArray:
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s], [s, c]])
+
+
+def _rotate_xy(rot: FloatArray, p: FloatArray) -> FloatArray:
+    """``p`` (3,) with its horizontal part multiplied by ``rot`` (2, 2); height unchanged."""
+    out = np.array(p, dtype=float)
+    out[:2] = rot @ out[:2]
+    return out
 
 
 def sole_torque_limits(robot: BipedParams) -> tuple[float, float]:
