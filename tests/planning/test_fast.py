@@ -354,3 +354,37 @@ def test_propagation_drops_only_members_without_a_compatible_partner(
     link56 = next(lk for lk in structure.compat if lk.groups == (g5, g6))
     assert (z5, z6) not in {(int(a), int(b)) for a, b in link56.pairs}
     assert bnb._propagate(structure, clash) is None
+
+
+def test_clarabel_gets_the_same_problem_from_lists() -> None:
+    """The node solver hands Clarabel its matrices as lists (:class:`bnb._CscLists`, cheaper to
+    convert): same solution as from the scipy matrices, also for a non-canonical input."""
+    import clarabel
+    import scipy.sparse as sp
+
+    rng = np.random.default_rng(0)
+    m, n = 12, 5
+    a_dense = rng.normal(size=(m, n))
+    rows, cols = np.nonzero(a_dense)
+    # duplicate entries (summed by scipy) make the COO input non-canonical
+    a_mat = sp.csc_matrix(
+        (np.r_[a_dense[rows, cols], [1.0]], (np.r_[rows, [0]], np.r_[cols, [0]])), shape=(m, n)
+    )
+    a_dup = sp.csc_matrix(
+        (np.r_[a_dense[rows, cols], [0.5, 0.5]], (np.r_[rows, [0, 0]], np.r_[cols, [0, 0]])),
+        shape=(m, n),
+    )
+    a_dup.has_canonical_format = False
+    p_mat = sp.triu(sp.csc_matrix(np.eye(n) * 2.0), format="csc")
+    q, b = rng.normal(size=n), np.abs(rng.normal(size=m)) + 1.0
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    ref = clarabel.DefaultSolver(p_mat, q, a_mat, b, [clarabel.NonnegativeConeT(m)], settings)
+    ref_sol = ref.solve()
+    got = clarabel.DefaultSolver(
+        bnb._CscLists(p_mat), q.tolist(), bnb._CscLists(a_dup), b.tolist(),
+        [clarabel.NonnegativeConeT(m)], settings,
+    ).solve()  # fmt: skip
+    assert str(got.status) == str(ref_sol.status) == "Solved"
+    assert np.allclose(got.x, ref_sol.x, atol=1e-12)
+    assert got.obj_val == pytest.approx(ref_sol.obj_val, abs=1e-12)

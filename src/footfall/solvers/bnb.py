@@ -1065,6 +1065,27 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
     )
 
 
+class _CscLists:
+    """A CSC matrix with its arrays as Python lists, to hand to ``clarabel.DefaultSolver``.
+
+    Clarabel's Python wrapper (0.11) reads ``data``, ``indices`` and ``indptr`` element by element;
+    from numpy arrays that costs about 0.65 ms of a 9 ms node solve at N = 15, from lists (built by
+    ``tolist``) about a third of it. It reads only these attributes and ``shape`` and
+    ``has_canonical_format``; the matrices given are canonical (sorted, no duplicates).
+    """
+
+    __slots__ = ("data", "has_canonical_format", "indices", "indptr", "shape")
+
+    def __init__(self, mat: sp.csc_matrix) -> None:
+        if not mat.has_canonical_format:
+            mat.sum_duplicates()
+        self.data = mat.data.tolist()
+        self.indices = mat.indices.tolist()
+        self.indptr = mat.indptr.tolist()
+        self.shape = mat.shape
+        self.has_canonical_format = True
+
+
 def _offsets(counts: IntArray, mask: NDArray[np.bool_]) -> IntArray:
     """Start of each selected item in a packed layout (garbage where not selected)."""
     c = np.where(mask, counts, 0)
@@ -1257,7 +1278,9 @@ class HullRelaxation:
         cones += [cl.SecondOrderConeT(int(dd)) for dd in base.soc_dims]
         cones += [cl.SecondOrderConeT(int(dd)) for dd in t.cost_dim[persp]]
         t0 = time.perf_counter()
-        solver = cl.DefaultSolver(p_mat, q, a_mat, b, cones, self._settings)
+        solver = cl.DefaultSolver(
+            _CscLists(p_mat), q.tolist(), _CscLists(a_mat), b.tolist(), cones, self._settings
+        )
         sol = solver.solve()
         self.solve_time += time.perf_counter() - t0
         self.solves += 1
