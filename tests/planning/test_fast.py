@@ -388,3 +388,45 @@ def test_clarabel_gets_the_same_problem_from_lists() -> None:
     assert str(got.status) == str(ref_sol.status) == "Solved"
     assert np.allclose(got.x, ref_sol.x, atol=1e-12)
     assert got.obj_val == pytest.approx(ref_sol.obj_val, abs=1e-12)
+
+
+def test_compact_node_problems_are_the_same_relaxation(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``bnb.COMPACT`` leaves out free columns, excluded binaries and implied ``z >= 0`` rows:
+    the node bounds (condensed and full) and statuses stay those of the plain node problems."""
+    fp = build_footstep_problem(_scene(5, 0), ROBOT, 5)
+    structure = bnb.analyse(fp.problem)
+    monkeypatch.setattr(bnb, "COMPACT", False)
+    plain = bnb.HullRelaxation(structure)
+    monkeypatch.setattr(bnb, "COMPACT", True)
+    compact = bnb.HullRelaxation(structure)
+    assert compact.condensed is not None
+    dropped = compact._tpl[id(compact.condensed)].drop_col
+    # the private sin/cos of the heading segments (and footstep 0's, fixed by their bounds)
+    private = np.concatenate([grp.private for grp in structure.groups])
+    assert len(private) and set(compact.condensed.col[private]) <= set(dropped)
+    rng = np.random.default_rng(3)
+    root = bnb._root_allowed(structure)
+    nodes = [root]
+    for _ in range(12):  # random nodes: every group keeps a random non-empty subset
+        nodes.append(
+            tuple(
+                tuple(sorted(rng.choice(mem, size=rng.integers(1, len(mem) + 1), replace=False)))
+                for mem in root
+            )
+        )
+    statuses = set()
+    for allowed in nodes:
+        for full in (False, True):
+            monkeypatch.setattr(bnb, "COMPACT", False)
+            ref = plain.solve(allowed, full=full)
+            monkeypatch.setattr(bnb, "COMPACT", True)
+            got = compact.solve(allowed, full=full)
+            assert got.status == ref.status
+            statuses.add(ref.status)
+            if ref.status == "solved":
+                assert got.bound == pytest.approx(ref.bound, rel=1e-6, abs=1e-7)
+                assert got.x is not None
+                # the left-out variables get values within their bounds
+                v = np.flatnonzero(np.isin(compact.condensed.col, dropped))
+                assert np.all(fp.problem.lb[v] <= got.x[v]) and np.all(got.x[v] <= fp.problem.ub[v])
+    assert "solved" in statuses

@@ -116,6 +116,11 @@ LINKS = False
 LINK_MIN_DROP = 0.25
 #: write a staircase link as prefix rows on its binaries instead of pair weights
 STAIRCASE = True
+#: node problems leave out the columns only their own bounds constrain (see
+#: :func:`_dropped_columns`), the binaries of excluded members (instead of rows fixing them to 0)
+#: and the rows ``z >= 0`` that a member's perspective cone implies: the same relaxation with a
+#: smaller KKT system (a node's cost grows about linearly with its size)
+COMPACT = True
 #: with threads >= 2, keep the workers busy asynchronously (else: synchronous batches)
 ASYNC = True
 #: at the end of an asynchronous search, wait at most this long [s] for the solves in flight
@@ -920,6 +925,72 @@ class _Templates:
     l_row: IntArray
     l_col: IntArray
     l_val: FloatArray
+    # base columns left out of every node problem (see :func:`_dropped_columns`), their values
+    drop_col: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    drop_val: FloatArray = field(default_factory=lambda: np.zeros(0))
+    # static inequality rows that hold binaries only (they may lose every entry at a node)
+    le_bin_rows: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    # the base's P (upper triangle) as COO entries
+    p_i: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    p_j: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    p_v: FloatArray = field(default_factory=lambda: np.zeros(0))
+
+
+def _dropped_columns(s: _Structure, t: _Templates) -> _Templates:
+    """``t`` without the base columns that only their own bounds constrain.
+
+    A column with no cost that appears in no row but single-variable inequality rows (its bounds),
+    in no cone and in no group's rows is a free coordinate of the relaxation: leaving it out (with
+    those rows) is the exact projection, so every node bound stays the same while each node's KKT
+    system loses a column and two rows. In the planner these are the private sin/cos of the
+    heading segments (their member rows are eliminated, see :func:`analyse`). Their value in a
+    relaxation point is any value within their bounds (the midpoint, or the finite bound).
+    Columns with conflicting bounds are kept, so the node solve still reports infeasibility.
+    """
+    base = t.base
+    n = base.n_cols
+    le_cnt = np.bincount(t.le_r, minlength=t.m_le)
+    single = le_cnt[t.le_r] == 1
+    used = np.zeros(n, dtype=bool)
+    pm = base.p_mat.tocoo()
+    soc_c = _cat(base.soc.c, np.int64)
+    special = base.col[np.r_[np.flatnonzero(s.problem.integer), base.y_from]]
+    for cols in (t.eq_c, t.le_c[~single], soc_c, t.l_col, t.d_col, t.dp_i, t.dp_j, t.dq_i,
+                 t.zcol, pm.row, pm.col, special[special >= 0]):  # fmt: skip
+        used[cols] = True
+    used[base.q_vec != 0.0] = True
+    lo = np.full(n, -np.inf)
+    hi = np.full(n, np.inf)
+    sc, sv, sb = t.le_c[single], t.le_v[single], t.le_b[t.le_r[single]]
+    pos = sv > 0
+    np.minimum.at(hi, sc[pos], sb[pos] / sv[pos])
+    np.maximum.at(lo, sc[~pos], sb[~pos] / sv[~pos])
+    drop = ~used & (lo <= hi)
+    if not np.any(drop):
+        return t
+    both = np.isfinite(lo) & np.isfinite(hi)
+    val = np.clip(0.0, lo, hi)
+    val[both] = 0.5 * (lo[both] + hi[both])
+    keep_row = np.ones(t.m_le, dtype=bool)
+    keep_row[t.le_r[single & drop[t.le_c]]] = False
+    ent = keep_row[t.le_r]
+    row_map = np.cumsum(keep_row) - 1
+    is_bin = np.zeros(n, dtype=bool)
+    is_bin[t.zcol] = True
+    le_r = row_map[t.le_r[ent]]
+    m_le = int(np.count_nonzero(keep_row))
+    nonbin = np.bincount(le_r, weights=~is_bin[t.le_c[ent]], minlength=m_le)
+    return dataclasses.replace(
+        t,
+        le_r=le_r,
+        le_c=t.le_c[ent],
+        le_v=t.le_v[ent],
+        le_b=t.le_b[keep_row],
+        m_le=m_le,
+        drop_col=np.flatnonzero(drop),
+        drop_val=val[drop],
+        le_bin_rows=np.flatnonzero(nonbin == 0),
+    )
 
 
 def _templates(s: _Structure, base: _Base) -> _Templates:
@@ -1015,7 +1086,7 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
                 dconst.append(0.0)
             mi += 1
     i64, f64 = np.int64, float
-    return _Templates(
+    out = _Templates(
         base=base,
         eq_r=_cat(base.eq.r, i64),
         eq_c=_cat(base.eq.c, i64),
@@ -1063,6 +1134,15 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
         l_col=_cat(link[2], i64),
         l_val=_cat(link[3], f64),
     )
+    pm = base.p_mat.tocoo()
+    out = dataclasses.replace(
+        out, p_i=pm.row.astype(i64), p_j=pm.col.astype(i64), p_v=pm.data.astype(f64)
+    )
+    is_bin = np.zeros(base.n_cols, dtype=bool)
+    is_bin[out.zcol] = True
+    nonbin = np.bincount(out.le_r, weights=~is_bin[out.le_c], minlength=out.m_le)
+    out = dataclasses.replace(out, le_bin_rows=np.flatnonzero(nonbin == 0))
+    return _dropped_columns(s, out) if COMPACT else out
 
 
 class _CscLists:
@@ -1141,6 +1221,7 @@ class HullRelaxation:
         for key, value in CLARABEL_SETTINGS.items():
             setattr(settings, key, value)
         self._settings = settings
+        self._cones: dict[int, Any] = {}
         self.solves = 0
         self.solve_time = 0.0
 
@@ -1173,9 +1254,9 @@ class HullRelaxation:
         t_col = ncol0 + n_copies + _offsets(np.ones_like(t.k), persp)
         ncol = ncol0 + n_copies + int(np.count_nonzero(persp))
 
-        # equalities: static, excluded binaries = 0, linking rows of multi groups
+        # equalities: static, excluded binaries = 0 (unless left out), linking rows of multi groups
         ex_cols = t.zcol[excluded]
-        n_ex = len(ex_cols)
+        n_ex = 0 if COMPACT else len(ex_cols)
         k_group = np.zeros(n_groups, dtype=np.int64)
         k_group[t.group] = t.k
         link_start = t.m_eq + n_ex + _offsets(k_group, multi_g)
@@ -1187,7 +1268,7 @@ class HullRelaxation:
             [t.eq_r, t.m_eq + np.arange(n_ex), link_start[t.l_grp[lm]] + t.l_row[lm],
              link_start[t.group[cm]] + cj]
         )  # fmt: skip
-        eq_c = np.concatenate([t.eq_c, ex_cols, t.l_col[lm], copy_start[cm] + cj])
+        eq_c = np.concatenate([t.eq_c, ex_cols[:n_ex], t.l_col[lm], copy_start[cm] + cj])
         eq_v = np.concatenate([t.eq_v, np.ones(n_ex), t.l_val[lm], -np.ones(len(cm))])
         m_eq = t.m_eq + n_ex + int(np.sum(k_group[multi_g]))
         # link flows: sum_{pairs of z} w - z = 0 per (link, side, allowed member), w >= 0
@@ -1205,8 +1286,10 @@ class HullRelaxation:
         m_eq += int(np.count_nonzero(lrsel))
         eq_b = np.concatenate([t.eq_b, np.zeros(m_eq - t.m_eq)])
 
-        # inequalities: static, -z <= 0 for multi members, hull rows, direct rows
-        zm = t.zcol[multi]
+        # inequalities: static, -z <= 0 for multi members (not where the perspective cone implies
+        # it), hull rows, direct rows
+        zrow = multi & ~t.has_cost if COMPACT else multi
+        zm = t.zcol[zrow]
         nzm = len(zm)
         row0 = t.m_le + nzm
         h_start = row0 + _offsets(t.n_rows, multi)
@@ -1253,19 +1336,12 @@ class HullRelaxation:
         cols = np.concatenate([eq_c, le_c, _cat(soc.c, np.int64), c_cols])
         vals = np.concatenate([eq_v, le_v, _cat(soc.v, float), t.c_val[cmask]])
         b = np.concatenate([eq_b, le_b, _cat(soc.b, float), np.zeros(n_pc)])
-        a_mat = sp.csc_matrix((vals, (rows, cols)), shape=(m_eq + m_le + soc.m + n_pc, ncol))
+        n_rows = m_eq + m_le + soc.m + n_pc
 
-        pm = base.p_mat
-        p_mat = sp.csc_matrix(
-            (pm.data, pm.indices, np.r_[pm.indptr, np.full(ncol - base.n_cols, pm.nnz)]),
-            shape=(ncol, ncol),
-        )
         pmask = single[t.dp_mem]
-        if np.any(pmask):
-            p_mat = (
-                p_mat
-                + sp.csc_matrix((t.dp_v[pmask], (t.dp_i[pmask], t.dp_j[pmask])), shape=(ncol, ncol))
-            ).tocsc()
+        p_i = np.concatenate([t.p_i, t.dp_i[pmask]])
+        p_j = np.concatenate([t.p_j, t.dp_j[pmask]])
+        p_v = np.concatenate([t.p_v, t.dp_v[pmask]])
         q = np.zeros(ncol)
         q[: base.n_cols] = base.q_vec
         qmask = single[t.dq_mem]
@@ -1273,10 +1349,40 @@ class HullRelaxation:
         q[t_col[persp]] = 1.0
         const = base.const + float(np.sum(t.d_const[single]))
 
+        zrows = m_eq + t.m_le + np.arange(nzm)  # rows of -z <= 0, for the multipliers
+        keep_col = None
+        if COMPACT:
+            # leave out the excluded binaries (0 at the node) and the free columns of the base
+            keep_col = np.ones(ncol, dtype=bool)
+            keep_col[ex_cols] = False
+            keep_col[t.drop_col] = False
+            ent = keep_col[cols]
+            rows, cols, vals = rows[ent], cols[ent], vals[ent]
+            col_map = np.cumsum(keep_col) - 1
+            cols = col_map[cols]
+            p_i, p_j = col_map[p_i], col_map[p_j]  # no cost on left-out columns
+            q = q[keep_col]
+            if len(t.le_bin_rows):
+                # a row of binaries only that lost all its entries reads 0 <= b
+                bin_rows = t.le_bin_rows + m_eq
+                empty = bin_rows[np.bincount(rows, minlength=n_rows)[bin_rows] == 0]
+                if len(empty):
+                    if np.any(b[empty] < 0.0):
+                        return _Relaxation("infeasible")
+                    keep_row = np.ones(n_rows, dtype=bool)
+                    keep_row[empty] = False
+                    row_map = np.cumsum(keep_row) - 1
+                    rows, b, zrows = row_map[rows], b[keep_row], row_map[zrows]
+                    m_le -= len(empty)
+                    n_rows -= len(empty)
+        n_var = len(q)
+        a_mat = sp.csc_matrix((vals, (rows, cols)), shape=(n_rows, n_var))
+        p_mat = sp.csc_matrix((p_v, (p_i, p_j)), shape=(n_var, n_var))
+
         cl = self._clarabel
         cones: list[Any] = [cl.ZeroConeT(m_eq), cl.NonnegativeConeT(m_le)]
-        cones += [cl.SecondOrderConeT(int(dd)) for dd in base.soc_dims]
-        cones += [cl.SecondOrderConeT(int(dd)) for dd in t.cost_dim[persp]]
+        cones += [self._soc(int(dd)) for dd in base.soc_dims]
+        cones += [self._soc(int(dd)) for dd in t.cost_dim[persp]]
         t0 = time.perf_counter()
         solver = cl.DefaultSolver(
             _CscLists(p_mat), q.tolist(), _CscLists(a_mat), b.tolist(), cones, self._settings
@@ -1287,7 +1393,12 @@ class HullRelaxation:
         status = str(sol.status)
         if status in ("Solved", "AlmostSolved"):
             bound = min(float(sol.obj_val), float(sol.obj_val_dual)) + const
-            xs = np.asarray(sol.x)
+            if keep_col is None:
+                xs = np.asarray(sol.x)
+            else:
+                xs = np.zeros(ncol)
+                xs[keep_col] = sol.x
+                xs[t.drop_col] = t.drop_val
             x = np.zeros(pr.n)
             col = base.col
             mapped = col >= 0
@@ -1295,12 +1406,18 @@ class HullRelaxation:
             if base is self.condensed:
                 self.recover(x)
             zdual = np.zeros(pr.n)
-            lo = m_eq + t.m_le
-            zdual[self.member_vars[multi]] = np.maximum(np.asarray(sol.z)[lo : lo + nzm], 0.0)
+            zdual[self.member_vars[zrow]] = np.maximum(np.asarray(sol.z)[zrows], 0.0)
             return _Relaxation("solved", bound, x, int(sol.iterations), zdual)
         if status in ("PrimalInfeasible", "AlmostPrimalInfeasible"):
             return _Relaxation("infeasible", iterations=int(sol.iterations))
         return _Relaxation("failed", iterations=int(sol.iterations))
+
+    def _soc(self, dim: int) -> Any:
+        """A second-order cone of dimension ``dim`` (one object per dimension, reused)."""
+        cone = self._cones.get(dim)
+        if cone is None:
+            cone = self._cones[dim] = self._clarabel.SecondOrderConeT(dim)
+        return cone
 
 
 @dataclass(order=True)
