@@ -391,8 +391,9 @@ def test_clarabel_gets_the_same_problem_from_lists() -> None:
 
 
 def test_compact_node_problems_are_the_same_relaxation(monkeypatch: pytest.MonkeyPatch) -> None:
-    """``bnb.COMPACT`` leaves out free columns, excluded binaries and implied ``z >= 0`` rows:
-    the node bounds (condensed and full) and statuses stay those of the plain node problems."""
+    """``bnb.COMPACT`` leaves out free columns, excluded binaries and implied ``z >= 0`` rows and
+    projects the separable forms' copies out: the node bounds (condensed and full) and statuses
+    stay those of the plain node problems."""
     fp = build_footstep_problem(_scene(5, 0), ROBOT, 5)
     structure = bnb.analyse(fp.problem)
     monkeypatch.setattr(bnb, "COMPACT", False)
@@ -404,6 +405,11 @@ def test_compact_node_problems_are_the_same_relaxation(monkeypatch: pytest.Monke
     # the private sin/cos of the heading segments (and footstep 0's, fixed by their bounds)
     private = np.concatenate([grp.private for grp in structure.groups])
     assert len(private) and set(compact.condensed.col[private]) <= set(dropped)
+    # the heading of every multi-member heading-segment group is separable
+    t = compact._tpl[id(compact.condensed)]
+    assert int(np.sum(t.s_nrows)) >= 2 * sum(
+        1 for grp in structure.groups if len(grp.cost_rows) and len(grp.members) > 1
+    )
     rng = np.random.default_rng(3)
     root = bnb._root_allowed(structure)
     nodes = [root]

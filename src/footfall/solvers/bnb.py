@@ -925,6 +925,15 @@ class _Templates:
     l_row: IntArray
     l_col: IntArray
     l_val: FloatArray
+    # rows of the separable forms per multi group (see :func:`_separable_forms`): entries of
+    # kind 0 (column ``s_col``) or 1 (the binary of member ``s_mem``), rows per group
+    s_grp: IntArray
+    s_row: IntArray
+    s_kind: IntArray
+    s_col: IntArray
+    s_mem: IntArray
+    s_val: FloatArray
+    s_nrows: IntArray
     # base columns left out of every node problem (see :func:`_dropped_columns`), their values
     drop_col: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     drop_val: FloatArray = field(default_factory=lambda: np.zeros(0))
@@ -993,6 +1002,59 @@ def _dropped_columns(s: _Structure, t: _Templates) -> _Templates:
     )
 
 
+def _separable_forms(
+    s: _Structure, grp: _Group
+) -> tuple[IntArray, IntArray, FloatArray, FloatArray, dict[int, NDArray[np.bool_]]]:
+    """Forms of ``grp`` whose copies can be projected out of the hull exactly.
+
+    A form ``j`` that appears in no cost row and, in every member, only in rows on ``j`` alone
+    (``lo_z z <= f^z_j <= hi_z z``, e.g. a heading segment's heading interval, a region's height)
+    enters the hull only through ``B_j x_V = sum_z f^z_j``. With ``z >= 0`` (a row or the
+    perspective cone) its projection is ``sum_z lo_z z <= B_j x_V <= sum_z hi_z z``: two rows per
+    group instead of a copy and two rows per member, the same relaxation. A side is written when
+    every member bounds it and left out when none does; a form where only some members bound a
+    side, or a member's interval is empty, keeps its copies (so does every form with
+    ``COPY_BOUNDS`` or without ``COMPACT``).
+
+    Returns:
+        The kept forms, the separable forms, per member and separable form ``lo`` and ``hi``
+        (members x separable forms, +-inf where unbounded), and per member the mask of its rows
+        on separable forms (left out of its hull rows).
+    """
+    k = grp.basis.shape[0]
+    mem = grp.members
+    sep = (
+        np.ones(k, dtype=bool)
+        if COMPACT and not COPY_BOUNDS and len(mem) > 1
+        else np.zeros(k, dtype=bool)
+    )
+    if len(grp.cost_rows):
+        sep &= ~np.any(grp.cost_f != 0.0, axis=0)
+    for z in mem:
+        nz = s.member[z].a_f != 0.0
+        sep &= ~np.any(nz[np.count_nonzero(nz, axis=1) != 1], axis=0)
+    lo = np.full((len(mem), k), -np.inf)
+    hi = np.full((len(mem), k), np.inf)
+    for i, z in enumerate(mem):
+        a_f, beta = s.member[z].a_f, s.member[z].beta
+        for r in np.flatnonzero(np.count_nonzero(a_f, axis=1) == 1):
+            j = int(np.flatnonzero(a_f[r])[0])
+            if a_f[r, j] > 0:
+                hi[i, j] = min(hi[i, j], beta[r] / a_f[r, j])
+            else:
+                lo[i, j] = max(lo[i, j], beta[r] / a_f[r, j])
+    fin_lo, fin_hi = np.isfinite(lo), np.isfinite(hi)
+    sep &= np.all(fin_lo, axis=0) | ~np.any(fin_lo, axis=0)
+    sep &= np.all(fin_hi, axis=0) | ~np.any(fin_hi, axis=0)
+    sep &= np.all(lo <= hi, axis=0)
+    sepf = np.flatnonzero(sep)
+    rows = {}
+    for z in mem:
+        nz = s.member[z].a_f != 0.0
+        rows[z] = (np.count_nonzero(nz, axis=1) == 1) & np.any(nz[:, sep], axis=1)
+    return np.flatnonzero(~sep), sepf, lo[:, sepf], hi[:, sepf], rows
+
+
 def _templates(s: _Structure, base: _Base) -> _Templates:
     col = base.col
     groups: list[int] = []
@@ -1008,19 +1070,39 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
     dq: tuple[list[Any], ...] = ([], [], [])
     dconst: list[float] = []
     link: tuple[list[Any], ...] = ([], [], [], [])
+    sep: tuple[list[Any], ...] = ([], [], [], [], [], [])
+    sep_rows: list[int] = []
     mi = 0
     for g, grp in enumerate(s.groups):
-        k = grp.basis.shape[0]
         vcols = col[grp.variables]
-        br, bc = np.nonzero(grp.basis)
+        keepf, sepf, s_lo, s_hi, is_sep_row = _separable_forms(s, grp)
+        basis = grp.basis[keepf]
+        k = len(keepf)
+        br, bc = np.nonzero(basis)
         link[0].append(np.full(len(br), g))
         link[1].append(br)
         link[2].append(vcols[bc])
-        link[3].append(grp.basis[br, bc])
+        link[3].append(basis[br, bc])
+        # separable forms: sum_z lo_z z <= B_j x_V <= sum_z hi_z z (the copies projected out)
+        n_sep = 0
+        for i, j in enumerate(sepf):
+            bj = np.flatnonzero(grp.basis[j])
+            for sign, bnd in ((1.0, s_hi[:, i]), (-1.0, s_lo[:, i])):
+                if not np.all(np.isfinite(bnd)):
+                    continue  # no member bounds this side (see _separable_forms)
+                m_idx = mi + np.arange(len(grp.members))
+                sep[0].append(np.full(len(bj) + len(m_idx), g))
+                sep[1].append(np.full(len(bj) + len(m_idx), n_sep))
+                sep[2].append(np.r_[np.zeros(len(bj)), np.ones(len(m_idx))].astype(np.int64))
+                sep[3].append(np.r_[vcols[bj], np.zeros(len(m_idx), dtype=np.int64)])
+                sep[4].append(np.r_[np.full(len(bj), -1), m_idx].astype(np.int64))
+                sep[5].append(np.r_[sign * grp.basis[j, bj], -sign * bnd])
+                n_sep += 1
+        sep_rows.append(n_sep)
         n_cost = len(grp.cost_rows)
         if n_cost:
             sw = 2.0 * np.sqrt(grp.cost_w)
-            cf = sw[:, None] * grp.cost_f
+            cf = sw[:, None] * grp.cost_f[:, keepf]
             cr, cc = np.nonzero(cf)
             wv = grp.cost_w[:, None] * grp.cost_v
             pg = np.triu(2.0 * grp.cost_v.T @ wv)
@@ -1031,18 +1113,21 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
             groups.append(g)
             zcol.append(col[z])
             kk.append(k)
-            nb = len(mb.beta)
+            a_f = mb.a_f[~is_sep_row[z]][:, keepf]
+            beta = mb.beta[~is_sep_row[z]]
+            nb = len(beta)
             nrows.append(2 * k + nb if COPY_BOUNDS else nb)
             has_cost.append(n_cost > 0)
             cdim.append(n_cost + 2 if n_cost else 0)
             # hull rows: f - f_ub z <= 0 ; -f + f_lb z <= 0 ; a_f f - beta z <= 0
             ar = np.arange(k)
-            rr, cc2 = np.nonzero(mb.a_f)
+            rr, cc2 = np.nonzero(a_f)
             rows = np.r_[ar, ar, ar + k, ar + k, rr + 2 * k, np.arange(nb) + 2 * k]
             kind = np.r_[np.zeros(k), np.ones(k), np.zeros(k), np.ones(k), np.zeros(len(rr)),
                          np.ones(nb)].astype(np.int64)  # fmt: skip
             loc = np.r_[ar, ar, ar, ar, cc2, np.zeros(nb)].astype(np.int64)
-            val = np.r_[np.ones(k), -grp.f_ub, -np.ones(k), grp.f_lb, mb.a_f[rr, cc2], -mb.beta]
+            val = np.r_[np.ones(k), -grp.f_ub[keepf], -np.ones(k), grp.f_lb[keepf], a_f[rr, cc2],
+                        -beta]  # fmt: skip
             if not COPY_BOUNDS:
                 keep = rows >= 2 * k
                 rows, kind, loc, val = rows[keep] - 2 * k, kind[keep], loc[keep], val[keep]
@@ -1068,9 +1153,9 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
             d[1].append(rr)
             d[2].append(vcols[cc2])
             d[3].append(mb.a_v[rr, cc2])
-            d[4].append(nb)
+            d[4].append(len(mb.beta))
             d[5].append(mb.beta)
-            d[6].append(np.full(nb, mi))
+            d[6].append(np.full(len(mb.beta), mi))
             if n_cost:
                 lo = np.minimum(vcols[pi], vcols[pj])
                 hi = np.maximum(vcols[pi], vcols[pj])
@@ -1133,6 +1218,13 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
         l_row=_cat(link[1], i64),
         l_col=_cat(link[2], i64),
         l_val=_cat(link[3], f64),
+        s_grp=_cat(sep[0], i64),
+        s_row=_cat(sep[1], i64),
+        s_kind=_cat(sep[2], i64),
+        s_col=_cat(sep[3], i64),
+        s_mem=_cat(sep[4], i64),
+        s_val=_cat(sep[5], f64),
+        s_nrows=np.array(sep_rows, dtype=i64),
     )
     pm = base.p_mat.tocoo()
     out = dataclasses.replace(
@@ -1301,16 +1393,24 @@ class HullRelaxation:
         d_start = row0 + n_h + _offsets(t.d_nrows, single)
         dm = single[t.d_mem]
         n_d = int(np.sum(t.d_nrows[single]))
+        # rows of the separable forms of multi groups (see _separable_forms)
+        s_start = row0 + n_h + n_d + n_w + _offsets(t.s_nrows, multi_g)
+        sm = np.where(t.s_kind == 0, multi_g[t.s_grp], multi[np.maximum(t.s_mem, 0)])
+        s_cols = np.where(t.s_kind == 0, t.s_col, t.zcol[np.maximum(t.s_mem, 0)])[sm]
+        n_s = int(np.sum(t.s_nrows[multi_g]))
         le_r = np.concatenate(
             [t.le_r, t.m_le + np.arange(nzm), h_start[hmem] + t.h_row[hm],
-             d_start[t.d_mem[dm]] + t.d_row[dm], row0 + n_h + n_d + np.arange(n_w)]
+             d_start[t.d_mem[dm]] + t.d_row[dm], row0 + n_h + n_d + np.arange(n_w),
+             s_start[t.s_grp[sm]] + t.s_row[sm]]
         )  # fmt: skip
-        le_c = np.concatenate([t.le_c, zm, h_cols, t.d_col[dm], w_col])
-        le_v = np.concatenate([t.le_v, -np.ones(nzm), t.h_val[hm], t.d_val[dm], -np.ones(n_w)])
-        le_b = np.concatenate(
-            [t.le_b, np.zeros(nzm + n_h), t.d_beta[single[t.d_beta_mem]], np.zeros(n_w)]
+        le_c = np.concatenate([t.le_c, zm, h_cols, t.d_col[dm], w_col, s_cols])
+        le_v = np.concatenate(
+            [t.le_v, -np.ones(nzm), t.h_val[hm], t.d_val[dm], -np.ones(n_w), t.s_val[sm]]
         )
-        m_le = row0 + n_h + n_d + n_w
+        le_b = np.concatenate(
+            [t.le_b, np.zeros(nzm + n_h), t.d_beta[single[t.d_beta_mem]], np.zeros(n_w + n_s)]
+        )
+        m_le = row0 + n_h + n_d + n_w + n_s
 
         # cones: static (base) and perspective
         c_start = _offsets(t.cost_dim, persp)
