@@ -32,6 +32,13 @@ Relaxation of a node (each group ``G`` may use the members ``Z`` still allowed):
   the rest, from one KKT solve. Dropping their bounds and cones keeps a lower bound; when a node's
   recovered point violates one, the node is re-solved with the full model.
 
+* Compact node problems (``COMPACT``). The same relaxation with a smaller KKT system (a node
+  solve costs about linearly in its size): excluded binaries are left out instead of fixed to 0,
+  as are columns that only their own bounds constrain (the private sin/cos) and the rows
+  ``z >= 0`` that a perspective cone implies; a form that every member bounds only by its own
+  interval (a segment's heading) loses its copies, ``sum_z lo_z z <= B_j x_V <= sum_z hi_z z``
+  being their exact projection (:func:`_separable_forms`).
+
 * Links (``LINKS``, off: tighter but dearer per node, see ``benchmarks/RESULTS.md``). Two groups
   coupled by a plain row (the heading rate, eq. 5.12e, between the segment groups of consecutive
   steps) keep only the member pairs that row allows on the members' boxes; the group weights must
