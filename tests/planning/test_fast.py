@@ -354,3 +354,85 @@ def test_propagation_drops_only_members_without_a_compatible_partner(
     link56 = next(lk for lk in structure.compat if lk.groups == (g5, g6))
     assert (z5, z6) not in {(int(a), int(b)) for a, b in link56.pairs}
     assert bnb._propagate(structure, clash) is None
+
+
+def test_clarabel_gets_the_same_problem_from_lists() -> None:
+    """The node solver hands Clarabel its matrices as lists (:class:`bnb._CscLists`, cheaper to
+    convert): same solution as from the scipy matrices, also for a non-canonical input."""
+    import clarabel
+    import scipy.sparse as sp
+
+    rng = np.random.default_rng(0)
+    m, n = 12, 5
+    a_dense = rng.normal(size=(m, n))
+    rows, cols = np.nonzero(a_dense)
+    # duplicate entries (summed by scipy) make the COO input non-canonical
+    a_mat = sp.csc_matrix(
+        (np.r_[a_dense[rows, cols], [1.0]], (np.r_[rows, [0]], np.r_[cols, [0]])), shape=(m, n)
+    )
+    a_dup = sp.csc_matrix(
+        (np.r_[a_dense[rows, cols], [0.5, 0.5]], (np.r_[rows, [0, 0]], np.r_[cols, [0, 0]])),
+        shape=(m, n),
+    )
+    a_dup.has_canonical_format = False
+    p_mat = sp.triu(sp.csc_matrix(np.eye(n) * 2.0), format="csc")
+    q, b = rng.normal(size=n), np.abs(rng.normal(size=m)) + 1.0
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    ref = clarabel.DefaultSolver(p_mat, q, a_mat, b, [clarabel.NonnegativeConeT(m)], settings)
+    ref_sol = ref.solve()
+    got = clarabel.DefaultSolver(
+        bnb._CscLists(p_mat), q.tolist(), bnb._CscLists(a_dup), b.tolist(),
+        [clarabel.NonnegativeConeT(m)], settings,
+    ).solve()  # fmt: skip
+    assert str(got.status) == str(ref_sol.status) == "Solved"
+    assert np.allclose(got.x, ref_sol.x, atol=1e-12)
+    assert got.obj_val == pytest.approx(ref_sol.obj_val, abs=1e-12)
+
+
+def test_compact_node_problems_are_the_same_relaxation(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``bnb.COMPACT`` leaves out free columns, excluded binaries and implied ``z >= 0`` rows and
+    projects the separable forms' copies out: the node bounds (condensed and full) and statuses
+    stay those of the plain node problems."""
+    fp = build_footstep_problem(_scene(5, 0), ROBOT, 5)
+    structure = bnb.analyse(fp.problem)
+    monkeypatch.setattr(bnb, "COMPACT", False)
+    plain = bnb.HullRelaxation(structure)
+    monkeypatch.setattr(bnb, "COMPACT", True)
+    compact = bnb.HullRelaxation(structure)
+    assert compact.condensed is not None
+    dropped = compact._tpl[id(compact.condensed)].drop_col
+    # the private sin/cos of the heading segments (and footstep 0's, fixed by their bounds)
+    private = np.concatenate([grp.private for grp in structure.groups])
+    assert len(private) and set(compact.condensed.col[private]) <= set(dropped)
+    # the heading of every multi-member heading-segment group is separable
+    t = compact._tpl[id(compact.condensed)]
+    assert int(np.sum(t.s_nrows)) >= 2 * sum(
+        1 for grp in structure.groups if len(grp.cost_rows) and len(grp.members) > 1
+    )
+    rng = np.random.default_rng(3)
+    root = bnb._root_allowed(structure)
+    nodes = [root]
+    for _ in range(12):  # random nodes: every group keeps a random non-empty subset
+        nodes.append(
+            tuple(
+                tuple(sorted(rng.choice(mem, size=rng.integers(1, len(mem) + 1), replace=False)))
+                for mem in root
+            )
+        )
+    statuses = set()
+    for allowed in nodes:
+        for full in (False, True):
+            monkeypatch.setattr(bnb, "COMPACT", False)
+            ref = plain.solve(allowed, full=full)
+            monkeypatch.setattr(bnb, "COMPACT", True)
+            got = compact.solve(allowed, full=full)
+            assert got.status == ref.status
+            statuses.add(ref.status)
+            if ref.status == "solved":
+                assert got.bound == pytest.approx(ref.bound, rel=1e-6, abs=1e-7)
+                assert got.x is not None
+                # the left-out variables get values within their bounds
+                v = np.flatnonzero(np.isin(compact.condensed.col, dropped))
+                assert np.all(fp.problem.lb[v] <= got.x[v]) and np.all(got.x[v] <= fp.problem.ub[v])
+    assert "solved" in statuses

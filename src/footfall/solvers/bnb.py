@@ -32,6 +32,13 @@ Relaxation of a node (each group ``G`` may use the members ``Z`` still allowed):
   the rest, from one KKT solve. Dropping their bounds and cones keeps a lower bound; when a node's
   recovered point violates one, the node is re-solved with the full model.
 
+* Compact node problems (``COMPACT``). The same relaxation with a smaller KKT system (a node
+  solve costs about linearly in its size): excluded binaries are left out instead of fixed to 0,
+  as are columns that only their own bounds constrain (the private sin/cos) and the rows
+  ``z >= 0`` that a perspective cone implies; a form that every member bounds only by its own
+  interval (a segment's heading) loses its copies, ``sum_z lo_z z <= B_j x_V <= sum_z hi_z z``
+  being their exact projection (:func:`_separable_forms`).
+
 * Links (``LINKS``, off: tighter but dearer per node, see ``benchmarks/RESULTS.md``). Two groups
   coupled by a plain row (the heading rate, eq. 5.12e, between the segment groups of consecutive
   steps) keep only the member pairs that row allows on the members' boxes; the group weights must
@@ -116,6 +123,11 @@ LINKS = False
 LINK_MIN_DROP = 0.25
 #: write a staircase link as prefix rows on its binaries instead of pair weights
 STAIRCASE = True
+#: node problems leave out the columns only their own bounds constrain (see
+#: :func:`_dropped_columns`), the binaries of excluded members (instead of rows fixing them to 0)
+#: and the rows ``z >= 0`` that a member's perspective cone implies: the same relaxation with a
+#: smaller KKT system (a node's cost grows about linearly with its size)
+COMPACT = True
 #: with threads >= 2, keep the workers busy asynchronously (else: synchronous batches)
 ASYNC = True
 #: at the end of an asynchronous search, wait at most this long [s] for the solves in flight
@@ -920,6 +932,134 @@ class _Templates:
     l_row: IntArray
     l_col: IntArray
     l_val: FloatArray
+    # rows of the separable forms per multi group (see :func:`_separable_forms`): entries of
+    # kind 0 (column ``s_col``) or 1 (the binary of member ``s_mem``), rows per group
+    s_grp: IntArray
+    s_row: IntArray
+    s_kind: IntArray
+    s_col: IntArray
+    s_mem: IntArray
+    s_val: FloatArray
+    s_nrows: IntArray
+    # base columns left out of every node problem (see :func:`_dropped_columns`), their values
+    drop_col: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    drop_val: FloatArray = field(default_factory=lambda: np.zeros(0))
+    # static inequality rows that hold binaries only (they may lose every entry at a node)
+    le_bin_rows: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    # the base's P (upper triangle) as COO entries
+    p_i: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    p_j: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    p_v: FloatArray = field(default_factory=lambda: np.zeros(0))
+
+
+def _dropped_columns(s: _Structure, t: _Templates) -> _Templates:
+    """``t`` without the base columns that only their own bounds constrain.
+
+    A column with no cost that appears in no row but single-variable inequality rows (its bounds),
+    in no cone and in no group's rows is a free coordinate of the relaxation: leaving it out (with
+    those rows) is the exact projection, so every node bound stays the same while each node's KKT
+    system loses a column and two rows. In the planner these are the private sin/cos of the
+    heading segments (their member rows are eliminated, see :func:`analyse`). Their value in a
+    relaxation point is any value within their bounds (the midpoint, or the finite bound).
+    Columns with conflicting bounds are kept, so the node solve still reports infeasibility.
+    """
+    base = t.base
+    n = base.n_cols
+    le_cnt = np.bincount(t.le_r, minlength=t.m_le)
+    single = le_cnt[t.le_r] == 1
+    used = np.zeros(n, dtype=bool)
+    pm = base.p_mat.tocoo()
+    soc_c = _cat(base.soc.c, np.int64)
+    special = base.col[np.r_[np.flatnonzero(s.problem.integer), base.y_from]]
+    for cols in (t.eq_c, t.le_c[~single], soc_c, t.l_col, t.d_col, t.dp_i, t.dp_j, t.dq_i,
+                 t.zcol, pm.row, pm.col, special[special >= 0]):  # fmt: skip
+        used[cols] = True
+    used[base.q_vec != 0.0] = True
+    lo = np.full(n, -np.inf)
+    hi = np.full(n, np.inf)
+    sc, sv, sb = t.le_c[single], t.le_v[single], t.le_b[t.le_r[single]]
+    pos = sv > 0
+    np.minimum.at(hi, sc[pos], sb[pos] / sv[pos])
+    np.maximum.at(lo, sc[~pos], sb[~pos] / sv[~pos])
+    drop = ~used & (lo <= hi)
+    if not np.any(drop):
+        return t
+    both = np.isfinite(lo) & np.isfinite(hi)
+    val = np.clip(0.0, lo, hi)
+    val[both] = 0.5 * (lo[both] + hi[both])
+    keep_row = np.ones(t.m_le, dtype=bool)
+    keep_row[t.le_r[single & drop[t.le_c]]] = False
+    ent = keep_row[t.le_r]
+    row_map = np.cumsum(keep_row) - 1
+    is_bin = np.zeros(n, dtype=bool)
+    is_bin[t.zcol] = True
+    le_r = row_map[t.le_r[ent]]
+    m_le = int(np.count_nonzero(keep_row))
+    nonbin = np.bincount(le_r, weights=~is_bin[t.le_c[ent]], minlength=m_le)
+    return dataclasses.replace(
+        t,
+        le_r=le_r,
+        le_c=t.le_c[ent],
+        le_v=t.le_v[ent],
+        le_b=t.le_b[keep_row],
+        m_le=m_le,
+        drop_col=np.flatnonzero(drop),
+        drop_val=val[drop],
+        le_bin_rows=np.flatnonzero(nonbin == 0),
+    )
+
+
+def _separable_forms(
+    s: _Structure, grp: _Group
+) -> tuple[IntArray, IntArray, FloatArray, FloatArray, dict[int, NDArray[np.bool_]]]:
+    """Forms of ``grp`` whose copies can be projected out of the hull exactly.
+
+    A form ``j`` that appears in no cost row and, in every member, only in rows on ``j`` alone
+    (``lo_z z <= f^z_j <= hi_z z``, e.g. a heading segment's heading interval, a region's height)
+    enters the hull only through ``B_j x_V = sum_z f^z_j``. With ``z >= 0`` (a row or the
+    perspective cone) its projection is ``sum_z lo_z z <= B_j x_V <= sum_z hi_z z``: two rows per
+    group instead of a copy and two rows per member, the same relaxation. A side is written when
+    every member bounds it and left out when none does; a form where only some members bound a
+    side, or a member's interval is empty, keeps its copies (so does every form with
+    ``COPY_BOUNDS`` or without ``COMPACT``).
+
+    Returns:
+        The kept forms, the separable forms, per member and separable form ``lo`` and ``hi``
+        (members x separable forms, +-inf where unbounded), and per member the mask of its rows
+        on separable forms (left out of its hull rows).
+    """
+    k = grp.basis.shape[0]
+    mem = grp.members
+    sep = (
+        np.ones(k, dtype=bool)
+        if COMPACT and not COPY_BOUNDS and len(mem) > 1
+        else np.zeros(k, dtype=bool)
+    )
+    if len(grp.cost_rows):
+        sep &= ~np.any(grp.cost_f != 0.0, axis=0)
+    for z in mem:
+        nz = s.member[z].a_f != 0.0
+        sep &= ~np.any(nz[np.count_nonzero(nz, axis=1) != 1], axis=0)
+    lo = np.full((len(mem), k), -np.inf)
+    hi = np.full((len(mem), k), np.inf)
+    for i, z in enumerate(mem):
+        a_f, beta = s.member[z].a_f, s.member[z].beta
+        for r in np.flatnonzero(np.count_nonzero(a_f, axis=1) == 1):
+            j = int(np.flatnonzero(a_f[r])[0])
+            if a_f[r, j] > 0:
+                hi[i, j] = min(hi[i, j], beta[r] / a_f[r, j])
+            else:
+                lo[i, j] = max(lo[i, j], beta[r] / a_f[r, j])
+    fin_lo, fin_hi = np.isfinite(lo), np.isfinite(hi)
+    sep &= np.all(fin_lo, axis=0) | ~np.any(fin_lo, axis=0)
+    sep &= np.all(fin_hi, axis=0) | ~np.any(fin_hi, axis=0)
+    sep &= np.all(lo <= hi, axis=0)
+    sepf = np.flatnonzero(sep)
+    rows = {}
+    for z in mem:
+        nz = s.member[z].a_f != 0.0
+        rows[z] = (np.count_nonzero(nz, axis=1) == 1) & np.any(nz[:, sep], axis=1)
+    return np.flatnonzero(~sep), sepf, lo[:, sepf], hi[:, sepf], rows
 
 
 def _templates(s: _Structure, base: _Base) -> _Templates:
@@ -937,19 +1077,39 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
     dq: tuple[list[Any], ...] = ([], [], [])
     dconst: list[float] = []
     link: tuple[list[Any], ...] = ([], [], [], [])
+    sep: tuple[list[Any], ...] = ([], [], [], [], [], [])
+    sep_rows: list[int] = []
     mi = 0
     for g, grp in enumerate(s.groups):
-        k = grp.basis.shape[0]
         vcols = col[grp.variables]
-        br, bc = np.nonzero(grp.basis)
+        keepf, sepf, s_lo, s_hi, is_sep_row = _separable_forms(s, grp)
+        basis = grp.basis[keepf]
+        k = len(keepf)
+        br, bc = np.nonzero(basis)
         link[0].append(np.full(len(br), g))
         link[1].append(br)
         link[2].append(vcols[bc])
-        link[3].append(grp.basis[br, bc])
+        link[3].append(basis[br, bc])
+        # separable forms: sum_z lo_z z <= B_j x_V <= sum_z hi_z z (the copies projected out)
+        n_sep = 0
+        for i, j in enumerate(sepf):
+            bj = np.flatnonzero(grp.basis[j])
+            for sign, bnd in ((1.0, s_hi[:, i]), (-1.0, s_lo[:, i])):
+                if not np.all(np.isfinite(bnd)):
+                    continue  # no member bounds this side (see _separable_forms)
+                m_idx = mi + np.arange(len(grp.members))
+                sep[0].append(np.full(len(bj) + len(m_idx), g))
+                sep[1].append(np.full(len(bj) + len(m_idx), n_sep))
+                sep[2].append(np.r_[np.zeros(len(bj)), np.ones(len(m_idx))].astype(np.int64))
+                sep[3].append(np.r_[vcols[bj], np.zeros(len(m_idx), dtype=np.int64)])
+                sep[4].append(np.r_[np.full(len(bj), -1), m_idx].astype(np.int64))
+                sep[5].append(np.r_[sign * grp.basis[j, bj], -sign * bnd])
+                n_sep += 1
+        sep_rows.append(n_sep)
         n_cost = len(grp.cost_rows)
         if n_cost:
             sw = 2.0 * np.sqrt(grp.cost_w)
-            cf = sw[:, None] * grp.cost_f
+            cf = sw[:, None] * grp.cost_f[:, keepf]
             cr, cc = np.nonzero(cf)
             wv = grp.cost_w[:, None] * grp.cost_v
             pg = np.triu(2.0 * grp.cost_v.T @ wv)
@@ -960,18 +1120,21 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
             groups.append(g)
             zcol.append(col[z])
             kk.append(k)
-            nb = len(mb.beta)
+            a_f = mb.a_f[~is_sep_row[z]][:, keepf]
+            beta = mb.beta[~is_sep_row[z]]
+            nb = len(beta)
             nrows.append(2 * k + nb if COPY_BOUNDS else nb)
             has_cost.append(n_cost > 0)
             cdim.append(n_cost + 2 if n_cost else 0)
             # hull rows: f - f_ub z <= 0 ; -f + f_lb z <= 0 ; a_f f - beta z <= 0
             ar = np.arange(k)
-            rr, cc2 = np.nonzero(mb.a_f)
+            rr, cc2 = np.nonzero(a_f)
             rows = np.r_[ar, ar, ar + k, ar + k, rr + 2 * k, np.arange(nb) + 2 * k]
             kind = np.r_[np.zeros(k), np.ones(k), np.zeros(k), np.ones(k), np.zeros(len(rr)),
                          np.ones(nb)].astype(np.int64)  # fmt: skip
             loc = np.r_[ar, ar, ar, ar, cc2, np.zeros(nb)].astype(np.int64)
-            val = np.r_[np.ones(k), -grp.f_ub, -np.ones(k), grp.f_lb, mb.a_f[rr, cc2], -mb.beta]
+            val = np.r_[np.ones(k), -grp.f_ub[keepf], -np.ones(k), grp.f_lb[keepf], a_f[rr, cc2],
+                        -beta]  # fmt: skip
             if not COPY_BOUNDS:
                 keep = rows >= 2 * k
                 rows, kind, loc, val = rows[keep] - 2 * k, kind[keep], loc[keep], val[keep]
@@ -997,9 +1160,9 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
             d[1].append(rr)
             d[2].append(vcols[cc2])
             d[3].append(mb.a_v[rr, cc2])
-            d[4].append(nb)
+            d[4].append(len(mb.beta))
             d[5].append(mb.beta)
-            d[6].append(np.full(nb, mi))
+            d[6].append(np.full(len(mb.beta), mi))
             if n_cost:
                 lo = np.minimum(vcols[pi], vcols[pj])
                 hi = np.maximum(vcols[pi], vcols[pj])
@@ -1015,7 +1178,7 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
                 dconst.append(0.0)
             mi += 1
     i64, f64 = np.int64, float
-    return _Templates(
+    out = _Templates(
         base=base,
         eq_r=_cat(base.eq.r, i64),
         eq_c=_cat(base.eq.c, i64),
@@ -1062,7 +1225,44 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
         l_row=_cat(link[1], i64),
         l_col=_cat(link[2], i64),
         l_val=_cat(link[3], f64),
+        s_grp=_cat(sep[0], i64),
+        s_row=_cat(sep[1], i64),
+        s_kind=_cat(sep[2], i64),
+        s_col=_cat(sep[3], i64),
+        s_mem=_cat(sep[4], i64),
+        s_val=_cat(sep[5], f64),
+        s_nrows=np.array(sep_rows, dtype=i64),
     )
+    pm = base.p_mat.tocoo()
+    out = dataclasses.replace(
+        out, p_i=pm.row.astype(i64), p_j=pm.col.astype(i64), p_v=pm.data.astype(f64)
+    )
+    is_bin = np.zeros(base.n_cols, dtype=bool)
+    is_bin[out.zcol] = True
+    nonbin = np.bincount(out.le_r, weights=~is_bin[out.le_c], minlength=out.m_le)
+    out = dataclasses.replace(out, le_bin_rows=np.flatnonzero(nonbin == 0))
+    return _dropped_columns(s, out) if COMPACT else out
+
+
+class _CscLists:
+    """A CSC matrix with its arrays as Python lists, to hand to ``clarabel.DefaultSolver``.
+
+    Clarabel's Python wrapper (0.11) reads ``data``, ``indices`` and ``indptr`` element by element;
+    from numpy arrays that costs about 0.65 ms of a 9 ms node solve at N = 15, from lists (built by
+    ``tolist``) about a third of it. It reads only these attributes and ``shape`` and
+    ``has_canonical_format``; the matrices given are canonical (sorted, no duplicates).
+    """
+
+    __slots__ = ("data", "has_canonical_format", "indices", "indptr", "shape")
+
+    def __init__(self, mat: sp.csc_matrix) -> None:
+        if not mat.has_canonical_format:
+            mat.sum_duplicates()
+        self.data = mat.data.tolist()
+        self.indices = mat.indices.tolist()
+        self.indptr = mat.indptr.tolist()
+        self.shape = mat.shape
+        self.has_canonical_format = True
 
 
 def _offsets(counts: IntArray, mask: NDArray[np.bool_]) -> IntArray:
@@ -1120,6 +1320,7 @@ class HullRelaxation:
         for key, value in CLARABEL_SETTINGS.items():
             setattr(settings, key, value)
         self._settings = settings
+        self._cones: dict[int, Any] = {}
         self.solves = 0
         self.solve_time = 0.0
 
@@ -1152,9 +1353,9 @@ class HullRelaxation:
         t_col = ncol0 + n_copies + _offsets(np.ones_like(t.k), persp)
         ncol = ncol0 + n_copies + int(np.count_nonzero(persp))
 
-        # equalities: static, excluded binaries = 0, linking rows of multi groups
+        # equalities: static, excluded binaries = 0 (unless left out), linking rows of multi groups
         ex_cols = t.zcol[excluded]
-        n_ex = len(ex_cols)
+        n_ex = 0 if COMPACT else len(ex_cols)
         k_group = np.zeros(n_groups, dtype=np.int64)
         k_group[t.group] = t.k
         link_start = t.m_eq + n_ex + _offsets(k_group, multi_g)
@@ -1166,7 +1367,7 @@ class HullRelaxation:
             [t.eq_r, t.m_eq + np.arange(n_ex), link_start[t.l_grp[lm]] + t.l_row[lm],
              link_start[t.group[cm]] + cj]
         )  # fmt: skip
-        eq_c = np.concatenate([t.eq_c, ex_cols, t.l_col[lm], copy_start[cm] + cj])
+        eq_c = np.concatenate([t.eq_c, ex_cols[:n_ex], t.l_col[lm], copy_start[cm] + cj])
         eq_v = np.concatenate([t.eq_v, np.ones(n_ex), t.l_val[lm], -np.ones(len(cm))])
         m_eq = t.m_eq + n_ex + int(np.sum(k_group[multi_g]))
         # link flows: sum_{pairs of z} w - z = 0 per (link, side, allowed member), w >= 0
@@ -1184,8 +1385,10 @@ class HullRelaxation:
         m_eq += int(np.count_nonzero(lrsel))
         eq_b = np.concatenate([t.eq_b, np.zeros(m_eq - t.m_eq)])
 
-        # inequalities: static, -z <= 0 for multi members, hull rows, direct rows
-        zm = t.zcol[multi]
+        # inequalities: static, -z <= 0 for multi members (not where the perspective cone implies
+        # it), hull rows, direct rows
+        zrow = multi & ~t.has_cost if COMPACT else multi
+        zm = t.zcol[zrow]
         nzm = len(zm)
         row0 = t.m_le + nzm
         h_start = row0 + _offsets(t.n_rows, multi)
@@ -1197,16 +1400,24 @@ class HullRelaxation:
         d_start = row0 + n_h + _offsets(t.d_nrows, single)
         dm = single[t.d_mem]
         n_d = int(np.sum(t.d_nrows[single]))
+        # rows of the separable forms of multi groups (see _separable_forms)
+        s_start = row0 + n_h + n_d + n_w + _offsets(t.s_nrows, multi_g)
+        sm = np.where(t.s_kind == 0, multi_g[t.s_grp], multi[np.maximum(t.s_mem, 0)])
+        s_cols = np.where(t.s_kind == 0, t.s_col, t.zcol[np.maximum(t.s_mem, 0)])[sm]
+        n_s = int(np.sum(t.s_nrows[multi_g]))
         le_r = np.concatenate(
             [t.le_r, t.m_le + np.arange(nzm), h_start[hmem] + t.h_row[hm],
-             d_start[t.d_mem[dm]] + t.d_row[dm], row0 + n_h + n_d + np.arange(n_w)]
+             d_start[t.d_mem[dm]] + t.d_row[dm], row0 + n_h + n_d + np.arange(n_w),
+             s_start[t.s_grp[sm]] + t.s_row[sm]]
         )  # fmt: skip
-        le_c = np.concatenate([t.le_c, zm, h_cols, t.d_col[dm], w_col])
-        le_v = np.concatenate([t.le_v, -np.ones(nzm), t.h_val[hm], t.d_val[dm], -np.ones(n_w)])
-        le_b = np.concatenate(
-            [t.le_b, np.zeros(nzm + n_h), t.d_beta[single[t.d_beta_mem]], np.zeros(n_w)]
+        le_c = np.concatenate([t.le_c, zm, h_cols, t.d_col[dm], w_col, s_cols])
+        le_v = np.concatenate(
+            [t.le_v, -np.ones(nzm), t.h_val[hm], t.d_val[dm], -np.ones(n_w), t.s_val[sm]]
         )
-        m_le = row0 + n_h + n_d + n_w
+        le_b = np.concatenate(
+            [t.le_b, np.zeros(nzm + n_h), t.d_beta[single[t.d_beta_mem]], np.zeros(n_w + n_s)]
+        )
+        m_le = row0 + n_h + n_d + n_w + n_s
 
         # cones: static (base) and perspective
         c_start = _offsets(t.cost_dim, persp)
@@ -1232,19 +1443,12 @@ class HullRelaxation:
         cols = np.concatenate([eq_c, le_c, _cat(soc.c, np.int64), c_cols])
         vals = np.concatenate([eq_v, le_v, _cat(soc.v, float), t.c_val[cmask]])
         b = np.concatenate([eq_b, le_b, _cat(soc.b, float), np.zeros(n_pc)])
-        a_mat = sp.csc_matrix((vals, (rows, cols)), shape=(m_eq + m_le + soc.m + n_pc, ncol))
+        n_rows = m_eq + m_le + soc.m + n_pc
 
-        pm = base.p_mat
-        p_mat = sp.csc_matrix(
-            (pm.data, pm.indices, np.r_[pm.indptr, np.full(ncol - base.n_cols, pm.nnz)]),
-            shape=(ncol, ncol),
-        )
         pmask = single[t.dp_mem]
-        if np.any(pmask):
-            p_mat = (
-                p_mat
-                + sp.csc_matrix((t.dp_v[pmask], (t.dp_i[pmask], t.dp_j[pmask])), shape=(ncol, ncol))
-            ).tocsc()
+        p_i = np.concatenate([t.p_i, t.dp_i[pmask]])
+        p_j = np.concatenate([t.p_j, t.dp_j[pmask]])
+        p_v = np.concatenate([t.p_v, t.dp_v[pmask]])
         q = np.zeros(ncol)
         q[: base.n_cols] = base.q_vec
         qmask = single[t.dq_mem]
@@ -1252,19 +1456,56 @@ class HullRelaxation:
         q[t_col[persp]] = 1.0
         const = base.const + float(np.sum(t.d_const[single]))
 
+        zrows = m_eq + t.m_le + np.arange(nzm)  # rows of -z <= 0, for the multipliers
+        keep_col = None
+        if COMPACT:
+            # leave out the excluded binaries (0 at the node) and the free columns of the base
+            keep_col = np.ones(ncol, dtype=bool)
+            keep_col[ex_cols] = False
+            keep_col[t.drop_col] = False
+            ent = keep_col[cols]
+            rows, cols, vals = rows[ent], cols[ent], vals[ent]
+            col_map = np.cumsum(keep_col) - 1
+            cols = col_map[cols]
+            p_i, p_j = col_map[p_i], col_map[p_j]  # no cost on left-out columns
+            q = q[keep_col]
+            if len(t.le_bin_rows):
+                # a row of binaries only that lost all its entries reads 0 <= b
+                bin_rows = t.le_bin_rows + m_eq
+                empty = bin_rows[np.bincount(rows, minlength=n_rows)[bin_rows] == 0]
+                if len(empty):
+                    if np.any(b[empty] < 0.0):
+                        return _Relaxation("infeasible")
+                    keep_row = np.ones(n_rows, dtype=bool)
+                    keep_row[empty] = False
+                    row_map = np.cumsum(keep_row) - 1
+                    rows, b, zrows = row_map[rows], b[keep_row], row_map[zrows]
+                    m_le -= len(empty)
+                    n_rows -= len(empty)
+        n_var = len(q)
+        a_mat = sp.csc_matrix((vals, (rows, cols)), shape=(n_rows, n_var))
+        p_mat = sp.csc_matrix((p_v, (p_i, p_j)), shape=(n_var, n_var))
+
         cl = self._clarabel
         cones: list[Any] = [cl.ZeroConeT(m_eq), cl.NonnegativeConeT(m_le)]
-        cones += [cl.SecondOrderConeT(int(dd)) for dd in base.soc_dims]
-        cones += [cl.SecondOrderConeT(int(dd)) for dd in t.cost_dim[persp]]
+        cones += [self._soc(int(dd)) for dd in base.soc_dims]
+        cones += [self._soc(int(dd)) for dd in t.cost_dim[persp]]
         t0 = time.perf_counter()
-        solver = cl.DefaultSolver(p_mat, q, a_mat, b, cones, self._settings)
+        solver = cl.DefaultSolver(
+            _CscLists(p_mat), q.tolist(), _CscLists(a_mat), b.tolist(), cones, self._settings
+        )
         sol = solver.solve()
         self.solve_time += time.perf_counter() - t0
         self.solves += 1
         status = str(sol.status)
         if status in ("Solved", "AlmostSolved"):
             bound = min(float(sol.obj_val), float(sol.obj_val_dual)) + const
-            xs = np.asarray(sol.x)
+            if keep_col is None:
+                xs = np.asarray(sol.x)
+            else:
+                xs = np.zeros(ncol)
+                xs[keep_col] = sol.x
+                xs[t.drop_col] = t.drop_val
             x = np.zeros(pr.n)
             col = base.col
             mapped = col >= 0
@@ -1272,12 +1513,18 @@ class HullRelaxation:
             if base is self.condensed:
                 self.recover(x)
             zdual = np.zeros(pr.n)
-            lo = m_eq + t.m_le
-            zdual[self.member_vars[multi]] = np.maximum(np.asarray(sol.z)[lo : lo + nzm], 0.0)
+            zdual[self.member_vars[zrow]] = np.maximum(np.asarray(sol.z)[zrows], 0.0)
             return _Relaxation("solved", bound, x, int(sol.iterations), zdual)
         if status in ("PrimalInfeasible", "AlmostPrimalInfeasible"):
             return _Relaxation("infeasible", iterations=int(sol.iterations))
         return _Relaxation("failed", iterations=int(sol.iterations))
+
+    def _soc(self, dim: int) -> Any:
+        """A second-order cone of dimension ``dim`` (one object per dimension, reused)."""
+        cone = self._cones.get(dim)
+        if cone is None:
+            cone = self._cones[dim] = self._clarabel.SecondOrderConeT(dim)
+        return cone
 
 
 @dataclass(order=True)
