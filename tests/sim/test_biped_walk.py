@@ -25,6 +25,7 @@ from footfall.sim.biped_walk import (  # noqa: E402
     WalkOptions,
     _ds_propagator,
     ankle_joint_torque,
+    inset_polygon,
     project_to_polygon,
     sole_cop,
     sole_torque_limits,
@@ -129,6 +130,9 @@ def test_bad_walk_inputs_name_the_field(short_walk) -> None:  # type: ignore[no-
     with pytest.raises(InputError) as err:
         WalkOptions(control_dt=0.0)
     assert err.value.field == "control_dt"
+    with pytest.raises(InputError) as err:
+        WalkOptions(landing_margin=-0.01)
+    assert err.value.field == "landing_margin"
     moved = replace(plan, footsteps=plan.footsteps + np.array([0.5, 0.0, 0.0]))
     with pytest.raises(InputError) as err:
         walk(scene, moved)
@@ -156,6 +160,33 @@ def test_project_to_polygon_is_the_nearest_point() -> None:
     assert np.array_equal(project_to_polygon(inside, square), inside)
     assert project_to_polygon(np.array([2.0, 0.5]), square) == pytest.approx([1.0, 0.5])
     assert project_to_polygon(np.array([-1.0, -2.0]), square) == pytest.approx([0.0, 0.0])
+
+
+def test_inset_polygon_moves_every_edge_in() -> None:
+    tri = np.array([[0.0, 0.0], [4.0, 0.0], [0.0, 3.0]])
+    inner = inset_polygon(tri, 0.5)
+    assert inner is not None
+    # every inset vertex lies exactly 0.5 m inside the two edges that meet there
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    assert inset_polygon(square, 0.1) == pytest.approx(
+        np.array([[0.1, 0.1], [0.9, 0.1], [0.9, 0.9], [0.1, 0.9]])
+    )
+    region = Region.from_height("tri", 0.0, tri)
+    for v in inner:
+        assert float(region.signed_distance(v)) == pytest.approx(-0.5)
+    assert inset_polygon(square, 0.5) is None  # a point, no area
+    assert inset_polygon(square, 0.7) is None  # turned inside out
+
+
+def test_footstep_is_clamped_into_the_margin_even_when_the_plan_is_not(short_walk) -> None:  # type: ignore[no-untyped-def]
+    # the walker's margin (half sole + landing margin) is larger than the plan's: a planned
+    # footstep 0.02 m from the edge is moved to the nearest point 0.12 m inside
+    _, plan, _ = short_walk
+    region = Region.from_height("pad", 0.0, [[-1.0, -1.0], [0.3, -1.0], [0.3, 1.0], [-1.0, 1.0]])
+    fol = PlanFollower(plan, {"pad": region}, region_margin=0.12)
+    ref = np.array([0.28, 0.0, 0.0])
+    out = fol._clamp_to_region(np.array([0.35, 0.05, 0.0]), ref, "pad")
+    assert out == pytest.approx([0.18, 0.05, 0.0])
 
 
 def test_corrected_footsteps_stay_in_the_reach_trapezoid(short_walk) -> None:  # type: ignore[no-untyped-def]

@@ -82,7 +82,10 @@ class BipedModel:
         nominal_hip_height: height of the hip joints above the soles in the walking posture [m]
             (knees bent, so the legs can lengthen when stepping up).
         joint_range: (lower, upper) limits per joint of ``LEG_JOINTS`` [rad], same for both legs
-            (roll and yaw limits are mirrored for the right leg).
+            (roll and yaw limits are mirrored for the right leg). The ankle pitch reaches -1.3 rad
+            of dorsiflexion (Talos: -1.27): stepping down 0.18 m, the rear ankle sat at a -1.0
+            limit in double support, the rear foot's heel lifted and the landing foot never took
+            the weight (``discrete_steps``, issue 7 note).
     """
 
     pelvis_mass: float = 8.0
@@ -108,7 +111,7 @@ class BipedModel:
         (-0.4, 0.6),
         (-1.9, 0.9),
         (0.05, 2.4),
-        (-1.0, 1.0),
+        (-1.3, 1.0),
         (-0.5, 0.5),
     )
 

@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import expm
 
+from footfall._geometry import outward_halfspaces, signed_area
 from footfall._validate import finite_vector, non_negative, positive
 from footfall.control.mpc import MPC, MPCWeights, build_mpc
 from footfall.errors import FootfallError, InputError
@@ -157,6 +158,9 @@ class WalkOptions:
             offset on flat ground (20 x 0.2 m: 0.042 -> 0.027 m) and kept the 0.33 m steps of
             the ``flat`` scene from falling.
         stop_on_fall: end the simulation when a fall is detected.
+        landing_margin: the walker's MPC keeps each footstep this much further inside its region
+            than the plan's half sole length [m]: landings fall ~2 cm short of their targets, and
+            a heel over a block's edge on a step down tipped the landing foot.
         closed_loop_ik: start the IK from the measured configuration every tick, so the torso
             orientation, the CoM height and the swing foot are fed back through the joint
             servos; a torque-driven stance ankle is held at its measured angles and its sole at
@@ -180,11 +184,12 @@ class WalkOptions:
     true_momentum: bool = True
     stop_on_fall: bool = True
     closed_loop_ik: bool = True
+    landing_margin: float = 0.02
 
     def __post_init__(self) -> None:
         for name in ("control_dt", "swing_clearance", "shift_time", "stop_time"):
             object.__setattr__(self, name, positive(name, getattr(self, name)))
-        for name in ("settle_time", "hold_time", "com_gain"):
+        for name in ("settle_time", "hold_time", "com_gain", "landing_margin"):
             object.__setattr__(self, name, non_negative(name, getattr(self, name)))
         fb = non_negative("com_feedback", self.com_feedback)
         if fb > 1.0:
@@ -444,10 +449,16 @@ class PlanFollower:
             return ref
         xy = target[:2]
         if not _point_in_region(region, xy, self.region_margin):
+            if not _point_in_region(region, ref[:2], self.region_margin):
+                # the plan's own footstep is nearer the edge than the margin: the nearest point
+                # of the region moved in by the margin (the plan's footstep if there is none)
+                inner = inset_polygon(region.vertices, self.region_margin)
+                if inner is None:
+                    return ref
+                xy = project_to_polygon(xy, inner)
+                return np.array([xy[0], xy[1], float(region.height_at(xy))])
             # bisect on the segment from the planned footstep (inside) to the corrected one
             lo, hi = 0.0, 1.0
-            if not _point_in_region(region, ref[:2], self.region_margin):
-                return ref
             for _ in range(20):
                 mid = 0.5 * (lo + hi)
                 if _point_in_region(region, ref[:2] + mid * (xy - ref[:2]), self.region_margin):
@@ -573,6 +584,27 @@ def shrink_polygon(vertices: FloatArray, margin: float) -> FloatArray:
     r = float(np.min(np.linalg.norm(v - c, axis=1)))
     scale = max(0.0, 1.0 - margin / r) if r > 0 else 0.0
     return np.asarray(c + (v - c) * scale)
+
+
+def inset_polygon(vertices: FloatArray, margin: float) -> FloatArray | None:
+    """Convex CCW polygon (n, 2) with every edge moved ``margin`` [m] inward (parallel).
+
+    Its vertices are the intersections of consecutive moved edges; None when the inset polygon
+    is empty or loses an edge (then those intersections are not all inside every moved edge).
+    """
+    v = np.asarray(vertices, dtype=float)
+    a, b = outward_halfspaces(v)
+    b = b - margin
+    n = a.shape[0]
+    pts = np.empty((n, 2))
+    for j in range(n):
+        m = np.array([a[j - 1], a[j]])
+        if abs(float(np.linalg.det(m))) < 1e-12:
+            return None
+        pts[j] = np.linalg.solve(m, np.array([b[j - 1], b[j]]))
+    if np.any(pts @ a.T - b > 1e-9) or signed_area(pts) <= 0.0:
+        return None
+    return pts
 
 
 def project_to_polygon(q: FloatArray, vertices: FloatArray) -> FloatArray:
@@ -1136,7 +1168,7 @@ def walk(
         else MPCAdjuster(
             plan,
             regions,
-            region_margin=plan.robot.foot_length / 2.0,
+            region_margin=plan.robot.foot_length / 2.0 + opts.landing_margin,
             control_dt=dt,
             stop_steps=opts.stop_steps,
             torque_limits=sole_torque_limits(plan.robot),
@@ -1217,6 +1249,8 @@ def walk(
     z_stand = 0.5 * (scene.start.left[2] + scene.start.right[2]) + z_h
 
     ankle_mode = {sd: False for sd in sim.sides}
+    ctrl_prev = np.array(d.ctrl[sim.actuators], dtype=float)
+    pos_prev = np.zeros(ctrl_prev.shape[0], dtype=bool)  # nothing to ramp from at the start
     ankle_u = np.zeros(2)
     wall0 = time.perf_counter()
     for k in range(n_ticks):
@@ -1416,7 +1450,16 @@ def walk(
                 cop_a = sole_cop(*contacts[sd], pos_a, rot_a)
                 f_n = min(sim.weight, cop_a[1]) if cop_a is not None else 0.0
                 q_des[sim.ankle_actuators(sd)] = ankle_joint_torque(cmd, rot_a, f_n, sim.params)
-        d.ctrl[sim.actuators] = q_des
+        # Position set points ramp linearly over the physics substeps from the last tick's: a step
+        # every 10 ms into 5000 N m/rad servos jolted the stance foot (normal force spikes from
+        # 300 to 570 N at every tick); torque-driven ankles, and actuators that changed mode this
+        # tick, take their new command at once.
+        ctrl_new = np.array(q_des, dtype=float)
+        pos_now = np.ones(ctrl_new.shape[0], dtype=bool)
+        for sd in sim.sides:
+            if ankle_mode[sd]:
+                pos_now[sim.ankle_actuators(sd)] = False
+        ramp = pos_now & pos_prev
         c2 = time.perf_counter()
         timing["ik"] += c2 - c1
 
@@ -1426,8 +1469,11 @@ def walk(
             if p.active(t):
                 push_force += p.force
         d.xfrc_applied[sim.torso, :3] = push_force
-        for _ in range(substeps):
+        for j in range(substeps):
+            w = (j + 1) / substeps
+            d.ctrl[sim.actuators] = np.where(ramp, ctrl_prev + w * (ctrl_new - ctrl_prev), ctrl_new)
             mj.mj_step(m, d)
+        ctrl_prev, pos_prev = ctrl_new, pos_now
         c3 = time.perf_counter()
         timing["physics"] += c3 - c2
         if writer is not None and k % frame_every == 0:
