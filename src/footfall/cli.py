@@ -525,8 +525,9 @@ def compare_command(
 
     if sim not in ("reduced", "mujoco"):
         raise InputError("sim", sim, "reduced or mujoco")
+    n_steps = _steps_arg(steps)
     if sim == "mujoco":
-        _compare_mujoco(scenes, planners, trials, push_max, time_limit, out)
+        _compare_mujoco(scenes, planners, trials, push_max, time_limit, out, n_steps)
         return
 
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -537,15 +538,6 @@ def compare_command(
 
     _positive_int("trials", trials)
     _positive_int("workers", workers)
-    n_steps: int | dict[str, int] | None = None
-    if steps is not None:
-        try:
-            if "=" in steps:
-                n_steps = {k.strip(): int(v) for k, v in (kv.split("=") for kv in steps.split(","))}
-            else:
-                n_steps = int(steps)
-        except ValueError:
-            raise InputError("steps", steps, "an integer or 'scene=N,scene=N'") from None
     names = check_names("planners", planners.split(","), PLANNERS)
     spec = TrialSpec(
         push_max=push_max,
@@ -600,8 +592,32 @@ def compare_command(
     console.print(f"wrote {', '.join(str(p) for p in paths)}")
 
 
+def _steps_arg(steps: str | None) -> int | dict[str, int] | None:
+    """``--steps`` of ``compare``: one N for every scene, or ``scene=N,scene=N``."""
+    if steps is None:
+        return None
+    out: int | dict[str, int]
+    try:
+        if "=" in steps:
+            out = {k.strip(): int(v) for k, v in (kv.split("=") for kv in steps.split(","))}
+        else:
+            out = int(steps)
+    except ValueError:
+        raise InputError("steps", steps, "an integer or 'scene=N,scene=N'") from None
+    values = out.values() if isinstance(out, dict) else [out]
+    if any(v < 1 for v in values):
+        raise InputError("steps", steps, "step counts >= 1")
+    return out
+
+
 def _compare_mujoco(
-    scenes: str, planners: str, trials: int, push_max: float, time_limit: float, out: Path
+    scenes: str,
+    planners: str,
+    trials: int,
+    push_max: float,
+    time_limit: float,
+    out: Path,
+    n_steps: int | dict[str, int] | None = None,
 ) -> None:
     """``compare --sim mujoco``: the section 5.5 table from MuJoCo walks (issue 7)."""
     from footfall.planning.plan import PLANNERS
@@ -622,12 +638,20 @@ def _compare_mujoco(
         "scenes", [s.strip() for s in scenes.split(",") if s.strip()], builtin_scene_names()
     )
     force = push_max / PUSH_DURATION
+    # N per scene for the optimising planners (the reactive planner walks until the goal)
+    per_pair = {
+        (sc, p): n_steps if isinstance(n_steps, int) else n_steps[sc]
+        for sc in scene_names
+        for p in names
+        if p != "reactive" and n_steps is not None and (isinstance(n_steps, int) or sc in n_steps)
+    }
     with console.status("walking in MuJoCo ...") as status:
         rows = compare_mujoco(
             scene_names,
             names,
             seeds=tuple(range(trials)),
             push=force,
+            n_steps=per_pair or None,
             time_limit=time_limit,
             cache_dir=out / "plans",
             progress=lambda line: status.update(line),
