@@ -71,6 +71,8 @@ def test_compare_runs_trials_and_writes_the_table(tmp_path: Path) -> None:
         (("compare", "--planners", "reactive,dijkstra"), "miqcqp, kinematic, reactive"),
         (("compare", "--trials", "0"), "trials"),
         (("compare", "--scenes", "flat", "--workers", "0"), "workers"),
+        (("compare", "--scenes", "flat", "--steps", "flat=0"), "step counts >= 1"),
+        (("compare", "--sim", "mujoco", "--scenes", "flat", "--steps", "x"), "scene=N"),
     ],
 )
 def test_bad_input_exits_2_with_the_valid_choices(
