@@ -87,6 +87,15 @@ def polygons_intersect(p: FloatArray, q: FloatArray, tol: float = 1e-9) -> bool:
     return True
 
 
+def point_polygon_distance(p: FloatArray, poly: FloatArray) -> float:
+    """Euclidean distance [m] from point ``p`` (2,) to a convex CCW polygon; 0 inside it."""
+    a, b = outward_halfspaces(poly)
+    if float(np.max(a @ p - b)) <= 0.0:
+        return 0.0
+    nxt = np.roll(poly, -1, axis=0)
+    return float(min(point_segment_distance(p, u, v) for u, v in zip(poly, nxt, strict=True)))
+
+
 def polygon_distance(p: FloatArray, q: FloatArray) -> float:
     """Minimum Euclidean distance [m] between two convex CCW polygons; 0 when they overlap.
 
@@ -101,6 +110,27 @@ def polygon_distance(p: FloatArray, q: FloatArray) -> float:
             for a, b in zip(other, nxt, strict=True):
                 best = min(best, point_segment_distance(v, a, b))
     return float(best)
+
+
+def inset_polygon(vertices: FloatArray, margin: float) -> FloatArray | None:
+    """Convex CCW polygon (n, 2) with every edge moved ``margin`` [m] inward (parallel).
+
+    Its vertices are the intersections of consecutive moved edges; None when the inset polygon
+    is empty or loses an edge (then those intersections are not all inside every moved edge).
+    """
+    v = np.asarray(vertices, dtype=float)
+    a, b = outward_halfspaces(v)
+    b = b - margin
+    n = a.shape[0]
+    pts = np.empty((n, 2))
+    for j in range(n):
+        m = np.array([a[j - 1], a[j]])
+        if abs(float(np.linalg.det(m))) < 1e-12:
+            return None
+        pts[j] = np.linalg.solve(m, np.array([b[j - 1], b[j]]))
+    if np.any(pts @ a.T - b > 1e-9) or signed_area(pts) <= 0.0:
+        return None
+    return pts
 
 
 def as_points(xy: ArrayLike) -> tuple[FloatArray, bool]:

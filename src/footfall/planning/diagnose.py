@@ -7,13 +7,15 @@ from collections import deque
 
 import numpy as np
 
+from footfall._geometry import point_polygon_distance
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import goal_feet, wrap_near
 from footfall.terrain.scene import Scene
+from footfall.terrain.terrain import Terrain
 
 
-def _regions_at(scene: Scene, xy: np.ndarray) -> list[str]:
-    return [r.name for r in scene.terrain if float(r.signed_distance(xy)) <= 1e-9]
+def _regions_at(scene: Scene, xy: np.ndarray, margin: float = 0.0) -> list[str]:
+    return [r.name for r in scene.terrain if float(r.signed_distance(xy)) <= 1e-9 - margin]
 
 
 def min_steps_lower_bound(scene: Scene, robot: BipedParams) -> int:
@@ -32,44 +34,94 @@ def min_steps_lower_bound(scene: Scene, robot: BipedParams) -> int:
     return max(2, by_distance, by_heading)
 
 
-def diagnose_infeasible(scene: Scene, robot: BipedParams, n_steps: int) -> str:
-    """Say what is known about why ``n_steps`` footsteps cannot reach the goal of ``scene``."""
-    reasons: list[str] = []
+def reachable_regions(
+    scene: Scene, robot: BipedParams, region_margin: float = 0.0
+) -> dict[str, int]:
+    """Regions a footstep can reach from the start, with the fewest steps to get there.
+
+    A step is possible between regions whose polygons, each inset by ``region_margin`` (the
+    planner keeps footsteps that far inside), are within the robot's largest step (the reach
+    trapezoid's farthest vertex, any heading); the first step starts at the start stance foot.
+    Heights and the trapezoid's shape are ignored, so this is a necessary condition only.
+    """
+    reach = float(np.max(np.linalg.norm(robot.reach.vertices, axis=1)))
+    adj = scene.terrain.adjacency(reach, region_margin)
+    p0 = np.asarray(scene.start.stance_foot[:2], dtype=float)
+    seen: dict[str, int] = {}
+    queue: deque[str] = deque()
+    for r in scene.terrain:
+        poly = Terrain.inset(r, region_margin)
+        if poly is not None and point_polygon_distance(p0, poly) <= reach:
+            seen[r.name] = 1
+            queue.append(r.name)
+    while queue:
+        r_name = queue.popleft()
+        for nb in adj[r_name]:
+            if nb not in seen:
+                seen[nb] = seen[r_name] + 1
+                queue.append(nb)
+    return seen
+
+
+def _goal_regions(
+    scene: Scene, robot: BipedParams, region_margin: float, reasons: list[str]
+) -> set[str]:
+    """Regions holding both final feet (``region_margin`` inside); a reason for each foot in none."""
     theta_goal = wrap_near(scene.goal.heading, scene.start.heading)
     feet = goal_feet(robot, scene.goal.position[:2], theta_goal)
     goal_regions: set[str] = set()
     for side, xy in feet.items():
-        inside = _regions_at(scene, xy)
+        inside = _regions_at(scene, xy, region_margin)
         if not inside:
+            where = f" with the {region_margin:g} m margin" if region_margin > 0 else ""
             reasons.append(
                 f"the final {side.value} foot at ({xy[0]:.3f}, {xy[1]:.3f}) m lies in no region"
+                + where
             )
         goal_regions.update(inside)
+    return goal_regions
+
+
+def geometric_infeasibility(
+    scene: Scene, robot: BipedParams, n_steps: int | None = None, region_margin: float = 0.0
+) -> str | None:
+    """Why no plan can exist, from geometry alone, or None if geometry does not rule it out.
+
+    Checked before any solve: a goal foot outside every region, goal regions that no sequence of
+    steps reaches (for any N), and, with ``n_steps``, too few steps for the distance, heading
+    change or region hops. A solver would need to prove these by search, which for the mixed-
+    integer planner can take longer than any time limit.
+    """
+    reasons: list[str] = []
+    goal_regions = _goal_regions(scene, robot, region_margin, reasons)
+    seen = reachable_regions(scene, robot, region_margin)
     reach = float(np.max(np.linalg.norm(robot.reach.vertices, axis=1)))
-    adj = scene.terrain.adjacency(reach)
-    start_region = scene.start_regions()[scene.start.stance]
-    seen = {start_region: 0}
-    queue = deque([start_region])
-    while queue:
-        r = queue.popleft()
-        for nb in adj[r]:
-            if nb not in seen:
-                seen[nb] = seen[r] + 1
-                queue.append(nb)
     if goal_regions and not goal_regions & seen.keys():
+        where = f" {region_margin:g} m inside their regions" if region_margin > 0 else ""
         reasons.append(
-            f"no goal region ({', '.join(sorted(goal_regions))}) can be reached from the start region "
-            f"{start_region!r} with steps of at most {reach:.2f} m; reachable: {', '.join(sorted(seen))}"
+            f"no goal region ({', '.join(sorted(goal_regions))}) can be reached from the start "
+            f"with steps of at most {reach:.2f} m between footsteps{where}; reachable: "
+            f"{', '.join(sorted(seen)) or 'none'}"
         )
-    bound = min_steps_lower_bound(scene, robot)
-    hops = [seen[g] for g in goal_regions if g in seen]
-    if hops:
-        bound = max(bound, min(hops))
-    if bound > n_steps:
-        reasons.append(f"the goal needs at least {bound} footsteps, {n_steps} were asked for")
-    if not reasons:
-        reasons.append(
-            f"no assignment of regions and headings satisfies reach, step height, torque bound "
-            f"({robot.u_max:g} N m) and goal with {n_steps} footsteps; try more steps (--min-steps)"
-        )
-    return "infeasible: " + "; ".join(reasons)
+    if n_steps is not None:
+        bound = min_steps_lower_bound(scene, robot)
+        hops = [seen[g] for g in goal_regions if g in seen]
+        if hops:
+            bound = max(bound, min(hops))
+        if bound > n_steps:
+            reasons.append(f"the goal needs at least {bound} footsteps, {n_steps} were asked for")
+    return "infeasible: " + "; ".join(reasons) if reasons else None
+
+
+def diagnose_infeasible(
+    scene: Scene, robot: BipedParams, n_steps: int, region_margin: float = 0.0
+) -> str:
+    """Say what is known about why ``n_steps`` footsteps cannot reach the goal of ``scene``."""
+    found = geometric_infeasibility(scene, robot, n_steps, region_margin)
+    if found is not None:
+        return found
+    return (
+        f"infeasible: no assignment of regions and headings satisfies reach, step height, torque "
+        f"bound ({robot.u_max:g} N m) and goal with {n_steps} footsteps; try more steps "
+        "(--min-steps)"
+    )

@@ -29,16 +29,21 @@ def plan_kinematic(
     """Plan footsteps without dynamics, then attach the least-torque ALIP trajectory."""
     from dataclasses import replace
 
-    from footfall.planning.diagnose import diagnose_infeasible
+    from footfall.planning.diagnose import diagnose_infeasible, geometric_infeasibility
 
     options = options or PlannerOptions()
     solver_opts = options.solver_options()
     kin = build_footstep_problem(scene, robot, n_steps, options, dynamics=False)
+    early = geometric_infeasibility(scene, kin.robot, n_steps, options.region_margin)
+    if early is not None:
+        return FootstepPlan.empty(
+            "kinematic", SolveStatus.INFEASIBLE, kin.robot, early, solver=options.solver
+        )
     res = solve(kin.problem, options.solver, solver_opts)
     meta = result_meta(res)
     if res.x is None:
         msg = (
-            diagnose_infeasible(scene, kin.robot, n_steps)
+            diagnose_infeasible(scene, kin.robot, n_steps, options.region_margin)
             if res.status is SolveStatus.INFEASIBLE
             else f"kinematic planner found no plan ({res.stats.get('raw_status')})"
         )

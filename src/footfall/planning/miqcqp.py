@@ -409,24 +409,30 @@ def plan_footsteps(
         A :class:`FootstepPlan`; its status says whether it is optimal (within the gap), a
         time-limited incumbent, or infeasible (with a diagnosis in ``message``).
     """
-    from footfall.planning.diagnose import diagnose_infeasible
+    from footfall.planning.diagnose import diagnose_infeasible, geometric_infeasibility
 
     options = options or PlannerOptions()
     fp = build_footstep_problem(scene, robot, n_steps, options)
+    early = geometric_infeasibility(scene, fp.robot, n_steps, options.region_margin)
+    if early is not None:
+        # proven by geometry: no search (a branch and bound can take longer than any limit)
+        return FootstepPlan.empty(
+            "miqcqp", SolveStatus.INFEASIBLE, fp.robot, early, solver=options.solver
+        )
     if fp.problem.bounds_conflict():
         # The bounds implied by reach, heading rate and goal already contradict each other.
         return FootstepPlan.empty(
             "miqcqp",
             SolveStatus.INFEASIBLE,
             fp.robot,
-            diagnose_infeasible(scene, fp.robot, n_steps),
+            diagnose_infeasible(scene, fp.robot, n_steps, options.region_margin),
             solver=options.solver,
         )
     result = solve(fp.problem, options.solver, options.solver_options())
     meta = result_meta(result)
     if result.x is None:
         if result.status is SolveStatus.INFEASIBLE:
-            message = diagnose_infeasible(scene, fp.robot, n_steps)
+            message = diagnose_infeasible(scene, fp.robot, n_steps, options.region_margin)
         elif result.status is SolveStatus.TIME_LIMIT:
             message = f"no feasible plan found within the time limit of {options.time_limit:g} s"
         else:

@@ -37,7 +37,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import expm
 
-from footfall._geometry import outward_halfspaces, signed_area
+from footfall._geometry import inset_polygon
 from footfall._validate import finite_vector, non_negative, positive
 from footfall.control.mpc import MPC, MPCWeights, build_mpc
 from footfall.errors import FootfallError, InputError
@@ -584,27 +584,6 @@ def shrink_polygon(vertices: FloatArray, margin: float) -> FloatArray:
     r = float(np.min(np.linalg.norm(v - c, axis=1)))
     scale = max(0.0, 1.0 - margin / r) if r > 0 else 0.0
     return np.asarray(c + (v - c) * scale)
-
-
-def inset_polygon(vertices: FloatArray, margin: float) -> FloatArray | None:
-    """Convex CCW polygon (n, 2) with every edge moved ``margin`` [m] inward (parallel).
-
-    Its vertices are the intersections of consecutive moved edges; None when the inset polygon
-    is empty or loses an edge (then those intersections are not all inside every moved edge).
-    """
-    v = np.asarray(vertices, dtype=float)
-    a, b = outward_halfspaces(v)
-    b = b - margin
-    n = a.shape[0]
-    pts = np.empty((n, 2))
-    for j in range(n):
-        m = np.array([a[j - 1], a[j]])
-        if abs(float(np.linalg.det(m))) < 1e-12:
-            return None
-        pts[j] = np.linalg.solve(m, np.array([b[j - 1], b[j]]))
-    if np.any(pts @ a.T - b > 1e-9) or signed_area(pts) <= 0.0:
-        return None
-    return pts
 
 
 def project_to_polygon(q: FloatArray, vertices: FloatArray) -> FloatArray:

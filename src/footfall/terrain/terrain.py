@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from footfall._geometry import polygon_distance
+from footfall._geometry import inset_polygon, polygon_distance
 from footfall.errors import SceneError
 from footfall.terrain.region import Region
 
@@ -90,12 +90,15 @@ class Terrain:
         pts = np.vstack([r.vertices3d for r in self.regions])
         return np.vstack([pts.min(axis=0), pts.max(axis=0)])
 
-    def adjacency(self, reach_radius: float) -> dict[str, set[str]]:
+    def adjacency(self, reach_radius: float, margin: float = 0.0) -> dict[str, set[str]]:
         """Regions whose horizontal polygons are within ``reach_radius`` [m] of each other.
 
         A cheap necessary condition for stepping from one region to another (it ignores heights and
         the trapezoid shape): when the goal region is not connected to the start region in this
         graph for the robot's largest step, the scene is infeasible for any number of steps.
+        With ``margin`` [m] (footsteps that far inside their regions, the planner's
+        ``region_margin``) the polygons are first inset by it; a region too small to hold a
+        footstep then has no neighbours.
 
         Returns:
             For each region name, the set of other region names within the radius.
@@ -103,11 +106,21 @@ class Terrain:
         radius = float(reach_radius)
         if not np.isfinite(radius) or radius < 0.0:
             raise SceneError("reach_radius", reach_radius, "a finite distance >= 0 [m]")
+        m = float(margin)
+        if not np.isfinite(m) or m < 0.0:
+            raise SceneError("margin", margin, "a finite distance >= 0 [m]")
         adj: dict[str, set[str]] = {r.name: set() for r in self.regions}
-        regs = self.regions
-        for i, a in enumerate(regs):
-            for b in regs[i + 1 :]:
-                if polygon_distance(a.vertices, b.vertices) <= radius:
-                    adj[a.name].add(b.name)
-                    adj[b.name].add(a.name)
+        polys = [(r.name, self.inset(r, m)) for r in self.regions]
+        for i, (na, pa) in enumerate(polys):
+            for nb, pb in polys[i + 1 :]:
+                if pa is not None and pb is not None and polygon_distance(pa, pb) <= radius:
+                    adj[na].add(nb)
+                    adj[nb].add(na)
         return adj
+
+    @staticmethod
+    def inset(region: Region, margin: float) -> FloatArray | None:
+        """Horizontal polygon of ``region`` moved ``margin`` [m] in; None if nothing is left."""
+        if margin <= 0.0:
+            return np.asarray(region.vertices, dtype=float)
+        return inset_polygon(region.vertices, margin)
