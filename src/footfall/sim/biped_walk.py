@@ -159,8 +159,9 @@ class WalkOptions:
             the ``flat`` scene from falling.
         stop_on_fall: end the simulation when a fall is detected.
         landing_margin: the walker's MPC keeps each footstep this much further inside its region
-            than the plan's half sole length [m]: landings fall ~2 cm short of their targets, and
-            a heel over a block's edge on a step down tipped the landing foot.
+            than the plan did (its ``region_margin``, half the sole length for
+            :func:`footfall.sim.biped_compare.plan_for_walk`) [m]: landings fall ~2 cm short of
+            their targets, and a heel over a block's edge on a step down tipped the landing foot.
         closed_loop_ik: start the IK from the measured configuration every tick, so the torso
             orientation, the CoM height and the swing foot are fed back through the joint
             servos; a torque-driven stance ankle is held at its measured angles and its sole at
@@ -1147,7 +1148,7 @@ def walk(
         else MPCAdjuster(
             plan,
             regions,
-            region_margin=plan.robot.foot_length / 2.0 + opts.landing_margin,
+            region_margin=plan.region_margin + opts.landing_margin,
             control_dt=dt,
             stop_steps=opts.stop_steps,
             torque_limits=sole_torque_limits(plan.robot),
