@@ -329,3 +329,19 @@ def test_cli_compare_mujoco_writes_the_table(tmp_path) -> None:  # type: ignore[
     assert len(rows) == 2 and "zmp_mean_m" in rows[0]
     bad = CliRunner().invoke(app, [*args, "--sim", "bogus", "--out", str(tmp_path / "x")])
     assert isinstance(bad.exception, InputError) and bad.exception.field == "sim"
+
+
+def test_walk_plan_cache_round_trip_keeps_the_region_margin(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    # the walker keeps footsteps the plan's region margin (plus the landing margin) inside their
+    # regions: a cached plan must come back with the margin it was made with
+    from footfall.sim.biped_compare import plan_for_walk
+
+    scene = builtin_scene("flat")
+    scene = replace(scene, goal=Goal(np.array([0.6, 0.0, 0.0]), 0.0))
+    made = plan_for_walk(scene, "kinematic", 4, 60.0, tmp_path)
+    assert made.has_solution and made.region_margin == pytest.approx(made.robot.foot_length / 2)
+    loaded = plan_for_walk(scene, "kinematic", 4, 60.0, tmp_path)
+    assert "loaded from cache" in loaded.message
+    assert loaded.region_margin == made.region_margin
+    np.testing.assert_array_equal(loaded.footsteps, made.footsteps)
+    np.testing.assert_array_equal(loaded.states, made.states)

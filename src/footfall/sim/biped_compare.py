@@ -53,7 +53,7 @@ def plan_for_walk(
     key = cache_key(scene.name, planner, n_steps, robot, margin)
     path = cache_dir / f"plan_{scene.name}_{planner}.json" if cache_dir is not None else None
     if path is not None:
-        cached = load_plan(path, robot, key)
+        cached = load_plan(path, robot, key, margin)
         if cached is not None:
             return cached
     opts = PlannerOptions(time_limit=time_limit, region_margin=margin)

@@ -45,8 +45,14 @@ def _nan(v: Any) -> float:
     return math.nan if v is None else float(v)
 
 
-def load_plan(path: Path, robot: BipedParams, key: str) -> FootstepPlan | None:
-    """The cached plan at ``path`` if it exists and its key equals ``key``, else None."""
+def load_plan(
+    path: Path, robot: BipedParams, key: str, region_margin: float = 0.0
+) -> FootstepPlan | None:
+    """The cached plan at ``path`` if it exists and its key equals ``key``, else None.
+
+    ``region_margin`` is the margin the plan was made with (part of ``key``; the walker keeps its
+    footsteps at least that far inside their regions).
+    """
     if not path.is_file():
         return None
     try:
@@ -82,4 +88,5 @@ def load_plan(path: Path, robot: BipedParams, key: str) -> FootstepPlan | None:
         solve_time=float(d.get("solve_time_s", 0.0)),
         solver=d.get("solver", "none"),
         message=d.get("message", "") + " (loaded from cache)",
+        region_margin=region_margin,
     )
