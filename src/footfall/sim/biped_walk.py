@@ -1391,10 +1391,15 @@ def walk(
         if opts.ankle_torque and phase_log[k] >= 0:
             ankle_cmd[stance_side] = ankle_u
         elif opts.ankle_torque and t_walk0 <= t < t_end_steps:
-            # double support: both ankles passive, the legs form a closed chain whose joint
-            # servos place the CoM; each foot's CoP stays at its centre and the total CoP lies
-            # between the feet, where the contact-point ramp of eq. (5.8) puts it
+            # double support: the legs form a closed chain whose joint servos place the CoM and
+            # the total CoP moves between the feet, where the contact-point ramp of eq. (5.8)
+            # puts it. The landing ankle is passive; the rear ankle's torque ramps from its last
+            # single-support command to zero over T_ds. (Dropping it at once made the rear foot
+            # pivot and lift as the weight left it, both feet unloaded for a few ticks: with the
+            # ramp 12 of 12 pushed walks of discrete_steps N = 18 reached the goal, without 10.)
             ankle_cmd = {sd: np.zeros(2) for sd in sim.sides}
+            if tp >= t_ss:
+                ankle_cmd[stance_side] = max(0.0, 1.0 - (tp - t_ss) / t_ds) * ankle_u
         if ankle_cmd[stance_side] is None or phase_log[k] < 0:
             com_cmd[:2] += opts.com_gain * (com_ref[:2] - com[:2])
         if opts.closed_loop_ik:
