@@ -171,6 +171,18 @@ def test_parallel_workers_find_the_same_optimum(seed: int, n: int) -> None:
         assert parallel.stats["workers"] == 2
 
 
+def test_search_process_solving_beside_one_worker_finds_the_same_optimum(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    fp = build_footstep_problem(random_stepping_stones(1, 8, robot=ROBOT), ROBOT, 8)
+    serial = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=1))
+    monkeypatch.setattr(bnb, "LOCAL_SOLVES", True)
+    local = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=2))
+    assert local.status is serial.status is SolveStatus.OPTIMAL
+    assert local.objective == pytest.approx(serial.objective, rel=OBJ_RTOL)
+    assert local.stats["workers"] == 1
+
+
 class _Recorded(bnb._Workers):
     """The worker pool, remembering every instance (to check that its processes are reaped)."""
 

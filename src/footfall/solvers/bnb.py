@@ -133,6 +133,9 @@ STAIRCASE = True
 COMPACT = True
 #: with threads >= 2, keep the workers busy asynchronously (else: synchronous batches)
 ASYNC = True
+#: with threads >= 2, the search process solves nodes too, beside ``threads - 1`` workers (each
+#: kept two tasks deep so that it never waits while the search process is busy solving)
+LOCAL_SOLVES = False
 #: at the end of a parallel search, give the workers this long [s] to finish their solves in flight
 #: and exit before they are terminated (a node solve takes milliseconds; dives stop on a flag)
 DRAIN_TIMEOUT = 1.0
@@ -2107,7 +2110,7 @@ class _Search:
             root = self.evaluate(root_allowed, -math.inf, 0, False)
         pool = None
         if self.heap and self.options.threads >= 2 and _Workers.available():
-            pool = _Workers(self.relax, self.options.threads)
+            pool = _Workers(self.relax, self.options.threads - (1 if LOCAL_SOLVES else 0))
         self.workers = 0 if pool is None else len(pool.procs)
         try:
             dive_from = None
@@ -2179,6 +2182,8 @@ class _Search:
         node) starts a dive in one worker. Returns True when stopped by the time limit."""
         #: per task: (kind, assignment, parent node); kind "node", "fixed" or "dive"
         inflight: dict[int, tuple[str, tuple[tuple[int, ...], ...], _Node | None]] = {}
+        #: with LOCAL_SOLVES: the node tasks the search process solves itself
+        mine: list[tuple[int, Any]] = []
         next_id = 0
 
         def submit(kind: str, task: Any, allowed: Any, node: _Node | None) -> None:
@@ -2186,13 +2191,16 @@ class _Search:
             tid = next_id
             next_id += 1
             inflight[tid] = (kind, allowed, node)
-            pool.submit(tid, "dive" if kind == "dive" else "node", task)
+            if LOCAL_SOLVES and kind != "dive" and pool.busy >= 2 * len(pool.procs):
+                mine.append((tid, task))
+            else:
+                pool.submit(tid, "dive" if kind == "dive" else "node", task)
 
         if dive_from is not None:
             x0, allowed0 = dive_from
             submit("dive", (x0, allowed0, self.inc_obj, self.deadline), allowed0, None)
         try:
-            return self._async_steps(pool, submit, inflight)
+            return self._async_steps(pool, submit, inflight, mine)
         finally:
             for _, _, node in inflight.values():  # their results are dropped: keep the bounds
                 if node is not None:
@@ -2203,10 +2211,13 @@ class _Search:
         pool: _Workers,
         submit: Any,
         inflight: dict[int, tuple[str, tuple[tuple[int, ...], ...], _Node | None]],
+        mine: list[tuple[int, Any]],
     ) -> bool:
         """The body of :meth:`_loop_async`."""
         answered: list[tuple[int, Any]] = []
         threads = self.options.threads
+        if LOCAL_SOLVES:  # every worker two deep, one for the search process
+            threads = 2 * len(pool.procs) + 1
         branched = 0
         while True:
             while self.heap and len(inflight) < threads:
@@ -2236,6 +2247,12 @@ class _Search:
                 self.trace.append((self.nodes, time.perf_counter() - self.start, inc, top))
             if self.gap_of(top) <= self.options.gap:
                 return False
+            if not answered and mine:
+                if time.perf_counter() > self.deadline:
+                    return True
+                tid, (allowed, full) = mine.pop(0)
+                answered = [(tid, self.relax.solve(allowed, full=full)), *pool.wait(0.0)]
+                answered.reverse()
             if not answered:
                 answered = pool.wait(self.deadline - time.perf_counter())
                 if not answered:
