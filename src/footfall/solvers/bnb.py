@@ -1897,6 +1897,11 @@ class _Workers:
         return "fork" in mp.get_all_start_methods()
 
     @property
+    def idle(self) -> bool:
+        """Some worker has no task."""
+        return any(not p for p in self.pending)
+
+    @property
     def busy(self) -> int:
         """Tasks sent and not answered yet."""
         return sum(map(len, self.pending))
@@ -2175,9 +2180,9 @@ class _Search:
     def _loop_async(
         self, pool: _Workers, dive_from: tuple[FloatArray, tuple[tuple[int, ...], ...]] | None
     ) -> bool:
-        """Best-first loop with the node solves in ``pool``, asynchronously: whenever fewer than
-        ``threads`` solves are in flight, the best open node is branched and its children are
-        submitted, so the workers never wait for a batch. A node's bound counts in the global
+        """Best-first loop with the node solves in ``pool``, asynchronously: whenever a worker has
+        no task, the best open node is branched and its children are submitted (to the least
+        loaded workers), so the workers never wait for a batch. A node's bound counts in the global
         bound until its children's results are in. ``dive_from`` (a relaxation point and its
         node) starts a dive in one worker. Returns True when stopped by the time limit."""
         #: per task: (kind, assignment, parent node); kind "node", "fixed" or "dive"
@@ -2220,7 +2225,9 @@ class _Search:
             threads = 2 * len(pool.procs) + 1
         branched = 0
         while True:
-            while self.heap and len(inflight) < threads:
+            # Branch until every worker has a task: counting the tasks in flight instead left a
+            # worker idle whenever both children of a node had gone to the other worker's queue.
+            while self.heap and (len(inflight) < threads if LOCAL_SOLVES else pool.idle):
                 node = heapq.heappop(self.heap)
                 if node.bound >= self.inc_obj:
                     continue
