@@ -8,6 +8,7 @@ relaxation (a valid lower bound, exact at a fixed assignment) and of the fallbac
 from __future__ import annotations
 
 import math
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -153,14 +154,137 @@ def test_unsupported_problem_falls_back_to_scip() -> None:
     assert res.objective == pytest.approx(0.0, abs=1e-6)
 
 
-def test_parallel_workers_find_the_same_optimum() -> None:
-    scene = random_stepping_stones(1, 8, robot=ROBOT)
-    fp = build_footstep_problem(scene, ROBOT, 8)
+@pytest.mark.parametrize(("seed", "n"), [(1, 8), (0, 7), (2, 7), (3, 8)])
+def test_parallel_workers_find_the_same_optimum(seed: int, n: int) -> None:
+    scene = random_stepping_stones(seed, 8, robot=ROBOT)
+    fp = build_footstep_problem(scene, ROBOT, n)
     serial = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=1))
     parallel = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=2))
-    assert serial.status is parallel.status is SolveStatus.OPTIMAL
+    assert serial.status is parallel.status
+    assert serial.stats["workers"] == 0
+    if serial.status is SolveStatus.INFEASIBLE:
+        return
+    assert serial.status is SolveStatus.OPTIMAL
     assert parallel.objective == pytest.approx(serial.objective, rel=OBJ_RTOL)
-    assert parallel.stats["nodes"] > 1  # the search branched, so the workers were used
+    assert fp.problem.violation(parallel.x) <= bnb.FEAS_TOL
+    if parallel.stats["nodes"] > 1:  # the search branched, so the workers were used
+        assert parallel.stats["workers"] == 2
+
+
+def test_search_process_solving_beside_one_worker_finds_the_same_optimum(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    fp = build_footstep_problem(random_stepping_stones(1, 8, robot=ROBOT), ROBOT, 8)
+    serial = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=1))
+    monkeypatch.setattr(bnb, "LOCAL_SOLVES", True)
+    local = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=2))
+    assert local.status is serial.status is SolveStatus.OPTIMAL
+    assert local.objective == pytest.approx(serial.objective, rel=OBJ_RTOL)
+    assert local.stats["workers"] == 1
+
+
+class _Recorded(bnb._Workers):
+    """The worker pool, remembering every instance (to check that its processes are reaped)."""
+
+    made: ClassVar[list[bnb._Workers]] = []
+
+    def __init__(self, relax, n: int) -> None:  # type: ignore[no-untyped-def]
+        super().__init__(relax, n)
+        _Recorded.made.append(self)
+
+
+@pytest.fixture
+def recorded(monkeypatch: pytest.MonkeyPatch) -> list[bnb._Workers]:
+    """Pools the searches of a test made; afterwards every worker must be reaped."""
+    import multiprocessing as mp
+    import os
+
+    _Recorded.made = []
+    monkeypatch.setattr(bnb, "_Workers", _Recorded)
+    yield _Recorded.made
+    for pool in _Recorded.made:
+        assert pool.closed
+        for proc in pool.procs:
+            assert proc.exitcode is not None  # joined
+            assert not os.path.exists(f"/proc/{proc.pid}")  # not even a zombie
+    assert not mp.active_children()
+
+
+def _branching_problem() -> MIQCQP:
+    return build_footstep_problem(random_stepping_stones(0, 8, robot=ROBOT), ROBOT, 8).problem
+
+
+def test_workers_are_reaped_after_a_solve(recorded: list[bnb._Workers]) -> None:
+    res = solve(_branching_problem(), "bnb", SolverOptions(gap=GAP, threads=2))
+    assert res.status is SolveStatus.OPTIMAL
+    assert len(recorded) == 1 and len(recorded[0].procs) == 2
+
+
+def test_workers_are_reaped_after_the_time_limit(recorded: list[bnb._Workers]) -> None:
+    fp = build_footstep_problem(random_stepping_stones(0, 8, robot=ROBOT), ROBOT, 10)
+    res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.3, gap=0.0, threads=2))
+    assert res.status in (SolveStatus.TIME_LIMIT, SolveStatus.OPTIMAL)
+    assert len(recorded) == 1
+
+
+def _raise_in_worker(task):  # type: ignore[no-untyped-def]
+    raise ArithmeticError("node solver exploded")
+
+
+def _exit_in_worker(task):  # type: ignore[no-untyped-def]
+    import os
+
+    os._exit(7)  # a worker that dies without a word (as if killed)
+
+
+def test_a_failing_worker_stops_the_search_with_its_error(
+    recorded: list[bnb._Workers], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(bnb, "_work", _raise_in_worker)  # the forked workers inherit it
+    with pytest.raises(bnb.WorkerError, match="node solver exploded"):
+        solve(_branching_problem(), "bnb", SolverOptions(gap=GAP, threads=2))
+    assert len(recorded) == 1
+
+
+def test_a_dead_worker_is_an_error_not_a_hang(
+    recorded: list[bnb._Workers], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import time
+
+    monkeypatch.setattr(bnb, "_work", _exit_in_worker)
+    start = time.perf_counter()
+    with pytest.raises(bnb.WorkerError, match=r"died \(exit code 7\)"):
+        solve(_branching_problem(), "bnb", SolverOptions(time_limit=60.0, gap=GAP, threads=2))
+    assert time.perf_counter() - start < 20.0  # far below the time limit
+    assert len(recorded) == 1
+
+
+def test_an_error_in_the_search_process_reaps_the_workers(
+    recorded: list[bnb._Workers], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    calls = {"n": 0}
+    evaluate = bnb._Search.evaluate
+
+    def failing(self, *args, **kwargs):  # type: ignore[no-untyped-def]
+        calls["n"] += 1
+        if calls["n"] > 3:  # after the root, with workers solving
+            raise KeyboardInterrupt
+        return evaluate(self, *args, **kwargs)
+
+    monkeypatch.setattr(bnb._Search, "evaluate", failing)
+    with pytest.raises(KeyboardInterrupt):
+        solve(_branching_problem(), "bnb", SolverOptions(gap=GAP, threads=2))
+    assert len(recorded) == 1
+
+
+@pytest.mark.parametrize("threads", [0, -1, 1.5, True, "2", None])
+def test_bad_thread_counts_are_input_errors(threads: object) -> None:
+    from footfall.errors import InputError
+
+    with pytest.raises(InputError, match="threads"):
+        SolverOptions(threads=threads)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="threads"):
+        PlannerOptions(threads=threads)  # type: ignore[arg-type]
 
 
 def test_bench_plan_cli_writes_the_table(tmp_path) -> None:  # type: ignore[no-untyped-def]

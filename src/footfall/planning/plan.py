@@ -67,7 +67,10 @@ class PlannerOptions:
             SCIP), ``gurobi`` (optional).
         time_limit: solver wall-time limit [s].
         gap: relative optimality gap at which the solver stops.
-        threads: solver threads.
+        threads: solver threads; for ``bnb``, the forked worker processes that solve node
+            relaxations in parallel (1, the default: the serial search in the calling process, so
+            a library call starts no processes unless asked; the CLI passes 2, the benchmark
+            machine's cores). A worker that dies stops the solve with ``bnb.WorkerError``.
         verbose: print the solver log.
         momentum_bound: bound on |L| as a CoM speed [m/s] (|L| <= m z_H * bound); a physical limit
             that also gives the solver finite bounds.

@@ -31,7 +31,8 @@ class SolverOptions:
         gap: relative optimality gap at which to stop (|primal - dual| / |primal|).
         abs_gap: absolute gap at which to stop (needed when the optimum is near zero, where a
             relative gap cannot close).
-        threads: number of threads the backend may use.
+        threads: number of threads the backend may use; for ``bnb``, the number of forked worker
+            processes that solve node relaxations in parallel (1: all in the calling process).
         verbose: print the backend's log.
         seed: random seed of the backend.
         initial_solution: optional full variable vector used as a warm start (MIP start).
@@ -49,7 +50,7 @@ class SolverOptions:
         object.__setattr__(self, "time_limit", positive("time_limit", self.time_limit))
         object.__setattr__(self, "gap", non_negative("gap", self.gap))
         object.__setattr__(self, "abs_gap", non_negative("abs_gap", self.abs_gap))
-        if not isinstance(self.threads, int) or self.threads < 1:
+        if isinstance(self.threads, bool) or not isinstance(self.threads, int) or self.threads < 1:
             from footfall.errors import InputError
 
             raise InputError("threads", self.threads, "an integer >= 1")

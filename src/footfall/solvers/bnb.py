@@ -52,9 +52,12 @@ group is a feasible point of the MIQCQP (the binaries are then set to those memb
 is solved exactly even when the interior-point weights are spread. Otherwise the group whose nearest
 member is violated most is split where the cumulative weight of its members (in index order, the
 angle order for segments) crosses 1/2 (SOS1 branching). Incumbents come from such nodes and a dive
-from the root (periodic rounding is available, off). With ``threads >= 2`` forked workers solve
-the nodes asynchronously: whenever one is free, the best open node is branched and its children
-submitted; the dive runs in a worker meanwhile. The search stops when ``(incumbent - bound) / min(|incumbent|,
+from the root (periodic rounding is available, off). With ``threads >= 2`` forked worker processes
+(:class:`_Workers`) solve the nodes asynchronously: whenever one is free, the best open node is
+branched and its children submitted; the dive runs in a worker meanwhile. The queue, incumbent and
+pruning stay in the calling process, so the search is the serial one with the node solves moved
+out (node order may differ, the optimum within the gap does not). A worker that dies or raises
+stops the search with :class:`WorkerError`; every worker is reaped however the search ends. The search stops when ``(incumbent - bound) / min(|incumbent|,
 |bound|) <= gap`` (SCIP's definition) or at the time limit, returning the best point and an honest
 gap; a node whose solve fails numerically makes the result ``feasible`` at best, never ``optimal``.
 """
@@ -130,8 +133,12 @@ STAIRCASE = True
 COMPACT = True
 #: with threads >= 2, keep the workers busy asynchronously (else: synchronous batches)
 ASYNC = True
-#: at the end of an asynchronous search, wait at most this long [s] for the solves in flight
-DRAIN_TIMEOUT = 10.0
+#: with threads >= 2, the search process solves nodes too, beside ``threads - 1`` workers (each
+#: kept two tasks deep so that it never waits while the search process is busy solving)
+LOCAL_SOLVES = False
+#: at the end of a parallel search, give the workers this long [s] to finish their solves in flight
+#: and exit before they are terminated (a node solve takes milliseconds; dives stop on a flag)
+DRAIN_TIMEOUT = 1.0
 
 
 class UnsupportedProblem(ValueError):
@@ -1785,8 +1792,12 @@ def _dive(
 
 
 _WORKER: HullRelaxation | None = None
-#: in a worker: a shared flag the search sets when it ends (see :func:`_pool`)
+#: in a worker: a shared flag the search sets when it ends (see :class:`_Workers`)
 _STOP: Any = None
+
+
+class WorkerError(RuntimeError):
+    """A worker process of the search died or failed; the message says which and how."""
 
 
 def _work(task: tuple[tuple[tuple[int, ...], ...], bool]) -> _Relaxation:
@@ -1809,24 +1820,180 @@ def _work_dive(
     return chosen, None if chosen is None else _WORKER.solve(chosen)
 
 
-def _pool(relax: HullRelaxation, threads: int) -> Any:
-    """A pool of ``threads`` forked workers sharing ``relax`` (None for 1 thread or no fork)."""
-    import multiprocessing as mp
+def _serve(conn: Any, relax: HullRelaxation, stop: Any) -> None:
+    """Body of a worker process: answer ``(id, kind, task)`` messages with ``(id, ok, result)``
+    until ``None`` or the end of the pipe. A task's exception is sent back as text (it may not
+    pickle); SIGINT is left to the search, which shuts the workers down."""
+    import signal
+    import traceback
 
-    global _WORKER
-    if threads < 2 or "fork" not in mp.get_all_start_methods():
-        return None
-    global _STOP
-    ctx = mp.get_context("fork")
-    _WORKER = relax
-    _STOP = ctx.Value("b", 0, lock=False)
-    try:
-        pool: Any = ctx.Pool(threads)
-        pool.footfall_stop = _STOP  # set to 1 to end dives early
-        return pool
-    finally:
-        _WORKER = None
-        _STOP = None
+    global _WORKER, _STOP
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _WORKER, _STOP = relax, stop
+    while True:
+        try:
+            msg = conn.recv()
+        except (EOFError, OSError):
+            return  # the search process is gone
+        if msg is None:
+            return
+        tid, kind, task = msg
+        out: tuple[int, bool, Any]
+        try:
+            out = (tid, True, _work_dive(task) if kind == "dive" else _work(task))
+        except Exception:
+            out = (tid, False, traceback.format_exc())
+        try:
+            conn.send(out)
+        except (BrokenPipeError, OSError):
+            return
+
+
+class _Workers:
+    """``n`` forked worker processes solving the node relaxations of one search.
+
+    Forked, so every worker inherits the built relaxation (:class:`HullRelaxation`, with its
+    templates and condensed KKT factor) instead of receiving it pickled; a task is only a node's
+    allowed members (tuples of ints) and a result one :class:`_Relaxation`.
+
+    Not :class:`multiprocessing.pool.Pool`: a Pool silently replaces a worker that dies (a crash
+    in the node solver, the out-of-memory killer) and the task it held never returns, so the search
+    would wait for it until its time limit (and the replacement, forked later, would not hold the
+    relaxation). Here each worker has its own pipe and :meth:`wait` watches the pipes and the
+    processes' sentinels together, so a dead worker raises :class:`WorkerError` at once. There are
+    no helper threads, and :meth:`close` always reaps every process.
+    """
+
+    def __init__(self, relax: HullRelaxation, n: int) -> None:
+        import multiprocessing as mp
+
+        ctx = mp.get_context("fork")
+        #: shared flag: 1 ends dives early (set by :meth:`close`)
+        self.stop = ctx.Value("b", 0, lock=False)
+        self.conns: list[Any] = []
+        self.procs: list[Any] = []
+        #: per worker, the ids of the tasks sent and not answered yet
+        self.pending: list[list[int]] = []
+        self.closed = False
+        try:
+            for _ in range(n):
+                here, there = ctx.Pipe(duplex=True)
+                proc = ctx.Process(target=_serve, args=(there, relax, self.stop), daemon=True)
+                proc.start()
+                there.close()
+                self.conns.append(here)
+                self.procs.append(proc)
+                self.pending.append([])
+        except BaseException:
+            self.close()
+            raise
+
+    @staticmethod
+    def available() -> bool:
+        """Forked workers need the fork start method (Linux, and macOS where it is not the
+        default); elsewhere the search runs in one process."""
+        import multiprocessing as mp
+
+        return "fork" in mp.get_all_start_methods()
+
+    @property
+    def idle(self) -> bool:
+        """Some worker has no task."""
+        return any(not p for p in self.pending)
+
+    @property
+    def busy(self) -> int:
+        """Tasks sent and not answered yet."""
+        return sum(map(len, self.pending))
+
+    def submit(self, tid: int, kind: str, task: Any) -> None:
+        """Send task ``tid`` (``kind`` "node": :func:`_work`, "dive": :func:`_work_dive`) to the
+        worker with the fewest unanswered tasks."""
+        i = min(range(len(self.conns)), key=lambda k: len(self.pending[k]))
+        try:
+            self.conns[i].send((tid, kind, task))
+        except (BrokenPipeError, OSError) as exc:
+            raise self._died(i) from exc
+        self.pending[i].append(tid)
+
+    def _died(self, i: int) -> WorkerError:
+        proc = self.procs[i]
+        proc.join(timeout=1.0)
+        return WorkerError(
+            f"bnb worker process {proc.pid} died (exit code {proc.exitcode}) with "
+            f"{len(self.pending[i])} node solve(s) unanswered; the search is stopped"
+        )
+
+    def wait(self, timeout: float) -> list[tuple[int, Any]]:
+        """The ``(id, result)`` of the tasks answered within ``timeout`` seconds ([] if none).
+
+        Raises :class:`WorkerError` when a worker died or a task raised in a worker.
+        """
+        from multiprocessing.connection import wait
+
+        sentinels = {p.sentinel: i for i, p in enumerate(self.procs)}
+        ready = wait([*self.conns, *sentinels], timeout=max(timeout, 0.0))
+        out: list[tuple[int, Any]] = []
+        for i, conn in enumerate(self.conns):
+            try:
+                while conn.poll():
+                    tid, ok, res = conn.recv()
+                    self.pending[i].remove(tid)
+                    if not ok:
+                        raise WorkerError(f"a bnb worker failed solving a node:\n{res}")
+                    out.append((tid, res))
+            except (EOFError, OSError) as exc:
+                raise self._died(i) from exc
+        for obj in ready:
+            if obj in sentinels:
+                raise self._died(sentinels[obj])
+        return out
+
+    def map(self, kind: str, tasks: list[Any]) -> list[Any]:
+        """Results of ``tasks`` in their order, solved in the workers (for synchronous batches)."""
+        base = 1 << 40  # ids apart from the asynchronous tasks
+        for k, task in enumerate(tasks):
+            self.submit(base + k, kind, task)
+        got: dict[int, Any] = {}
+        while len(got) < len(tasks):
+            got.update(self.wait(60.0))
+        return [got[base + k] for k in range(len(tasks))]
+
+    def close(self, grace: float = DRAIN_TIMEOUT) -> None:
+        """Stop every worker and reap it: dives end early (shared flag), each worker finishes its
+        current solve and exits on ``None``; one still alive after ``grace`` seconds is
+        terminated, then killed. Unanswered results are dropped. Safe to call twice."""
+        if self.closed:
+            return
+        self.closed = True
+        self.stop.value = 1
+        for conn in self.conns:
+            try:
+                conn.send(None)
+            except (BrokenPipeError, OSError):
+                pass
+        end = time.perf_counter() + grace
+        from multiprocessing.connection import wait
+
+        # read what the workers still send, so none blocks on a full pipe while exiting
+        while any(p.is_alive() for p in self.procs) and time.perf_counter() < end:
+            live = [c for c, p in zip(self.conns, self.procs, strict=True) if p.is_alive()]
+            sentinels = [p.sentinel for p in self.procs if p.is_alive()]
+            for obj in wait([*live, *sentinels], timeout=max(end - time.perf_counter(), 0.0)):
+                if obj in live:
+                    try:
+                        self.conns[self.conns.index(obj)].recv()
+                    except (EOFError, OSError):
+                        pass
+        for proc in self.procs:
+            if proc.is_alive():
+                proc.terminate()
+                proc.join(timeout=1.0)
+            if proc.is_alive():  # pragma: no cover - SIGTERM is not ignored by the workers
+                proc.kill()
+            proc.join()
+        for conn in self.conns:
+            conn.close()
 
 
 class _Search:
@@ -1849,6 +2016,8 @@ class _Search:
         self.lost_bound = math.inf
         self.fixed_by_duals = 0
         self.strong_solves = 0
+        #: worker processes of the search (0: the search process solves every node)
+        self.workers = 0
         #: (nodes, seconds, incumbent or None, best bound) every 25 nodes
         self.trace: list[tuple[int, float, float | None, float]] = []
         if options.initial_solution is not None:
@@ -1944,24 +2113,27 @@ class _Search:
         root = None
         if all(root_allowed):
             root = self.evaluate(root_allowed, -math.inf, 0, False)
-        pool = _pool(self.relax, self.options.threads) if self.heap else None
-        dive_from = None
-        if root is not None and root.x is not None and DIVE:
-            if pool is not None and ASYNC:
-                dive_from = (root.x, root_allowed)  # one worker dives while the others branch
-            else:
-                self.dive(root.x, root_allowed)
+        pool = None
+        if self.heap and self.options.threads >= 2 and _Workers.available():
+            pool = _Workers(self.relax, self.options.threads - (1 if LOCAL_SOLVES else 0))
+        self.workers = 0 if pool is None else len(pool.procs)
         try:
+            dive_from = None
+            if root is not None and root.x is not None and DIVE:
+                if pool is not None and ASYNC:
+                    dive_from = (root.x, root_allowed)  # one worker dives while the others branch
+                else:
+                    self.dive(root.x, root_allowed)
             if pool is None or not ASYNC:
                 timed_out = self._loop(pool)
             else:
                 timed_out = self._loop_async(pool, dive_from)
         finally:
             if pool is not None:
-                pool.terminate()
+                pool.close()
         return self.result(timed_out)
 
-    def _loop(self, pool: Any) -> bool:
+    def _loop(self, pool: _Workers | None) -> bool:
         """The best-first loop; returns True when stopped by the time limit. With a ``pool``, the
         children of the best ``threads`` open nodes are solved in parallel."""
         batch = 1 if pool is None else self.options.threads
@@ -2000,24 +2172,23 @@ class _Search:
                 for child, node in tasks:
                     self.evaluate(child, node.bound, node.depth + 1, node.full)
             else:
-                results = pool.map(_work, [(child, node.full) for child, node in tasks])
+                results = pool.map("node", [(child, node.full) for child, node in tasks])
                 for (child, node), res in zip(tasks, results, strict=True):
                     self.evaluate(child, node.bound, node.depth + 1, node.full, res)
         return False
 
     def _loop_async(
-        self, pool: Any, dive_from: tuple[FloatArray, tuple[tuple[int, ...], ...]] | None
+        self, pool: _Workers, dive_from: tuple[FloatArray, tuple[tuple[int, ...], ...]] | None
     ) -> bool:
-        """Best-first loop with the node solves in ``pool``, asynchronously: whenever fewer than
-        ``threads`` solves are in flight, the best open node is branched and its children are
-        submitted, so the workers never wait for a batch. A node's bound counts in the global
+        """Best-first loop with the node solves in ``pool``, asynchronously: whenever a worker has
+        no task, the best open node is branched and its children are submitted (to the least
+        loaded workers), so the workers never wait for a batch. A node's bound counts in the global
         bound until its children's results are in. ``dive_from`` (a relaxation point and its
         node) starts a dive in one worker. Returns True when stopped by the time limit."""
-        import queue
-
-        done: queue.Queue[tuple[int, Any]] = queue.Queue()
         #: per task: (kind, assignment, parent node); kind "node", "fixed" or "dive"
         inflight: dict[int, tuple[str, tuple[tuple[int, ...], ...], _Node | None]] = {}
+        #: with LOCAL_SOLVES: the node tasks the search process solves itself
+        mine: list[tuple[int, Any]] = []
         next_id = 0
 
         def submit(kind: str, task: Any, allowed: Any, node: _Node | None) -> None:
@@ -2025,45 +2196,38 @@ class _Search:
             tid = next_id
             next_id += 1
             inflight[tid] = (kind, allowed, node)
-            pool.apply_async(
-                _work_dive if kind == "dive" else _work,
-                (task,),
-                callback=lambda res, tid=tid: done.put((tid, res)),
-                error_callback=lambda exc, tid=tid: done.put((tid, exc)),
-            )
+            if LOCAL_SOLVES and kind != "dive" and pool.busy >= 2 * len(pool.procs):
+                mine.append((tid, task))
+            else:
+                pool.submit(tid, "dive" if kind == "dive" else "node", task)
 
         if dive_from is not None:
             x0, allowed0 = dive_from
             submit("dive", (x0, allowed0, self.inc_obj, self.deadline), allowed0, None)
         try:
-            return self._async_steps(submit, done, inflight)
+            return self._async_steps(pool, submit, inflight, mine)
         finally:
-            # Let the workers finish their solves before the pool is terminated: a worker killed
-            # while it holds the task queue's lock can hang Pool.terminate.
-            pool.footfall_stop.value = 1
             for _, _, node in inflight.values():  # their results are dropped: keep the bounds
                 if node is not None:
                     self.lost_bound = min(self.lost_bound, node.bound)
-            end = time.perf_counter() + DRAIN_TIMEOUT
-            while inflight and time.perf_counter() < end:
-                try:
-                    inflight.pop(done.get(timeout=max(end - time.perf_counter(), 0.0))[0], None)
-                except queue.Empty:
-                    break
 
     def _async_steps(
         self,
+        pool: _Workers,
         submit: Any,
-        done: Any,
         inflight: dict[int, tuple[str, tuple[tuple[int, ...], ...], _Node | None]],
+        mine: list[tuple[int, Any]],
     ) -> bool:
         """The body of :meth:`_loop_async`."""
-        import queue
-
+        answered: list[tuple[int, Any]] = []
         threads = self.options.threads
+        if LOCAL_SOLVES:  # every worker two deep, one for the search process
+            threads = 2 * len(pool.procs) + 1
         branched = 0
         while True:
-            while self.heap and len(inflight) < threads:
+            # Branch until every worker has a task: counting the tasks in flight instead left a
+            # worker idle whenever both children of a node had gone to the other worker's queue.
+            while self.heap and (len(inflight) < threads if LOCAL_SOLVES else pool.idle):
                 node = heapq.heappop(self.heap)
                 if node.bound >= self.inc_obj:
                     continue
@@ -2090,13 +2254,19 @@ class _Search:
                 self.trace.append((self.nodes, time.perf_counter() - self.start, inc, top))
             if self.gap_of(top) <= self.options.gap:
                 return False
-            try:
-                tid, res = done.get(timeout=max(self.deadline - time.perf_counter(), 0.0))
-            except queue.Empty:
-                return True
+            if not answered and mine:
+                if time.perf_counter() > self.deadline:
+                    return True
+                tid, (allowed, full) = mine.pop(0)
+                answered = [(tid, self.relax.solve(allowed, full=full)), *pool.wait(0.0)]
+                answered.reverse()
+            if not answered:
+                answered = pool.wait(self.deadline - time.perf_counter())
+                if not answered:
+                    return True
+                answered.reverse()  # popped from the end: oldest first
+            tid, res = answered.pop()
             kind, allowed, parent = inflight.pop(tid)
-            if isinstance(res, BaseException):
-                raise res
             if kind == "dive":
                 allowed, res = res
                 if allowed is None or allowed in self.tried:
@@ -2111,7 +2281,7 @@ class _Search:
             self.evaluate(allowed, parent.bound, parent.depth + 1, parent.full, res)
 
     def strong(
-        self, node: _Node, allowed: tuple[tuple[int, ...], ...], pool: Any
+        self, node: _Node, allowed: tuple[tuple[int, ...], ...], pool: _Workers | None
     ) -> list[tuple[tuple[tuple[int, ...], ...], _Relaxation]] | None:
         """Strong branching over the ``STRONG`` best candidates: the children (with their solved
         relaxations) of the split whose children bounds rise most (product score)."""
@@ -2124,7 +2294,7 @@ class _Search:
         if pool is None:
             results = [self.relax.solve(c, full=node.full) for c in flat]
         else:
-            results = pool.map(_work, [(c, node.full) for c in flat])
+            results = pool.map("node", [(c, node.full) for c in flat])
         self.strong_solves += len(flat) - 2
         best, best_i = -math.inf, 0
         for i in range(len(splits)):
@@ -2180,6 +2350,7 @@ class _Search:
                 "condensed": self.relax.condensed is not None,
                 "fixed_by_duals": self.fixed_by_duals,
                 "strong_solves": self.strong_solves,
+                "workers": self.workers,
                 "trace": self.trace,
             },
         )
