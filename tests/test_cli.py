@@ -43,6 +43,20 @@ def test_lip_examples(tmp_path: Path, name: str) -> None:
     assert json.loads((tmp_path / "lip_walk.json").read_text())["footsteps"]
 
 
+def test_lip_example_options_change_the_example(tmp_path: Path) -> None:
+    base, low = tmp_path / "base", tmp_path / "low"
+    assert run("lip", "--example", "straight", "--out", str(base)).returncode == 0
+    res = run("lip", "--example", "straight", "--zc", "0.6", "--out", str(low))
+    assert res.returncode == 0, res.stderr
+    p0 = json.loads((base / "lip_walk.json").read_text())["params"]
+    p1 = json.loads((low / "lip_walk.json").read_text())["params"]
+    assert p1["z_c"] == pytest.approx(0.6) and p0["z_c"] != pytest.approx(0.6)
+    # everything not given stays the example's
+    assert {k: v for k, v in p1.items() if k != "z_c"} == {
+        k: v for k, v in p0.items() if k != "z_c"
+    }
+
+
 @pytest.mark.parametrize(
     ("args", "needle"),
     [
@@ -53,6 +67,9 @@ def test_lip_examples(tmp_path: Path, name: str) -> None:
         (["--sx", "0,abc"], "sx"),
         (["--theta-deg", "0,20"], "theta"),
         (["--example", "zigzag"], "straight, diagonal, turn, circle"),
+        # options given with an example change it, so they are checked like any other
+        (["--example", "straight", "--zc", "nan"], "z_c"),
+        (["--example", "turn", "--sx", "0,0.3"], "sx"),
     ],
 )
 def test_lip_bad_input_exits_2_with_clear_message(

@@ -14,6 +14,7 @@ import typer
 from rich.console import Console
 
 from footfall._io import write_json
+from footfall._validate import non_negative
 from footfall.errors import FootfallError, InputError
 
 app = typer.Typer(
@@ -53,47 +54,80 @@ def main() -> None:
 def lip(
     out: Path = typer.Option(Path("out/lip"), help="Output folder for lip_walk.json and .png."),
     example: str | None = typer.Option(
-        None, help="A document example: straight, diagonal, turn or circle (overrides the rest)."
+        None,
+        help="A document example: straight, diagonal, turn or circle; the options below that are "
+        "given change it.",
     ),
-    zc: float = typer.Option(0.8, help="CoM height z_c [m]."),
-    t_sup: float = typer.Option(0.8, help="Support duration T_sup [s]."),
-    sx: str = typer.Option("0,0.3,0.3,0.3,0", help="Forward walk parameters per step [m]."),
-    sy: str = typer.Option("0.2,0.2,0.2,0.2,0.2", help="Lateral walk parameters per step [m]."),
+    zc: float | None = typer.Option(None, help="CoM height z_c [m] (default 0.8)."),
+    t_sup: float | None = typer.Option(None, help="Support duration T_sup [s] (default 0.8)."),
+    sx: str | None = typer.Option(
+        None, help="Forward walk parameters per step [m] (default 0,0.3,0.3,0.3,0)."
+    ),
+    sy: str | None = typer.Option(
+        None, help="Lateral walk parameters per step [m] (default 0.2,0.2,0.2,0.2,0.2)."
+    ),
     theta_deg: str | None = typer.Option(None, help="Heading per step [deg]; default all 0."),
-    a: float = typer.Option(10.0, help="Position weight of the foot placement cost."),
-    b: float = typer.Option(1.0, help="Velocity weight of the foot placement cost."),
-    a_stop: float = typer.Option(1.0, help="Position weight for the stop step."),
-    b_stop: float = typer.Option(1.0, help="Velocity weight for the stop step."),
-    g: float = typer.Option(9.81, help="Gravity [m/s^2] (the document's code uses 9.8)."),
+    a: float | None = typer.Option(
+        None, help="Position weight of the foot placement cost (default 10)."
+    ),
+    b: float | None = typer.Option(
+        None, help="Velocity weight of the foot placement cost (default 1)."
+    ),
+    a_stop: float | None = typer.Option(
+        None, help="Position weight for the stop step (default 1)."
+    ),
+    b_stop: float | None = typer.Option(
+        None, help="Velocity weight for the stop step (default 1)."
+    ),
+    g: float | None = typer.Option(
+        None, help="Gravity [m/s^2] (default 9.81; the document's code uses 9.8)."
+    ),
     dt: float = typer.Option(0.01, help="Sampling period of the CoM trajectory in the JSON [s]."),
 ) -> None:
     """Kajita LIP walking pattern with foot placement modification (document 004)."""
     import math
+    from dataclasses import replace
 
     from footfall.planning.lip_examples import example as get_example
     from footfall.planning.lip_io import lip_walk_to_dict
     from footfall.planning.lip_walk import LipWalkParams, lip_walk
     from footfall.viz.lip_plot import plot_lip_walk
 
+    given: dict[str, object] = {
+        k: v
+        for k, v in {
+            "z_c": zc,
+            "t_sup": t_sup,
+            "sx": None if sx is None else tuple(parse_floats("sx", sx)),
+            "sy": None if sy is None else tuple(parse_floats("sy", sy)),
+            "theta": None
+            if theta_deg is None
+            else tuple(math.radians(v) for v in parse_floats("theta_deg", theta_deg)),
+            "a": a,
+            "b": b,
+            "a_stop": a_stop,
+            "b_stop": b_stop,
+            "g": g,
+        }.items()
+        if v is not None
+    }
     if example is not None:
-        params = get_example(example)
+        # the example's walk, changed only where the user asked (LipWalkParams checks the result)
+        params = replace(get_example(example), **given)  # type: ignore[arg-type]
         title = f"LIP walk: {example} (document 004)"
     else:
-        theta = None
-        if theta_deg is not None:
-            theta = tuple(math.radians(v) for v in parse_floats("theta_deg", theta_deg))
-        params = LipWalkParams(
-            z_c=zc,
-            t_sup=t_sup,
-            sx=tuple(parse_floats("sx", sx)),
-            sy=tuple(parse_floats("sy", sy)),
-            theta=theta,
-            a=a,
-            b=b,
-            a_stop=a_stop,
-            b_stop=b_stop,
-            g=g,
-        )
+        base: dict[str, object] = {
+            "z_c": 0.8,
+            "t_sup": 0.8,
+            "sx": (0.0, 0.3, 0.3, 0.3, 0.0),
+            "sy": (0.2, 0.2, 0.2, 0.2, 0.2),
+            "a": 10.0,
+            "b": 1.0,
+            "a_stop": 1.0,
+            "b_stop": 1.0,
+            "g": 9.81,
+        }
+        params = LipWalkParams(**(base | given))  # type: ignore[arg-type]
         title = "LIP walk"
     walk = lip_walk(params)
     write_json(out / "lip_walk.json", lip_walk_to_dict(walk, dt))
@@ -631,8 +665,7 @@ def _compare_mujoco(
     from footfall.terrain.scene import builtin_scene_names
 
     _positive_int("trials", trials)
-    if push_max < 0:
-        raise InputError("push_max", push_max, "an impulse >= 0 [N s]")
+    push_max = non_negative("push_max", push_max)
     names = check_names("planners", planners.split(","), PLANNERS)
     scene_names = check_names(
         "scenes", [s.strip() for s in scenes.split(",") if s.strip()], builtin_scene_names()
@@ -728,8 +761,7 @@ def walk_cmd(
     check_planner_name(planner)
     if steps is not None and steps < 1:
         raise InputError("steps", steps, "an integer >= 1")
-    if push < 0:
-        raise InputError("push", push, "a force magnitude >= 0 [N]")
+    push = non_negative("push", push)
     sc = resolve_scene(scene_file, scene)
     with console.status(f"planning {sc.name} with {planner} ..."):
         plan = plan_for_walk(sc, planner, steps, time_limit, out)

@@ -143,7 +143,14 @@ def test_bad_walk_inputs_name_the_field(short_walk) -> None:  # type: ignore[no-
 
 
 @pytest.mark.parametrize(
-    "args", [["--planner", "bogus"], ["--push", "-1"], ["--steps", "0"], ["--scene", "nowhere"]]
+    "args",
+    [
+        ["--planner", "bogus"],
+        ["--push", "-1"],
+        ["--push", "nan"],
+        ["--steps", "0"],
+        ["--scene", "nowhere"],
+    ],
 )
 def test_cli_walk_rejects_bad_input(args: list[str], tmp_path) -> None:  # type: ignore[no-untyped-def]
     base = ["walk", "--scene", "flat", "--planner", "reactive", "--out", str(tmp_path)]

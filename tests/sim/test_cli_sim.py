@@ -73,6 +73,8 @@ def test_compare_runs_trials_and_writes_the_table(tmp_path: Path) -> None:
         (("compare", "--scenes", "flat", "--workers", "0"), "workers"),
         (("compare", "--scenes", "flat", "--steps", "flat=0"), "step counts >= 1"),
         (("compare", "--sim", "mujoco", "--scenes", "flat", "--steps", "x"), "scene=N"),
+        (("compare", "--sim", "mujoco", "--scenes", "flat", "--push-max", "nan"), "push_max"),
+        (("compare", "--scenes", "flat", "--push-max", "nan"), "push_max"),
     ],
 )
 def test_bad_input_exits_2_with_the_valid_choices(
