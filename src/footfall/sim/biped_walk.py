@@ -434,9 +434,7 @@ class PlanFollower:
         """``target`` moved into the reach trapezoid of the measured stance foot (eq. 5.12f)."""
         robot = self.plan.robot
         side = self.plan.sides[phase]
-        th = float(self.plan.headings[phase])
-        c, s = math.cos(th), math.sin(th)
-        rot = np.array([[c, -s], [s, c]])
+        rot = _rot2(float(self.plan.headings[phase]))
         q = rot.T @ (target[:2] - stance[:2])
         poly = shrink_polygon(robot.reach.for_stance(side), self.reach_margin)
         q = project_to_polygon(q, poly)
