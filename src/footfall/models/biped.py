@@ -88,6 +88,11 @@ class ReachTrapezoid:
         v.setflags(write=False)
         object.__setattr__(self, "vertices", v)
 
+    @property
+    def radius(self) -> float:
+        """The longest step [m]: distance of the farthest vertex from the stance foot (any heading)."""
+        return float(np.max(np.linalg.norm(self.vertices, axis=1)))
+
     def for_stance(self, stance: Side) -> FloatArray:
         """CCW vertices (4, 2) [m] of the reachable set when ``stance`` is the standing foot.
 

@@ -20,7 +20,7 @@ def _regions_at(scene: Scene, xy: np.ndarray, margin: float = 0.0) -> list[str]:
 
 def min_steps_lower_bound(scene: Scene, robot: BipedParams) -> int:
     """A lower bound on the number of footsteps any plan needs (distance and heading change)."""
-    reach = float(np.max(np.linalg.norm(robot.reach.vertices, axis=1)))
+    reach = robot.reach.radius
     start = scene.start
     theta_goal = wrap_near(scene.goal.heading, start.heading)
     feet = goal_feet(robot, scene.goal.position[:2], theta_goal)
@@ -44,7 +44,7 @@ def reachable_regions(
     trapezoid's farthest vertex, any heading); the first step starts at the start stance foot.
     Heights and the trapezoid's shape are ignored, so this is a necessary condition only.
     """
-    reach = float(np.max(np.linalg.norm(robot.reach.vertices, axis=1)))
+    reach = robot.reach.radius
     adj = scene.terrain.adjacency(reach, region_margin)
     p0 = np.asarray(scene.start.stance_foot[:2], dtype=float)
     seen: dict[str, int] = {}
@@ -95,7 +95,7 @@ def geometric_infeasibility(
     reasons: list[str] = []
     goal_regions = _goal_regions(scene, robot, region_margin, reasons)
     seen = reachable_regions(scene, robot, region_margin)
-    reach = float(np.max(np.linalg.norm(robot.reach.vertices, axis=1)))
+    reach = robot.reach.radius
     if goal_regions and not goal_regions & seen.keys():
         where = f" {region_margin:g} m inside their regions" if region_margin > 0 else ""
         reasons.append(

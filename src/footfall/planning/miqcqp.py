@@ -136,7 +136,7 @@ def build_footstep_problem(
     mzh = robot.mass * robot.com_height
 
     feet = goal_feet(robot, scene.goal.position[:2], theta_goal)
-    reach = float(np.max(np.linalg.norm(robot.reach.vertices, axis=1)))
+    reach = robot.reach.radius
     p0 = start.foot(start.stance)
 
     b = ProblemBuilder()
