@@ -258,6 +258,11 @@ def plan(
     region_margin: float = typer.Option(
         0.0, help="Keep footsteps this far inside their region [m] (0: point footholds)."
     ),
+    reach_both_frames: bool = typer.Option(
+        False,
+        help="Beyond the document: each step also in the reach set of the landing foot's frame "
+        "(no trailing foot beside or across the new stance foot when headings differ).",
+    ),
     out: Path = typer.Option(Path("out/plan"), help="Output folder for plan.json and plan.png."),
 ) -> None:
     """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists."""
@@ -271,7 +276,12 @@ def plan(
     if steps is not None and (steps < 1):
         raise InputError("steps", steps, "an integer >= 1")
     options = PlannerOptions(
-        time_limit=time_limit, gap=gap, solver=solver, threads=threads, region_margin=region_margin
+        time_limit=time_limit,
+        gap=gap,
+        solver=solver,
+        threads=threads,
+        region_margin=region_margin,
+        reach_both_frames=reach_both_frames,
     )
     with console.status(f"planning {sc.name} with {planner} ...") as status:
 

@@ -77,6 +77,21 @@ def test_infeasible_detected_by_both() -> None:
     assert not check_plan(plan, scene).ok
 
 
+def test_unsolvable_node_relaxations_are_an_error_that_says_so(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Clarabel stopping early on every node (one iteration allowed, also in the retry) must
+    not read as infeasible: the plan says how many nodes failed and with which status."""
+    monkeypatch.setattr(bnb, "CLARABEL_SETTINGS", {**bnb.CLARABEL_SETTINGS, "max_iter": 1})
+    monkeypatch.setattr(bnb, "CLARABEL_RETRY_SETTINGS", {"max_iter": 1})
+    scene = _scene(4, 0)
+    plan = plan_footsteps_fast(scene, ROBOT, 4, PlannerOptions(time_limit=30.0))
+    assert plan.status is SolveStatus.ERROR
+    assert plan.stats["failed_nodes"] == {"MaxIterations": plan.stats["nodes"]}
+    assert "infeasibility not proven" in plan.message
+    assert "MaxIterations" in plan.message
+
+
 def test_relaxation_is_a_lower_bound_and_exact_when_fixed() -> None:
     scene = _scene(5, 0)
     fp = build_footstep_problem(scene, ROBOT, 5)

@@ -284,3 +284,45 @@ def test_reactive_step_limit_counts_the_last_step() -> None:
     assert exact.status is SolveStatus.FEASIBLE and exact.n_steps == free.n_steps
     short = plan_reactive(sc, max_steps=free.n_steps - 1)
     assert short.status is SolveStatus.INFEASIBLE
+
+
+def test_reach_both_frames_holds_each_step_in_both_feet_frames() -> None:
+    """With ``reach_both_frames`` every step lies in the reach set seen from either foot."""
+    sc = scene(SHORT_TURN)
+    one = plan_footsteps(sc, n_steps=5, options=OPTS)
+    both = plan_footsteps(sc, n_steps=5, options=replace(OPTS, reach_both_frames=True))
+    assert one.status is SolveStatus.OPTIMAL and both.status is SolveStatus.OPTIMAL
+    assert both.reach_both_frames and not one.reach_both_frames
+    assert check_plan(both, sc).ok
+
+    def outside_in_landing_frame(plan) -> list[int]:  # type: ignore[no-untyped-def]
+        bad = []
+        for i in range(plan.n_steps):
+            d = plan.footsteps[i + 1, :2] - plan.footsteps[i, :2]
+            th = plan.headings[i + 1]
+            q = np.array(
+                [
+                    math.cos(th) * d[0] + math.sin(th) * d[1],
+                    -math.sin(th) * d[0] + math.cos(th) * d[1],
+                ]
+            )
+            if not sc.robot.reach.contains(q, plan.sides[i], tol=1e-6):
+                bad.append(i + 1)
+        return bad
+
+    # the document's plan turns by moving the trailing foot beside the new stance foot
+    assert outside_in_landing_frame(one)
+    assert "reach" in check_plan(replace(one, reach_both_frames=True), sc).kinds()
+    assert outside_in_landing_frame(both) == []
+    # a restriction of the document's problem: never a better objective
+    assert both.objective >= one.objective - 1e-6
+    # the direct model on SCIP has the same optimum (the rows are built once, for every backend)
+    direct = plan_footsteps(
+        sc, n_steps=5, options=replace(OPTS, reach_both_frames=True, solver="scip")
+    )
+    assert direct.status is SolveStatus.OPTIMAL
+    assert direct.objective == pytest.approx(both.objective, rel=1e-4)
+    with pytest.raises(InputError, match="reach_both_frames"):
+        PlannerOptions(reach_both_frames="yes")  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="reach_both_frames"):
+        make_plan(sc, "reactive", options=replace(OPTS, reach_both_frames=True))

@@ -193,17 +193,24 @@ def check_plan(plan: FootstepPlan, scene: Scene, robot: BipedParams | None = Non
 
     checked.append("reach")
     for i in range(n):
-        th = plan.headings[i]
         d = feet[i + 1, :2] - feet[i, :2]
-        q = np.array(
-            [math.cos(th) * d[0] + math.sin(th) * d[1], -math.sin(th) * d[0] + math.cos(th) * d[1]]
-        )
         corners = np.array(robot.reach.vertices, dtype=float)  # for a right stance foot
         if plan.sides[i] is Side.LEFT:
             corners = corners * np.array([1.0, -1.0])
-        outside = _inside_polygon(q, corners, GEOM_TOL)
-        if outside > GEOM_TOL:
-            out.append(Violation("reach", i + 1, outside, f"{outside:.2e} m outside the reach set"))
+        # the step in the stance foot's heading frame; also in the landing foot's if asked
+        for k in (i, i + 1) if plan.reach_both_frames else (i,):
+            th = plan.headings[k]
+            q = np.array(
+                [
+                    math.cos(th) * d[0] + math.sin(th) * d[1],
+                    -math.sin(th) * d[0] + math.cos(th) * d[1],
+                ]
+            )
+            outside = _inside_polygon(q, corners, GEOM_TOL)
+            if outside > GEOM_TOL:
+                frame = "" if k == i else " in the landing foot's frame"
+                msg = f"{outside:.2e} m outside the reach set{frame}"
+                out.append(Violation("reach", i + 1, outside, msg))
         dz = abs(feet[i + 1, 2] - feet[i, 2])
         if dz > robot.step_height_max + GEOM_TOL:
             out.append(Violation("step_height", i + 1, dz, f"step height {dz:.3f} m"))

@@ -260,26 +260,31 @@ def build_footstep_problem(
                 b.add_le_big_m({int(var[i]): 1.0, ti: -g_l}, h_l, z, label)
                 b.add_le_big_m({int(var[i]): -1.0, ti: g_l}, -h_l, z, label)
 
-    # (5.12f) reachability of footstep i+1 from footstep i in Rot(theta_i) R_reach(side_i).
+    # (5.12f) reachability of footstep i+1 from footstep i in Rot(theta_i) R_reach(side_i); with
+    # ``reach_both_frames`` the same step also in the landing foot's frame Rot(theta_{i+1}).
+    frames = (0, 1) if options.reach_both_frames else (0,)
     for i in range(n):
         g_rows, h_rows = robot.reach.halfspaces(sides[i])
         d = {int(p[i + 1, 0]): 1.0, int(p[i, 0]): -1.0}, {int(p[i + 1, 1]): 1.0, int(p[i, 1]): -1.0}
-        if i == 0:
-            rot = rot2(theta0)
-            for j, (g, h) in enumerate(zip(g_rows, h_rows, strict=True)):
-                a = rot @ g  # (Rot g)^T d = g^T Rot^T d
-                row = _combine(d, a)
-                b.add_le(row, float(h), f"5.12f reach 0 row {j}")
-            continue
-        for ell in range(n_seg):
-            z = int(segments[i, ell])
-            if z < 0:
+        for f in frames:
+            k = i + f  # the footstep whose heading frame holds the step
+            if k == 0:
+                rot = rot2(theta0)
+                for j, (g, h) in enumerate(zip(g_rows, h_rows, strict=True)):
+                    a = rot @ g  # (Rot g)^T d = g^T Rot^T d
+                    row = _combine(d, a)
+                    b.add_le(row, float(h), f"5.12f reach 0 row {j}")
                 continue
-            for j, (g, h) in enumerate(zip(g_rows, h_rows, strict=True)):
-                h_eff = float(h) * math.cos(half) if h > 0 else float(h)
-                for phi in (breaks[ell], breaks[ell + 1]):
-                    row = _combine(d, rot2(float(phi)) @ g)
-                    b.add_le_big_m(row, h_eff, z, f"5.12f reach {i} segment {ell} row {j}")
+            for ell in range(n_seg):
+                z = int(segments[k, ell])
+                if z < 0:
+                    continue
+                for j, (g, h) in enumerate(zip(g_rows, h_rows, strict=True)):
+                    h_eff = float(h) * math.cos(half) if h > 0 else float(h)
+                    for phi in (breaks[ell], breaks[ell + 1]):
+                        row = _combine(d, rot2(float(phi)) @ g)
+                        label = f"5.12f reach {i} frame {k} segment {ell} row {j}"
+                        b.add_le_big_m(row, h_eff, z, label)
 
     # (5.12i-k) region assignment for footsteps 1..N. A region whose bounding box misses the
     # footstep's bounds can never hold it, so it gets no binary (H fixed to 0).
@@ -393,7 +398,22 @@ def extract_plan(fp: FootstepProblem, x: FloatArray, **meta: Any) -> FootstepPla
         final_state=x[fp.x_final],
         sin_cos=np.stack([x[fp.s], x[fp.c]], axis=1),
         region_margin=fp.options.region_margin,
+        reach_both_frames=fp.options.reach_both_frames,
         **meta,
+    )
+
+
+def solver_failure_message(result: Any) -> str:
+    """Why a solve that ended without a plan and without a proof of infeasibility did so."""
+    stats = result.stats
+    failed = stats.get("failed_nodes") or {}
+    if not failed:
+        return f"solver {result.solver} failed: {stats.get('raw_status')}"
+    counts = ", ".join(f"{n} x {status or 'unknown'}" for status, n in sorted(failed.items()))
+    return (
+        f"no plan found, and infeasibility not proven: {sum(failed.values())} of "
+        f"{stats.get('nodes', '?')} node relaxations could not be solved by Clarabel ({counts}); "
+        f"try another N, or solver='scip'"
     )
 
 
@@ -436,7 +456,7 @@ def plan_footsteps(
         elif result.status is SolveStatus.TIME_LIMIT:
             message = f"no feasible plan found within the time limit of {options.time_limit:g} s"
         else:
-            message = f"solver {result.solver} failed: {result.stats.get('raw_status')}"
+            message = solver_failure_message(result)
         return FootstepPlan.empty("miqcqp", robot=fp.robot, message=message, **meta)
     message = {
         SolveStatus.OPTIMAL: f"optimal within gap {options.gap:g}",

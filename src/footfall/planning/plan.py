@@ -77,6 +77,11 @@ class PlannerOptions:
         region_margin: keep every footstep at least this far inside its region's polygon [m]
             (eq. 5.18 with each edge moved inward). 0 is the document's point foothold; half the
             sole width (0.05 m) keeps the sole on narrow stones at any heading.
+        reach_both_frames: beyond the document: every step ``p_{i+1} - p_i`` must lie in the
+            reach set both in the stance foot's heading frame (eq. 5.12f) and in the landing
+            foot's. False is the document's problem. With headings that differ between the
+            feet, eq. (5.12f) alone lets the trailing foot end up beside or across the new
+            stance foot in that foot's frame, and the next swing then passes through it.
     """
 
     weights: PlannerWeights = field(default_factory=PlannerWeights)
@@ -88,6 +93,7 @@ class PlannerOptions:
     verbose: bool = False
     momentum_bound: float = 3.0
     region_margin: float = 0.0
+    reach_both_frames: bool = False
 
     def __post_init__(self) -> None:
         if not isinstance(self.heading_segments, int) or self.heading_segments < 4:
@@ -100,6 +106,8 @@ class PlannerOptions:
             raise InputError("solver", self.solver, f"one of {', '.join(KNOWN_BACKENDS)}")
         object.__setattr__(self, "momentum_bound", positive("momentum_bound", self.momentum_bound))
         object.__setattr__(self, "region_margin", non_negative("region_margin", self.region_margin))
+        if not isinstance(self.reach_both_frames, bool):
+            raise InputError("reach_both_frames", self.reach_both_frames, "True or False")
 
     def solver_options(self) -> SolverOptions:
         """The backend options these planner options imply."""
@@ -171,6 +179,7 @@ class FootstepPlan:
     message: str = ""
     sin_cos: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
     region_margin: float = 0.0
+    reach_both_frames: bool = False
 
     @property
     def n_steps(self) -> int:

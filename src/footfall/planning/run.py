@@ -38,6 +38,11 @@ def make_plan(
     if planner == "reactive":
         from footfall.planning.reactive import plan_reactive
 
+        if options.reach_both_frames:
+            raise InputError(
+                "reach_both_frames", True, "False for the reactive planner (miqcqp or kinematic)"
+            )
+
         return plan_reactive(
             scene, robot, max_steps=n_steps or 40, region_margin=options.region_margin
         )

@@ -89,4 +89,5 @@ def load_plan(
         solver=d.get("solver", "none"),
         message=d.get("message", "") + " (loaded from cache)",
         region_margin=region_margin,
+        reach_both_frames=bool(d.get("reach_both_frames", False)),
     )

@@ -116,10 +116,15 @@ STRONG = 0
 #: Clarabel settings of the node solves. Iterative refinement and equilibration cost about 45 % of
 #: a node solve here (100 node problems of N = 10 and 15: 3.06 s -> 1.68 s, 1885 -> 1503
 #: iterations) and change no status and no bound by more than 1e-7
+#: Clarabel statuses that end a node solve (anything else is retried once, then "failed")
+_CLARABEL_DONE = ("Solved", "AlmostSolved", "PrimalInfeasible", "AlmostPrimalInfeasible")
 CLARABEL_SETTINGS: dict[str, Any] = {
     "iterative_refinement_enable": False,
     "equilibrate_enable": False,
 }
+#: the retry of a node whose solve ended in another status: Clarabel's defaults (equilibration,
+#: iterative refinement) with more iterations
+CLARABEL_RETRY_SETTINGS: dict[str, Any] = {"max_iter": 200}
 #: couple groups linked by plain rows through weights on their compatible member pairs
 LINKS = False
 #: keep a link only when its rows rule out at least this share of the member pairs
@@ -633,6 +638,8 @@ class _Relaxation:
     #: any solution of the node with ``z = 1`` costs at least ``bound + zdual[z]`` (the value of a
     #: convex program is convex in the right-hand side; the multiplier is a subgradient)
     zdual: FloatArray | None = None
+    #: Clarabel's status when ``status`` is "failed"
+    raw: str = ""
 
 
 class _Coo:
@@ -1327,6 +1334,11 @@ class HullRelaxation:
         for key, value in CLARABEL_SETTINGS.items():
             setattr(settings, key, value)
         self._settings = settings
+        robust = clarabel.DefaultSettings()
+        robust.verbose = False
+        for key, value in CLARABEL_RETRY_SETTINGS.items():
+            setattr(robust, key, value)
+        self._robust_settings = robust
         self._cones: dict[int, Any] = {}
         self.solves = 0
         self.solve_time = 0.0
@@ -1498,13 +1510,16 @@ class HullRelaxation:
         cones += [self._soc(int(dd)) for dd in base.soc_dims]
         cones += [self._soc(int(dd)) for dd in t.cost_dim[persp]]
         t0 = time.perf_counter()
-        solver = cl.DefaultSolver(
-            _CscLists(p_mat), q.tolist(), _CscLists(a_mat), b.tolist(), cones, self._settings
-        )
-        sol = solver.solve()
+        data = (_CscLists(p_mat), q.tolist(), _CscLists(a_mat), b.tolist(), cones)
+        sol = cl.DefaultSolver(*data, self._settings).solve()
+        status = str(sol.status)
+        if status not in _CLARABEL_DONE:
+            # numerical trouble with the fast settings: once more with Clarabel's own defaults
+            # (equilibration, iterative refinement) and more iterations
+            sol = cl.DefaultSolver(*data, self._robust_settings).solve()
+            status = str(sol.status)
         self.solve_time += time.perf_counter() - t0
         self.solves += 1
-        status = str(sol.status)
         if status in ("Solved", "AlmostSolved"):
             bound = min(float(sol.obj_val), float(sol.obj_val_dual)) + const
             if keep_col is None:
@@ -1524,7 +1539,7 @@ class HullRelaxation:
             return _Relaxation("solved", bound, x, int(sol.iterations), zdual)
         if status in ("PrimalInfeasible", "AlmostPrimalInfeasible"):
             return _Relaxation("infeasible", iterations=int(sol.iterations))
-        return _Relaxation("failed", iterations=int(sol.iterations))
+        return _Relaxation("failed", iterations=int(sol.iterations), raw=status)
 
     def _soc(self, dim: int) -> Any:
         """A second-order cone of dimension ``dim`` (one object per dimension, reused)."""
@@ -2013,6 +2028,8 @@ class _Search:
         self.nodes = 0
         self.counter = 0
         self.failed = False
+        #: Clarabel status -> number of nodes left unsolved with it
+        self.failures: dict[str, int] = {}
         self.lost_bound = math.inf
         self.fixed_by_duals = 0
         self.strong_solves = 0
@@ -2082,6 +2099,7 @@ class _Search:
         if res.status == "failed":
             # unsolved node: its parent's bound stays in the reported bound (an honest gap)
             self.failed = True
+            self.failures[res.raw] = self.failures.get(res.raw, 0) + 1
             self.lost_bound = min(self.lost_bound, parent_bound)
             return None
         if res.status != "solved" or res.x is None:
@@ -2341,6 +2359,7 @@ class _Search:
             stats={
                 "raw_status": status.value,
                 "nodes": self.nodes,
+                "failed_nodes": dict(self.failures),
                 "relaxations": self.relax.solves,
                 "relaxation_time_s": self.relax.solve_time,
                 "variables": self.problem.n,
