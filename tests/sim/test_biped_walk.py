@@ -325,6 +325,17 @@ def test_flat_walk_of_twenty_steps_reaches_the_goal() -> None:
         assert COP_SLOPE[0] < slope < COP_SLOPE[1]
 
 
+def test_long_flat_steps_reach_the_goal_with_a_limp_landing_ankle() -> None:
+    # the flat scene's plan takes 0.36 m steps; with a stiff swing ankle every landing hit the
+    # toe first and lifted the robot, and the walk ended 0.51 m short (0.05 m with it limp)
+    scene = builtin_scene("flat")
+    plan = make_plan(scene, "miqcqp", robot=planner_params(base=scene.robot))
+    assert np.linalg.norm(np.diff(plan.footsteps[:, :2], axis=0), axis=1).max() > 0.35
+    res = walk(scene, plan, WalkOptions(passive_landing=True))
+    assert not res.fell
+    assert res.metrics["reached_goal"]
+
+
 def test_cli_compare_mujoco_writes_the_table(tmp_path) -> None:  # type: ignore[no-untyped-def]
     args = ["compare", "--sim", "mujoco", "--scenes", "flat", "--planners", "reactive"]
     res = CliRunner().invoke(app, [*args, "--trials", "1", "--out", str(tmp_path)])

@@ -162,6 +162,14 @@ class WalkOptions:
             than the plan did (its ``region_margin``, half the sole length for
             :func:`footfall.sim.biped_compare.plan_for_walk`) [m]: landings fall ~2 cm short of
             their targets, and a heel over a block's edge on a step down tipped the landing foot.
+        passive_landing: the swing ankle goes limp (torque mode, zero torque) from the first
+            contact of the swing sole during its descent until the double support, where the
+            landing ankle is passive anyway. A position-servoed ankle (5000 N m / rad) met the
+            ground on the toe (0.6 deg off flat) and held the foot's angle: 900 N on the toe for
+            20 ms lifted the robot (CoM vertical velocity -0.02 -> +0.29 m/s), both feet left the
+            ground for 30-50 ms and the landing lost 10-20 % of the angular momentum about the new
+            foot (flat, 0.33 m steps: 0.22 m short of the goal before, 0.05 m after). See
+            :attr:`MPCAdjuster.hold_frozen` for what the two did together.
         closed_loop_ik: start the IK from the measured configuration every tick, so the torso
             orientation, the CoM height and the swing foot are fed back through the joint
             servos; a torque-driven stance ankle is held at its measured angles and its sole at
@@ -186,6 +194,7 @@ class WalkOptions:
     stop_on_fall: bool = True
     closed_loop_ik: bool = True
     landing_margin: float = 0.02
+    passive_landing: bool = True
 
     def __post_init__(self) -> None:
         for name in ("control_dt", "swing_clearance", "shift_time", "stop_time"):
@@ -489,6 +498,20 @@ class MPCAdjuster(PlanFollower):
         torque_limits: semi-axes ``(U_x, U_y)`` [N m] of the MPC's torque ellipse
             (:func:`footfall.control.mpc.build_mpc`); None = the plan's ``U_max`` ball
             (eq. 5.19e). :func:`walk` passes :func:`sole_torque_limits`.
+        hold_frozen: once the footstep is frozen, keep applying the torque of the solution it
+            was frozen with (the MPC's torque block is the plan's node interval, 0.1 s, so that
+            solution already holds one torque for the rest of the single support) instead of
+            re-solving. Re-solving with the footstep free returned torques for a footstep the
+            swing foot no longer went to (on discrete_steps N = 20 the stance ankle torque
+            jumped from -14.6 to +5.1 N m at the first frozen tick before a step down).
+            Re-solving with the footstep fixed there is consistent but, with 1-4 ticks left,
+            the torque barely moves the state and the solve spends the whole ellipse on it: a
+            CoP command of -0.064 m at the last tick (measured -0.019 m), which the double
+            support's rear-ankle ramp then held at the heel edge. Holding, together with
+            :attr:`WalkOptions.passive_landing`, reached 5 goals in the battery of cached-plan
+            walks (discrete_steps N = 13/16/18/20, flat_long, flat, turn; 2 before) and 24 of 24
+            seeded 20 N pushes on discrete_steps N = 18 (19 before); re-solving with the
+            footstep fixed reached 5 goals but 19 of 24.
         footstep_in_region: solve the MPC with the next footstep kept in its planned region
             (``region_margin`` inside, :meth:`footfall.control.mpc.MPC.solve_in_polygon`)
             instead of clamping the document's unconstrained footstep afterwards, so the ankle
@@ -501,7 +524,9 @@ class MPCAdjuster(PlanFollower):
     capture_stop: bool = False
     torque_limits: tuple[float, float] | None = None
     footstep_in_region: bool = True
+    hold_frozen: bool = True
     mpc: MPC = field(init=False, repr=False)
+    _frozen_torque: dict[int, FloatArray] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -530,6 +555,8 @@ class MPCAdjuster(PlanFollower):
             _rotate_xy(rot.T, ref_next),
             rot4.T @ x_next,
         )
+        if phase in self._frozen and self.hold_frozen:
+            return self._frozen[phase], self._frozen_torque[phase]
         if self.footstep_in_region and region is not None and phase not in self._frozen:
             a, b = region.halfspaces()
             sol = self.mpc.solve_in_polygon(*args, a @ rot, b - self.region_margin)
@@ -544,7 +571,10 @@ class MPCAdjuster(PlanFollower):
         else:
             target = _rotate_xy(rot, sol.next_footstep)
         target = self._legal(target, ref_next, stance, phase)
-        return self._maybe_freeze(t, phase, target), u
+        target = self._maybe_freeze(t, phase, target)
+        if phase in self._frozen:
+            self._frozen_torque[phase] = u
+        return target, u
 
 
 def _rot2(theta: float) -> FloatArray:
@@ -1230,6 +1260,7 @@ def walk(
     ctrl_prev = np.array(d.ctrl[sim.actuators], dtype=float)
     pos_prev = np.zeros(ctrl_prev.shape[0], dtype=bool)  # nothing to ramp from at the start
     ankle_u = np.zeros(2)
+    landed_in = -1  # the single support in which the swing sole touched down early
     wall0 = time.perf_counter()
     for k in range(n_ticks):
         t = float(ts[k])
@@ -1388,6 +1419,15 @@ def walk(
         ankle_cmd: dict[Side, FloatArray | None] = {sd: None for sd in sim.sides}
         if opts.ankle_torque and phase_log[k] >= 0:
             ankle_cmd[stance_side] = ankle_u
+            swing_side = stance_side.other
+            if opts.passive_landing and landed_in != i and tp >= descend * t_ss:
+                pos_w, rot_w = sim.sole(swing_side)
+                cop_w = sole_cop(*contacts[swing_side], pos_w, rot_w)
+                if cop_w is not None and cop_w[1] > CONTACT_FORCE_SHARE * sim.weight:
+                    landed_in = i
+            if landed_in == i:
+                # the swing sole touched down: a limp ankle lets it settle flat (see options)
+                ankle_cmd[swing_side] = np.zeros(2)
         elif opts.ankle_torque and t_walk0 <= t < t_end_steps:
             # double support: the legs form a closed chain whose joint servos place the CoM and
             # the total CoP moves between the feet, where the contact-point ramp of eq. (5.8)
