@@ -116,12 +116,12 @@ STRONG = 0
 #: Clarabel settings of the node solves. Iterative refinement and equilibration cost about 45 % of
 #: a node solve here (100 node problems of N = 10 and 15: 3.06 s -> 1.68 s, 1885 -> 1503
 #: iterations) and change no status and no bound by more than 1e-7
-#: Clarabel statuses that end a node solve (anything else is retried once, then "failed")
-_CLARABEL_DONE = ("Solved", "AlmostSolved", "PrimalInfeasible", "AlmostPrimalInfeasible")
 CLARABEL_SETTINGS: dict[str, Any] = {
     "iterative_refinement_enable": False,
     "equilibrate_enable": False,
 }
+#: Clarabel statuses that end a node solve (anything else is retried once, then "failed")
+_CLARABEL_DONE = ("Solved", "AlmostSolved", "PrimalInfeasible", "AlmostPrimalInfeasible")
 #: the retry of a node whose solve ended in another status: Clarabel's defaults (equilibration,
 #: iterative refinement) with more iterations
 CLARABEL_RETRY_SETTINGS: dict[str, Any] = {"max_iter": 200}
@@ -624,6 +624,15 @@ def _links(s: _Structure) -> list[_Link]:
         if len(pairs) <= (1.0 - LINK_MIN_DROP) * n_all:
             links.append(_Link((g1, g2), np.array(pairs, dtype=np.int64).reshape(-1, 2)))
     return links
+
+
+def _clarabel_settings(clarabel: Any, overrides: dict[str, Any]) -> Any:
+    """Clarabel's default settings, quiet, with ``overrides`` applied."""
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    for key, value in overrides.items():
+        setattr(settings, key, value)
+    return settings
 
 
 @dataclass
@@ -1329,16 +1338,8 @@ class HullRelaxation:
         self.lr_mem = _cat(lr_mem, np.int64)
         self.p_r = np.vstack([*p_r, np.zeros((0, 2), dtype=np.int64)])
         self.p_m = np.vstack([*p_m, np.zeros((0, 2), dtype=np.int64)])
-        settings = clarabel.DefaultSettings()
-        settings.verbose = False
-        for key, value in CLARABEL_SETTINGS.items():
-            setattr(settings, key, value)
-        self._settings = settings
-        robust = clarabel.DefaultSettings()
-        robust.verbose = False
-        for key, value in CLARABEL_RETRY_SETTINGS.items():
-            setattr(robust, key, value)
-        self._robust_settings = robust
+        self._settings = _clarabel_settings(clarabel, CLARABEL_SETTINGS)
+        self._robust_settings = _clarabel_settings(clarabel, CLARABEL_RETRY_SETTINGS)
         self._cones: dict[int, Any] = {}
         self.solves = 0
         self.solve_time = 0.0
