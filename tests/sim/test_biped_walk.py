@@ -246,6 +246,28 @@ def test_mpc_adjuster_keeps_the_footstep_in_its_region_and_the_cop_on_the_sole(s
     assert u[1] < u_free[1] - 0.1
 
 
+def test_mpc_adjuster_holds_footstep_and_torque_once_frozen(short_walk) -> None:  # type: ignore[no-untyped-def]
+    scene, plan, _ = short_walk
+    robot = plan.robot
+    regions = {r.name: r for r in scene.terrain.regions}
+    lim = sole_torque_limits(robot)
+    stance = np.array(plan.footsteps[1])
+    alip = robot.alip()
+    slow = alip.state_from_velocity(np.array([0.02, 0.0]), np.array([0.3, 0.05]))
+    fast = alip.state_from_velocity(np.array([0.04, 0.0]), np.array([0.7, -0.1]))
+    t_freeze = 0.9 * robot.t_ss
+    for hold in (True, False):
+        adj = MPCAdjuster(plan, regions, torque_limits=lim, hold_frozen=hold)
+        target0, u0 = adj.update(t_freeze, slow, stance, 1)
+        target1, u1 = adj.update(t_freeze + 0.02, fast, stance, 1)
+        np.testing.assert_array_equal(target1, target0)  # the footstep is frozen either way
+        if hold:
+            # the torque of the solution the footstep was frozen with, whatever the state
+            np.testing.assert_array_equal(u1, u0)
+        else:
+            assert np.abs(u1 - u0).max() > 0.1
+
+
 def in_sole_frame(u: np.ndarray, heading: float) -> np.ndarray:
     """World-frame ankle torque (2,) as (roll, pitch) about the axes of a sole at ``heading``."""
     c, s = np.cos(heading), np.sin(heading)
