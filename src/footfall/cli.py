@@ -263,6 +263,11 @@ def plan(
         help="Beyond the document: each step also in the reach set of the landing foot's frame "
         "(no trailing foot beside or across the new stance foot when headings differ).",
     ),
+    robot: str | None = typer.Option(
+        None,
+        help="Plan for a MuJoCo walker model: biped or g1 (mass, CoM height, stance width and "
+        "foot size measured on the model, the rest from the scene); omitted: the scene's robot.",
+    ),
     out: Path = typer.Option(Path("out/plan"), help="Output folder for plan.json and plan.png."),
 ) -> None:
     """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists."""
@@ -283,15 +288,21 @@ def plan(
         region_margin=region_margin,
         reach_both_frames=reach_both_frames,
     )
+    robot_params = None
+    if robot is not None:
+        from footfall.sim.biped_compare import robot_model
+        from footfall.sim.biped_model import planner_params
+
+        robot_params = planner_params(robot_model(robot), base=sc.robot)
     with console.status(f"planning {sc.name} with {planner} ...") as status:
 
         def progress(n: int, result: Any) -> None:
             status.update(f"planning {sc.name} with {planner}: N = {n} -> {result.status.value}")
 
         if planner != "reactive" and (min_steps or steps is None):
-            result = plan_min_steps(sc, planner, options, progress=progress)
+            result = plan_min_steps(sc, planner, options, progress=progress, robot=robot_params)
         else:
-            result = make_plan(sc, planner, steps, options)
+            result = make_plan(sc, planner, steps, options, robot_params)
     payload = plan_to_dict(result, sc.name)
     if result.has_solution:
         report = check_plan(result, sc)
@@ -751,6 +762,11 @@ def walk_cmd(
     seed: int = typer.Option(0, help="Seed of the push direction and timing."),
     out: Path = typer.Option(Path("out/walk"), help="Output folder."),
     video: bool = typer.Option(True, "--video/--no-video", help="Write walk.mp4 (offscreen GL)."),
+    robot: str = typer.Option(
+        "biped",
+        help="biped (ours) or g1 (Unitree G1 from example-robot-data: pip install "
+        "'footfall[robots]'); the plan is made for its measured mass, CoM height and feet.",
+    ),
 ) -> None:
     """Walk a footstep plan with the MuJoCo biped (document 000, section 5.5).
 
@@ -764,7 +780,7 @@ def walk_cmd(
         # headless offscreen rendering; MuJoCo picks its GL backend when it is first imported
         os.environ.setdefault("MUJOCO_GL", "egl")
     from footfall.planning.plan import check_planner_name
-    from footfall.sim.biped_compare import plan_for_walk, random_push
+    from footfall.sim.biped_compare import plan_for_walk, random_push, robot_model
     from footfall.sim.biped_plot import plot_walk
     from footfall.sim.biped_walk import WalkOptions, walk
 
@@ -772,9 +788,10 @@ def walk_cmd(
     if steps is not None and steps < 1:
         raise InputError("steps", steps, "an integer >= 1")
     push = non_negative("push", push)
+    model = robot_model(robot)
     sc = resolve_scene(scene_file, scene)
-    with console.status(f"planning {sc.name} with {planner} ..."):
-        plan = plan_for_walk(sc, planner, steps, time_limit, out)
+    with console.status(f"planning {sc.name} with {planner} for the {robot} ..."):
+        plan = plan_for_walk(sc, planner, steps, time_limit, out, model=model)
     if not plan.has_solution:
         console.print(f"{sc.name}: {planner} found no plan ({plan.status.value}). {plan.message}")
         raise typer.Exit(1)
@@ -782,10 +799,13 @@ def walk_cmd(
     pushes = (random_push(seed, push, plan, opts),) if push > 0 else ()
     opts = WalkOptions(pushes=pushes)
     with console.status(f"walking {plan.n_steps} steps in MuJoCo ..."):
-        res = walk(sc, plan, opts, video_path=out / "walk.mp4" if video else None)
+        res = walk(
+            sc, plan, opts, model_params=model, video_path=out / "walk.mp4" if video else None
+        )
     payload = {
         "scene": sc.name,
         "planner": planner,
+        "robot": robot,
         "plan": {
             "status": plan.status.value,
             "n_steps": plan.n_steps,
@@ -808,10 +828,10 @@ def walk_cmd(
         "video_note": res.video_note,
     }
     write_json(out / "walk.json", _json_clean(payload))
-    plot_walk(res, sc, out / "walk.png", title=f"{sc.name}, {planner}")
+    plot_walk(res, sc, out / "walk.png", title=f"{sc.name}, {planner}, {robot}")
     m = res.metrics
     console.print(
-        f"{sc.name} / {planner}: {plan.n_steps} steps, fell={m['fell']}, "
+        f"{sc.name} / {planner} / {robot}: {plan.n_steps} steps, fell={m['fell']}, "
         f"reached goal={m['reached_goal']}, footstep error mean "
         f"{m['footstep_error_m']['mean']:.3f} m, ZMP offset mean {m['zmp']['mean']:.3f} m "
         f"max {m['zmp']['max']:.3f} m"

@@ -19,15 +19,35 @@ import numpy as np
 from footfall._validate import non_negative
 from footfall.errors import InputError
 from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
-from footfall.sim.biped_model import BipedModel, planner_params
+from footfall.sim.biped_model import BipedModel, WalkerModel, planner_params
 from footfall.sim.biped_walk import Push, WalkOptions, WalkResult, walk
 from footfall.sim.plan_cache import cache_key, load_plan, save_plan
 from footfall.terrain.scene import Scene, builtin_scene
 
+#: robots the walker can walk (``footfall walk --robot``): our biped and the Unitree G1 of
+#: example-robot-data (``footfall[robots]``)
+ROBOTS = ("biped", "g1")
 #: pushes last this long [s]
 PUSH_DURATION = 0.1
 #: a push starts at a random single support between these shares of the walk
 PUSH_WINDOW = (0.3, 0.7)
+
+
+def robot_model(name: str) -> WalkerModel:
+    """The walker model called ``name`` (one of :data:`ROBOTS`), with its default settings.
+
+    Raises:
+        InputError: for an unknown name.
+        FootfallError: for ``g1`` without ``example-robot-data`` installed.
+    """
+    if name == "biped":
+        return BipedModel()
+    if name == "g1":
+        from footfall.sim.g1_model import G1Model, g1_urdf_path
+
+        g1_urdf_path()  # fail here, with the extra to install, rather than at the first use
+        return G1Model()
+    raise InputError("robot", name, f"one of {', '.join(ROBOTS)}")
 
 
 def plan_for_walk(
@@ -36,12 +56,14 @@ def plan_for_walk(
     n_steps: int | None = None,
     time_limit: float = 300.0,
     cache_dir: Path | None = None,
-    model: BipedModel | None = None,
+    model: WalkerModel | None = None,
 ) -> FootstepPlan:
-    """The plan of ``scene`` for the MuJoCo biped (robot parameters from :func:`planner_params`).
+    """The plan of ``scene`` for the MuJoCo biped or another walker model (robot parameters from
+    :func:`planner_params`).
 
-    With ``cache_dir`` the plan is stored as ``plan_<scene>_<planner>.json`` and reused while the
-    scene, planner, N and robot parameters are unchanged (MIQCQP plans take minutes).
+    With ``cache_dir`` the plan is stored as ``plan_<scene>_<planner>.json`` (another robot than
+    our biped: ``plan_<scene>_<planner>_<robot name>.json``) and reused while the scene, planner,
+    N and robot parameters are unchanged (MIQCQP plans take minutes).
     """
     from footfall.planning.run import make_plan
 
@@ -51,7 +73,10 @@ def plan_for_walk(
     # whole sole stands on the block (at the plan's headings, which stay near the scene's)
     margin = robot.foot_length / 2.0
     key = cache_key(scene.name, planner, n_steps, robot, margin)
-    path = cache_dir / f"plan_{scene.name}_{planner}.json" if cache_dir is not None else None
+    suffix = "" if model is None or model.name == "biped" else f"_{model.name}"
+    path = (
+        cache_dir / f"plan_{scene.name}_{planner}{suffix}.json" if cache_dir is not None else None
+    )
     if path is not None:
         cached = load_plan(path, robot, key, margin)
         if cached is not None:

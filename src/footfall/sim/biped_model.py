@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -54,6 +54,59 @@ class BipedSimSettings(SimSettings):
     kv: float = 100.0
     torque_limit: float = 300.0
     armature: float = 0.02
+
+
+class WalkerModel(Protocol):
+    """What the walker (:mod:`footfall.sim.biped_walk`) and :func:`planner_params` need of a robot.
+
+    :class:`BipedModel` (our biped) and :class:`footfall.sim.g1_model.G1Model` (the Unitree G1 of
+    ``example-robot-data``) implement it. The MJCF must name its elements as
+    :mod:`footfall.sim.biped_names` does (pelvis, torso, 12 leg joints and their position
+    actuators, sole sites, four corner contact geoms per foot, pelvis and torso geoms).
+    """
+
+    @property
+    def name(self) -> str:
+        """Short robot name (``footfall walk --robot``, plan cache file names)."""
+        ...
+
+    @property
+    def pelvis_height(self) -> float:
+        """Pelvis body origin above the soles in the nominal posture [m]."""
+        ...
+
+    @property
+    def foot_length(self) -> float:
+        """Sole contact rectangle length (x) [m]; corners at +-(length/2 - corner_radius)."""
+        ...
+
+    @property
+    def foot_width(self) -> float:
+        """Sole contact rectangle width (y) [m]."""
+        ...
+
+    @property
+    def corner_radius(self) -> float:
+        """Radius of the contact spheres at the sole corners [m]."""
+        ...
+
+    @property
+    def stance_width(self) -> float:
+        """Lateral distance between the sole centres in the nominal posture [m]."""
+        ...
+
+    @property
+    def ankle_offset(self) -> tuple[float, float]:
+        """Sole centre relative to the ankle axes, (x, y) in the foot frame [m] (ours: 0, 0)."""
+        ...
+
+    def nominal_joints(self) -> FloatArray:
+        """Joint angles (12,) [rad] of the nominal posture, left then right leg, LEG_JOINTS order."""
+        ...
+
+    def mjcf(self, terrain: tuple[str, str] = ("", ""), settings: Any = None) -> str:
+        """MJCF text of the robot on ``terrain`` (``(asset_xml, worldbody_xml)``)."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -189,6 +242,27 @@ class BipedModel:
     def pelvis_height(self) -> float:
         """Pelvis centre above the soles in the nominal posture [m]."""
         return self.nominal_hip_height + self.hip_drop
+
+    @property
+    def name(self) -> str:
+        """``"biped"``."""
+        return "biped"
+
+    @property
+    def stance_width(self) -> float:
+        """Lateral distance between the sole centres in the nominal posture: ``hip_width`` [m]."""
+        return self.hip_width
+
+    @property
+    def ankle_offset(self) -> tuple[float, float]:
+        """Sole centre relative to the ankle axes in the foot frame: straight below, (0, 0) [m]."""
+        return (0.0, 0.0)
+
+    def mjcf(
+        self, terrain: tuple[str, str] = ("", ""), settings: BipedSimSettings | None = None
+    ) -> str:
+        """:func:`biped_mjcf` of this model."""
+        return biped_mjcf(self, terrain, settings)
 
 
 def _joint_range(p: BipedModel, side: Side, index: int) -> tuple[float, float]:
@@ -355,19 +429,25 @@ class ModelInfo:
     com_offset: tuple[float, float]
 
 
-def measure_model(params: BipedModel | None = None) -> ModelInfo:
-    """Compile the model without terrain and measure its mass and nominal CoM height."""
+def measure_model(params: WalkerModel | None = None) -> ModelInfo:
+    """Compile the model without terrain and measure its mass and nominal CoM height.
+
+    The pelvis is placed upright at ``pelvis_height`` with the joints at ``nominal_joints()``;
+    the CoM is the pelvis subtree's (the whole robot), relative to the midpoint of the two sole
+    sites.
+    """
     mujoco = require_mujoco()
-    p = params if params is not None else BipedModel()
-    model = mujoco.MjModel.from_xml_string(biped_mjcf(p))
+    p: WalkerModel = params if params is not None else BipedModel()
+    model = mujoco.MjModel.from_xml_string(p.mjcf())
     data = mujoco.MjData(model)
     root = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, nm.ROOT_JOINT)]
     data.qpos[root : root + 3] = (0.0, 0.0, p.pelvis_height)
     data.qpos[root + 3 : root + 7] = (1.0, 0.0, 0.0, 0.0)
+    q = p.nominal_joints()
     for i, side in enumerate((Side.LEFT, Side.RIGHT)):
         for j, name in enumerate(nm.LEG_JOINTS):
             jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, nm.joint(side, name))
-            data.qpos[model.jnt_qposadr[jid]] = p.nominal_joints()[6 * i + j]
+            data.qpos[model.jnt_qposadr[jid]] = q[6 * i + j]
     mujoco.mj_forward(model, data)
     pelvis = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, nm.PELVIS_BODY)
     com = np.array(data.subtree_com[pelvis])
@@ -384,16 +464,16 @@ def measure_model(params: BipedModel | None = None) -> ModelInfo:
 
 
 def planner_params(
-    params: BipedModel | None = None, base: BipedParams | None = None
+    params: WalkerModel | None = None, base: BipedParams | None = None
 ) -> BipedParams:
-    """The planner's robot parameters derived from the MuJoCo model.
+    """The planner's robot parameters derived from the MuJoCo model (ours or e.g. the G1).
 
     Mass and CoM height are measured (:func:`measure_model`); stance width and foot size are the
     model's; the ankle-torque bound is ``U_MAX_FOOT_SHARE * m g * foot_width / 2`` (or the base's,
     if smaller) so that a planned ZMP always lies inside the sole. Everything else (timing, reach,
     heading limits) comes from ``base`` (default :class:`BipedParams`).
     """
-    p = params if params is not None else BipedModel()
+    p: WalkerModel = params if params is not None else BipedModel()
     b = base if base is not None else BipedParams()
     info = measure_model(p)
     u_foot = U_MAX_FOOT_SHARE * info.mass * b.g * p.foot_width / 2.0
@@ -401,7 +481,7 @@ def planner_params(
         b,
         mass=info.mass,
         com_height=info.com_height,
-        stance_width=p.hip_width,
+        stance_width=p.stance_width,
         foot_length=p.foot_length,
         foot_width=p.foot_width,
         u_max=min(b.u_max, u_foot),

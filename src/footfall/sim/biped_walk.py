@@ -49,7 +49,7 @@ from footfall.sim.biped_model import (
     U_MAX_FOOT_SHARE,
     BipedModel,
     BipedSimSettings,
-    biped_mjcf,
+    WalkerModel,
     require_mujoco,
 )
 from footfall.sim.terrain_mjcf import terrain_xml
@@ -786,19 +786,24 @@ class CoMHeight:
 
 # ============================================================================= the simulator
 class BipedSim:
-    """MuJoCo model + data of the biped on a scene's terrain, with handles resolved by name."""
+    """MuJoCo model + data of a biped on a scene's terrain, with handles resolved by name.
+
+    ``model_params`` is any :class:`~footfall.sim.biped_model.WalkerModel`: our biped
+    (:class:`BipedModel`, the default) or e.g. :class:`footfall.sim.g1_model.G1Model`; its MJCF
+    names its elements as :mod:`footfall.sim.biped_names` does. ``settings`` go to its ``mjcf``
+    (None: the model's defaults).
+    """
 
     def __init__(
         self,
         scene: Scene,
-        model_params: BipedModel | None = None,
+        model_params: WalkerModel | None = None,
         settings: BipedSimSettings | None = None,
     ) -> None:
         mujoco = require_mujoco()
         self.mujoco = mujoco
-        self.params = model_params if model_params is not None else BipedModel()
-        self.settings = settings if settings is not None else BipedSimSettings()
-        xml = biped_mjcf(self.params, terrain_xml(scene.terrain), self.settings)
+        self.params: WalkerModel = model_params if model_params is not None else BipedModel()
+        xml = self.params.mjcf(terrain_xml(scene.terrain), settings)
         self.model = mujoco.MjModel.from_xml_string(xml)
         self.data = mujoco.MjData(self.model)
         m = self.model
@@ -870,6 +875,12 @@ class BipedSim:
         q = self.params.nominal_joints()
         d.qpos[self.joint_qpos] = q
         d.ctrl[self.actuators] = q
+        self.mujoco.mj_kinematics(self.model, d)
+        # a model whose nominal soles are not straight below the pelvis (the G1's reach forward of
+        # its ankles) is moved so that their midpoint is the feet's; ours: no shift (<= 1e-9 m)
+        shift = mid - 0.5 * (self.sole(Side.LEFT)[0] + self.sole(Side.RIGHT)[0])
+        if float(np.max(np.abs(shift))) > 1e-9:
+            d.qpos[self.root_adr : self.root_adr + 3] += shift
         self.mujoco.mj_forward(self.model, d)
 
     def ankle_actuators(self, side: Side) -> NDArray[np.int_]:
@@ -1125,7 +1136,7 @@ def walk(
     plan: FootstepPlan,
     options: WalkOptions | None = None,
     adjuster: FootstepAdjuster | None = None,
-    model_params: BipedModel | None = None,
+    model_params: WalkerModel | None = None,
     settings: BipedSimSettings | None = None,
     video_path: Path | None = None,
     video_size: tuple[int, int] = (640, 480),
@@ -1138,8 +1149,11 @@ def walk(
         plan: a footstep plan with ALIP states and torques (any planner).
         options: controller options.
         adjuster: footstep / torque source; default :class:`PlanFollower`.
-        model_params: the biped's link parameters.
-        settings: physics settings.
+        model_params: the robot (default: our biped, :class:`BipedModel`); any
+            :class:`~footfall.sim.biped_model.WalkerModel`, e.g. the G1 of
+            :mod:`footfall.sim.g1_model`. The plan should be made for it
+            (:func:`~footfall.sim.biped_model.planner_params`).
+        settings: physics settings (None: the model's defaults).
         video_path: write an MP4 here (offscreen GL); None = no video.
         video_size: (width, height) [px].
         progress: optional callback receiving the fraction done.
@@ -1540,7 +1554,7 @@ def walk(
 
 
 def ankle_joint_torque(
-    u: FloatArray, sole_rot: FloatArray, weight: float, params: BipedModel
+    u: FloatArray, sole_rot: FloatArray, weight: float, params: WalkerModel
 ) -> FloatArray:
     """Ankle (pitch, roll) joint torques [N m] that make the ground exert the ALIP torque ``u``.
 
@@ -1549,13 +1563,19 @@ def ankle_joint_torque(
     the child (the foot) and ``-tau`` on the parent, hence joint torque = ``-u`` expressed in the
     foot's axes. Each component is clipped so that the CoP stays ``SOLE_TORQUE_SHARE`` inside
     the contact rectangle of the sole (a larger torque would only tip the foot).
+
+    When the sole centre is not straight below the ankle axes (``params.ankle_offset`` = (dx, dy)
+    in the foot frame, e.g. the G1's sole reaches further forward than back), the normal force
+    ``weight`` on the sole centre adds its moment about the ankle: ``(dx, dy, -h) x (0, 0, F_n)
+    = (dy F_n, -dx F_n)``, so the joints add ``(+dx F_n, -dy F_n)`` (pitch, roll). Ours: (0, 0).
     """
     local = sole_rot[:2, :2].T @ np.asarray(u, dtype=float)
     lim_x = SOLE_TORQUE_SHARE * weight * (params.foot_width / 2 - params.corner_radius)
     lim_y = SOLE_TORQUE_SHARE * weight * (params.foot_length / 2 - params.corner_radius)
     tau_x = float(np.clip(local[0], -lim_x, lim_x))
     tau_y = float(np.clip(local[1], -lim_y, lim_y))
-    return np.array([-tau_y, -tau_x])
+    dx, dy = params.ankle_offset
+    return np.array([-tau_y + dx * weight, -tau_x - dy * weight])
 
 
 def _blend_rot(r0: FloatArray, r1: FloatArray, s: float) -> FloatArray:
@@ -1571,7 +1591,7 @@ def _blend_rot(r0: FloatArray, r1: FloatArray, s: float) -> FloatArray:
 
 
 def summarise(
-    res: WalkResult, scene: Scene, plan: FootstepPlan, params: BipedModel, t_steps_end: float
+    res: WalkResult, scene: Scene, plan: FootstepPlan, params: WalkerModel, t_steps_end: float
 ) -> dict[str, Any]:
     """Summary metrics of a walk.
 
