@@ -195,3 +195,28 @@ def test_missing_example_robot_data_names_the_extra(monkeypatch: pytest.MonkeyPa
     finally:
         monkeypatch.undo()
         g1_model.g1_urdf_path.cache_clear()
+
+
+def test_cli_plans_for_the_g1_and_rejects_unknown_robots(tmp_path: object) -> None:
+    import json
+    from pathlib import Path
+
+    from typer.testing import CliRunner
+
+    from footfall.cli import app
+
+    out = Path(str(tmp_path))
+    runner = CliRunner()
+    res = runner.invoke(
+        app,
+        ["plan", "--scene", "flat", "--planner", "kinematic", "--robot", "g1", "--out", str(out)],
+    )
+    assert res.exit_code == 0, res.output
+    robot = json.loads((out / "plan.json").read_text())["robot"]
+    info = measure_model(G1Model())
+    assert robot["mass"] == pytest.approx(info.mass)
+    assert robot["com_height"] == pytest.approx(info.com_height)
+    # the runner bypasses main()'s error printing: the InputError itself comes back
+    bad = runner.invoke(app, ["walk", "--scene", "flat", "--robot", "atlas", "--out", str(out)])
+    assert isinstance(bad.exception, InputError)
+    assert bad.exception.field == "robot" and bad.exception.value == "atlas"

@@ -247,6 +247,8 @@ def g1_spec(params: G1Model | None = None) -> Any:
     spec.modelname = "footfall_g1"
     # keep the fixed links (torso_link) as bodies: the walker needs the torso's orientation
     spec.compiler.fusestatic = False
+    # the URDF importer discards geoms that collide with nothing: keep the visual capsules
+    spec.compiler.discardvisual = False
     spec.option.timestep = p.timestep
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
