@@ -50,6 +50,11 @@ STAND_TIME = 3.0
 STAND_SAG = 0.005
 STAND_DRIFT = 0.01
 STAND_TILT = math.radians(1.0)
+#: short flat walk: mean distance of the landed soles from the commanded footsteps [m] (as for
+#: our biped, test_biped_walk.LANDING_TOL)
+WALK_LANDING_TOL = 0.06
+#: footsteps of the short flat walk
+WALK_STEPS = 6
 
 
 def _urdf() -> ET.Element:
@@ -220,3 +225,28 @@ def test_cli_plans_for_the_g1_and_rejects_unknown_robots(tmp_path: object) -> No
     bad = runner.invoke(app, ["walk", "--scene", "flat", "--robot", "atlas", "--out", str(out)])
     assert isinstance(bad.exception, InputError)
     assert bad.exception.field == "robot" and bad.exception.value == "atlas"
+
+
+def test_g1_walks_a_short_flat_plan_made_for_it() -> None:
+    pytest.importorskip("mink")
+    from dataclasses import replace
+
+    from footfall.planning import PlannerOptions, make_plan
+    from footfall.sim.biped_walk import walk
+    from footfall.terrain import Goal
+
+    scene = builtin_scene("flat")
+    scene = replace(scene, goal=Goal(np.array([1.0, 0.0, 0.0]), 0.0))
+    g = G1Model()
+    robot = planner_params(g, base=scene.robot)
+    # 6 even steps of the kinematic planner with the whole sole inside the region, as
+    # plan_for_walk plans (the reactive planner's uneven 0.2-0.3 m steps make the G1 fall)
+    opts = PlannerOptions(region_margin=robot.foot_length / 2)
+    plan = make_plan(scene, "kinematic", WALK_STEPS, opts, robot)
+    res = walk(scene, plan, model_params=g)
+    m = res.metrics
+    assert not res.fell
+    assert m["reached_goal"]
+    assert m["steps_landed"] == plan.n_steps
+    assert m["footstep_error_vs_target_m"]["mean"] < WALK_LANDING_TOL
+    assert m["zmp"]["samples"] > 0 and m["zmp"]["inside_share"] == 1.0
