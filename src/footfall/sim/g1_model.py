@@ -23,7 +23,7 @@ G1's URDF, ``g1_29dof_rev_1_0.urdf``). :func:`g1_spec` builds a MuJoCo model fro
   the servo saturates), ``kv = kp * servo_damping_time``.
 
 Beyond the document: the nominal posture is solved numerically (:func:`g1_nominal_posture`): the
-pelvis upright at ``nominal_pelvis_height`` above flat soles straight under the hips, knees bent,
+pelvis upright at ``nominal_pelvis_height`` above flat soles ``stance_width`` apart, knees bent,
 the soles moved forward until the whole-body CoM lies above the sole centres.
 """
 
@@ -89,12 +89,6 @@ def g1_urdf_path() -> Path:
             f"{ERD_DISTRIBUTION} {dist.version} has no {G1_URDF}: {ROBOTS_EXTRA} (>= 6.0)"
         )
     return path
-
-
-def g1_urdf_mass(path: Path | None = None) -> float:
-    """Sum of the ``<inertial><mass>`` of every URDF link [kg] (read with xml.etree only)."""
-    root = ET.parse(path if path is not None else g1_urdf_path()).getroot()
-    return float(sum(float(m.get("value", "nan")) for m in root.findall("./link/inertial/mass")))
 
 
 def g1_urdf_efforts(path: Path | None = None) -> dict[str, float]:
