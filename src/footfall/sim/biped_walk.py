@@ -53,6 +53,7 @@ from footfall.sim.biped_model import (
     require_mujoco,
 )
 from footfall.sim.terrain_mjcf import terrain_xml
+from footfall.terrain.edges import inset_riser_edges
 from footfall.terrain.region import Region
 from footfall.terrain.scene import Scene
 
@@ -94,6 +95,10 @@ SOLE_TORQUE_SHARE = 0.9
 #: corrected footsteps stay this far inside the reach trapezoid [m]; the planners use its
 #: boundary (the first lateral step of the reactive plan lies on it), so no margin
 REACH_MARGIN = 0.0
+#: landing error [m] the walk leaves room for at riser edges (:mod:`footfall.terrain.edges`):
+#: landings fall 2-4 cm short of their targets, and on stairs_slope_gap a heel that landed on the
+#: edge of the tread above (step down from ``top``, footstep 0.10 m from the riser) tipped the foot
+RISER_LANDING_TOLERANCE = 0.04
 
 
 # ============================================================================= options
@@ -162,6 +167,13 @@ class WalkOptions:
             than the plan did (its ``region_margin``, half the sole length for
             :func:`footfall.sim.biped_compare.plan_for_walk`) [m]: landings fall ~2 cm short of
             their targets, and a heel over a block's edge on a step down tipped the landing foot.
+        riser_tolerance: the MPC keeps each footstep in its region with the riser edges moved
+            in by :func:`footfall.terrain.edges.inset_riser_edges` with this landing tolerance
+            [m] (on top of ``region_margin`` + ``landing_margin``), as
+            :func:`footfall.sim.biped_compare.plan_for_walk` plans; 0 = the regions as they are.
+            Without it the MPC moved the footstep below ``top``'s riser of stairs_slope_gap
+            (N = 15) from the plan's 0.147 m to 0.12 m from the riser, the heel landed on the
+            riser edge and the robot fell at 6.4 s (8 steps); with it, at 7.5 s (10 steps).
         passive_landing: the swing ankle goes limp (torque mode, zero torque) from the first
             contact of the swing sole during its descent until the double support, where the
             landing ankle is passive anyway. A position-servoed ankle (5000 N m / rad) met the
@@ -194,12 +206,19 @@ class WalkOptions:
     stop_on_fall: bool = True
     closed_loop_ik: bool = True
     landing_margin: float = 0.02
+    riser_tolerance: float = RISER_LANDING_TOLERANCE
     passive_landing: bool = True
 
     def __post_init__(self) -> None:
         for name in ("control_dt", "swing_clearance", "shift_time", "stop_time"):
             object.__setattr__(self, name, positive(name, getattr(self, name)))
-        for name in ("settle_time", "hold_time", "com_gain", "landing_margin"):
+        for name in (
+            "settle_time",
+            "hold_time",
+            "com_gain",
+            "landing_margin",
+            "riser_tolerance",
+        ):
             object.__setattr__(self, name, non_negative(name, getattr(self, name)))
         fb = non_negative("com_feedback", self.com_feedback)
         if fb > 1.0:
@@ -1170,12 +1189,13 @@ def walk(
         )
     dt = opts.control_dt
     regions = {r.name: r for r in scene.terrain.regions}
+    inner = inset_riser_edges(scene.terrain, opts.riser_tolerance) if opts.riser_tolerance else None
     src: FootstepAdjuster = (
         adjuster
         if adjuster is not None
         else MPCAdjuster(
             plan,
-            regions,
+            {r.name: r for r in inner.regions} if inner is not None else regions,
             region_margin=plan.region_margin + opts.landing_margin,
             control_dt=dt,
             stop_steps=opts.stop_steps,
