@@ -137,6 +137,9 @@ class WalkOptions:
             physics step.
         ik_iterations: differential-IK QP solves per control tick.
         swing_clearance: height of the swing sole above the highest region it passes over [m].
+        swing_side_gap: the swing sole passes the stance sole at least this far apart sideways
+            [m]: their centres at least the sole width plus this (:func:`swing_bow`; beyond the
+            document). 0 = straight swing paths.
         com_feedback: share in [0, 1] by which the ALIP reference is pulled toward the measured
             state every tick: 0 tracks the planned CoM motion stiffly (the ankle absorbs every
             error), 1 lets the CoM move as an ALIP from the measured state (errors are corrected
@@ -193,6 +196,7 @@ class WalkOptions:
     control_dt: float = 0.01
     ik_iterations: int = 2
     swing_clearance: float = 0.05
+    swing_side_gap: float = 0.03
     com_feedback: float = 0.0
     settle_time: float = 0.3
     shift_time: float = 2.0
@@ -217,6 +221,7 @@ class WalkOptions:
             "hold_time",
             "com_gain",
             "landing_margin",
+            "swing_side_gap",
             "riser_tolerance",
         ):
             object.__setattr__(self, name, non_negative(name, getattr(self, name)))
@@ -678,23 +683,77 @@ def swing_reference(
     apex: float,
     rise: float = 0.35,
     descend: float = 0.65,
+    stance: FloatArray | None = None,
+    side_clearance: float = 0.0,
 ) -> tuple[FloatArray, float]:
     """Swing sole position (3,) [m] at phase share ``tau`` and the horizontal progress in [0, 1].
 
     The sole rises to ``apex`` in the first ``rise`` share of the swing, moves horizontally during
     ``SWING_MOVE`` and descends from the ``descend`` share on, so it crosses every step edge at
     the apex height; every profile is a quintic smoothstep (zero velocity at lift-off and
-    touchdown).
+    touchdown). With the ``stance`` sole centre (3,) [m] the horizontal path bows sideways, away
+    from it, so that it passes the stance sole centre at least ``side_clearance`` [m] apart
+    (:func:`swing_bow`; beyond the document).
     """
     s_h = smoothstep((tau - SWING_MOVE[0]) / (SWING_MOVE[1] - SWING_MOVE[0]))
-    if tau < rise:
-        z = start[2] + (apex - start[2]) * smoothstep(tau / rise)
-    elif tau < descend:
-        z = apex
-    else:
-        z = apex + (target[2] - apex) * smoothstep((tau - descend) / (1.0 - descend))
+    if stance is not None and side_clearance > 0.0:
+        bow, s_pass = swing_bow(start, target, stance, side_clearance)
+        if s_h <= s_pass:
+            w = math.sin(0.5 * math.pi * s_h / s_pass) if s_pass > 0.0 else 1.0
+        else:
+            w = math.sin(0.5 * math.pi * (1.0 - s_h) / (1.0 - s_pass)) if s_pass < 1.0 else 1.0
+        xy = start[:2] + (target[:2] - start[:2]) * s_h + bow * w
+        z = _swing_height(tau, start, target, apex, rise, descend)
+        return np.array([xy[0], xy[1], z]), s_h
+    z = _swing_height(tau, start, target, apex, rise, descend)
     xy = start[:2] + (target[:2] - start[:2]) * s_h
     return np.array([xy[0], xy[1], z]), s_h
+
+
+def _swing_height(
+    tau: float, start: FloatArray, target: FloatArray, apex: float, rise: float, descend: float
+) -> float:
+    if tau < rise:
+        return float(start[2] + (apex - start[2]) * smoothstep(tau / rise))
+    if tau < descend:
+        return float(apex)
+    return float(apex + (target[2] - apex) * smoothstep((tau - descend) / (1.0 - descend)))
+
+
+def swing_bow(
+    start: FloatArray, target: FloatArray, stance: FloatArray, clearance: float
+) -> tuple[FloatArray, float]:
+    """Sideways bow of a swing path that passes the stance sole centre too closely.
+
+    The straight horizontal path ``start -> target`` passes ``stance`` (all (2,) or (3,) [m],
+    horizontal parts used) at the share ``s`` in [0, 1] of its length where ``stance`` projects
+    onto it, at the distance ``d``. When ``s`` is strictly inside the path and ``d <
+    clearance``, the path must move ``clearance - d`` further from ``stance`` there, along the
+    path's normal pointing away from it (the swing foot's side of the path when ``stance`` lies
+    on it, the left of the path).
+    :func:`swing_reference` adds ``bow * w(s_h)`` with ``w`` a quarter sine rising from 0 at the
+    start to 1 at ``s`` and falling back to 0 at the target, so lift-off and touchdown points are
+    unchanged.
+
+    Returns:
+        ``(bow (2,) [m], s)``: the bow at its peak (zero when none is needed) and where it peaks.
+    """
+    p0, p1, c = (np.asarray(v, dtype=float)[:2] for v in (start, target, stance))
+    e = p1 - p0
+    length = float(np.linalg.norm(e))
+    if length < 1e-9:
+        return np.zeros(2), 0.5
+    u = e / length
+    s = float((c - p0) @ u) / length
+    if not 0.0 < s < 1.0:
+        return np.zeros(2), min(max(s, 0.0), 1.0)
+    normal = np.array([-u[1], u[0]])  # left of the path
+    side = float((p0 - c) @ normal)
+    d = abs(side)
+    if d >= clearance:
+        return np.zeros(2), s
+    away = normal if side >= 0.0 else -normal
+    return away * (clearance - d), s
 
 
 def swing_shares(rise_height: float, fall_height: float, t_ss: float) -> tuple[float, float]:
@@ -1359,7 +1418,16 @@ def walk(
                 ankle_u = u
                 x_ref = ad_tick @ x_ref + bd_tick @ u
                 tau = min(1.0, (tp + dt) / t_ss)
-                pos, s_h = swing_reference(tau, swing_start, nxt, apex, rise, descend)
+                pos, s_h = swing_reference(
+                    tau,
+                    swing_start,
+                    nxt,
+                    apex,
+                    rise,
+                    descend,
+                    stance,
+                    robot.foot_width + opts.swing_side_gap if opts.swing_side_gap > 0 else 0.0,
+                )
                 rot1 = foot_rotation(normals[i + 1], plan.headings[i + 1])
                 rot = _blend_rot(swing_rot0, rot1, s_h)
                 targets_now = {stance_side: (stance, foot_rot[stance_side]), swing_side: (pos, rot)}
