@@ -144,9 +144,11 @@ class WalkOptions:
             lag) and stayed on its toe through double support: the CoP sat at the toe for the
             first 1-3 ticks of the next single support, costing 0.03-0.09 m/s of walking speed
             per step, and on stairs_slope_gap (N = 15, one footstep per tread) the robot stalled
-            on stair2 and fell. With 1.5-4 deg it walked to the goal; 2.5 deg is inside that range
-            and kept the battery of discrete_steps N = 16/18/20, flat_long and flat walks at the
-            goal (3 deg dropped discrete_steps N = 18). 0 = land flat.
+            on stair2 and fell. With 1.5-4 deg it walks to the goal (1 deg falls). The angle
+            trades against push recovery on discrete_steps N = 18 (seeded 20 N pushes: 0 deg
+            23/24, 1.5 deg 24/24, 2.5 deg 19/24; 30 N: 12/12 at 0 deg, 8/12 at 1.5 deg); 1.5 deg
+            kept the unpushed battery (discrete_steps N = 16/18/20, flat_long, flat) at the goal.
+            0 = land flat.
         swing_side_gap: the swing sole passes the stance sole at least this far apart sideways
             [m]: their centres at least the sole width plus this (:func:`swing_bow`; beyond the
             document). 0 = straight swing paths.
@@ -207,7 +209,7 @@ class WalkOptions:
     ik_iterations: int = 2
     swing_clearance: float = 0.05
     swing_side_gap: float = 0.03
-    heel_strike: float = math.radians(2.5)
+    heel_strike: float = math.radians(1.5)
     com_feedback: float = 0.0
     settle_time: float = 0.3
     shift_time: float = 2.0
