@@ -146,7 +146,7 @@ class WalkOptions:
             per step, and on stairs_slope_gap (N = 15, one footstep per tread) the robot stalled
             on stair2 and fell. With 1.5-4 deg it walks to the goal (1 deg falls). The angle
             trades against push recovery on discrete_steps N = 18 (seeded 20 N pushes: 0 deg
-            23/24, 1.5 deg 24/24, 2.5 deg 19/24; 30 N: 12/12 at 0 deg, 8/12 at 1.5 deg); 1.5 deg
+            23/24, 1.5 deg 24/24, 2.5 deg 19/24; 30 N: 8/12 at 1.5 deg, 12/12 before any); 1.5 deg
             kept the unpushed battery (discrete_steps N = 16/18/20, flat_long, flat) at the goal.
             0 = land flat.
         swing_side_gap: the swing sole passes the stance sole at least this far apart sideways
