@@ -141,3 +141,30 @@ def as_points(xy: ArrayLike) -> tuple[FloatArray, bool]:
     if pts.shape[-1] < 2:
         raise ValueError(f"expected points with at least 2 coordinates, got shape {arr.shape}")
     return pts[:, :2], single
+
+
+def clip_halfplane(poly: FloatArray, a: FloatArray, b: float, tol: float = 1e-12) -> FloatArray:
+    """Part of a convex CCW polygon (V, 2) with ``a . q <= b`` (Sutherland-Hodgman, one plane).
+
+    ``a`` (2,) need not be a unit vector; ``a = 0`` keeps everything when ``b >= 0`` and nothing
+    otherwise. Returns a convex CCW polygon (W, 2), possibly with fewer than 3 vertices (empty or
+    degenerate); consecutive vertices closer than ``tol`` [m] are merged.
+    """
+    p = np.asarray(poly, dtype=float)
+    s = p @ np.asarray(a, dtype=float) - float(b)
+    out: list[FloatArray] = []
+    n = p.shape[0]
+    for j in range(n):
+        k = (j + 1) % n
+        if s[j] <= 0.0:
+            out.append(p[j])
+        if (s[j] < 0.0 < s[k]) or (s[k] < 0.0 < s[j]):
+            t = s[j] / (s[j] - s[k])
+            out.append(p[j] + t * (p[k] - p[j]))
+    kept: list[FloatArray] = []
+    for q in out:
+        if not kept or float(np.linalg.norm(q - kept[-1])) > tol:
+            kept.append(q)
+    if len(kept) > 1 and float(np.linalg.norm(kept[0] - kept[-1])) <= tol:
+        kept.pop()
+    return np.array(kept, dtype=float).reshape(-1, 2)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -12,11 +14,19 @@ from footfall.planning import make_plan
 from footfall.planning.diagnose import geometric_infeasibility, reachable_regions
 from footfall.planning.plan import PlannerOptions
 from footfall.solvers import SolveStatus
-from footfall.terrain import builtin_scene
+from footfall.terrain import Region, Scene, Terrain, builtin_scene
 
 ROBOT = BipedParams()
 #: the largest step of the default reach trapezoid (its farthest vertex) [m]
 REACH = float(np.max(np.linalg.norm(ROBOT.reach.vertices, axis=1)))
+
+
+def wide_gap_scene() -> Scene:
+    """stairs_slope_gap as it was before the gap was narrowed: the landing starts at x = 3.44."""
+    scene = builtin_scene("stairs_slope_gap")
+    wide = Region.from_height("landing", 0.0, [[3.44, -0.5], [4.4, -0.5], [4.4, 0.5], [3.44, 0.5]])
+    regions = tuple(wide if r.name == "landing" else r for r in scene.terrain.regions)
+    return replace(scene, terrain=Terrain(regions))
 
 
 def test_point_polygon_distance() -> None:
@@ -35,10 +45,10 @@ def test_inset_polygon_is_the_polygon_moved_in() -> None:
     assert inset_polygon(square, 0.5) is None
 
 
-def test_the_gap_of_stairs_slope_gap_with_the_sole_margin() -> None:
+def test_a_gap_too_wide_for_the_sole_margin() -> None:
     # ledge ends at x = 3.2, landing starts at 3.44: 0.24 m apart, 0.44 m between footsteps kept
     # 0.1 m inside, more than the largest step (~0.41 m); 0.24 m alone is not
-    scene = builtin_scene("stairs_slope_gap")
+    scene = wide_gap_scene()
     assert 0.24 < REACH < 0.44
     adj0 = scene.terrain.adjacency(REACH)
     adj1 = scene.terrain.adjacency(REACH, margin=0.1)
@@ -50,6 +60,15 @@ def test_the_gap_of_stairs_slope_gap_with_the_sole_margin() -> None:
     assert why is not None and "landing" in why and "0.1 m inside" in why
     with pytest.raises(SceneError):
         scene.terrain.adjacency(REACH, margin=-0.1)
+
+
+def test_the_shipped_gap_fits_the_sole_margin() -> None:
+    # the shipped scene's landing starts at x = 3.32: 0.32 m between footsteps 0.1 m inside
+    scene = builtin_scene("stairs_slope_gap")
+    assert scene.terrain["landing"].vertices[:, 0].min() == pytest.approx(3.32)
+    assert "landing" in scene.terrain.adjacency(REACH, margin=0.1)["ledge"]
+    assert "landing" in reachable_regions(scene, ROBOT, 0.1)
+    assert geometric_infeasibility(scene, ROBOT, None, 0.1) is None
 
 
 def test_planners_answer_an_unreachable_goal_without_a_search(
@@ -64,7 +83,7 @@ def test_planners_answer_an_unreachable_goal_without_a_search(
     # a mixed-integer search would not prove this within minutes; geometry needs no solve
     monkeypatch.setattr(miqcqp, "solve", no_solve)
     monkeypatch.setattr(kinematic, "solve", no_solve)
-    scene = builtin_scene("stairs_slope_gap")
+    scene = wide_gap_scene()
     opts = PlannerOptions(region_margin=0.1)
     for planner in ("miqcqp", "kinematic"):
         plan = make_plan(scene, planner, 20, opts, ROBOT)

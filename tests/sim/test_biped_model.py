@@ -152,8 +152,8 @@ def test_terrain_surfaces_are_the_region_planes(name: str) -> None:
 def test_gaps_are_holes() -> None:
     scene = builtin_scene("stairs_slope_gap")
     m, d = _terrain_model(scene.terrain)
-    # the 0.24 m gap between the ledge (x <= 3.2) and the landing (x >= 3.44)
-    assert _ray_height(m, d, np.array([3.32, 0.0])) == -math.inf
+    # the 0.12 m gap between the ledge (x <= 3.2) and the landing (x >= 3.32)
+    assert _ray_height(m, d, np.array([3.26, 0.0])) == -math.inf
 
 
 def test_a_non_rectangular_region_becomes_a_prism() -> None:

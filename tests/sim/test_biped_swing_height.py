@@ -19,6 +19,7 @@ from footfall.sim.biped_walk import (
     SWING_SHARES,
     CoMHeight,
     smoothstep,
+    swing_bow,
     swing_reference,
     swing_shares,
     terrain_height_along,
@@ -86,6 +87,41 @@ def test_swing_shares_bound_the_vertical_acceleration() -> None:
     z = np.array([swing_reference(t, start, target, apex, rise, descend)[0][2] for t in tau])
     acc = np.diff(z, 2) / (tau[1] - tau[0]) ** 2 / t_ss**2
     assert np.max(np.abs(acc)) <= SWING_ACC_MAX * 1.01
+
+
+def test_swing_bows_out_around_the_stance_foot() -> None:
+    # stance sole at the origin; the swing foot passes 0.10 m beside it (the soles, 0.10 m wide,
+    # touch); with a 0.13 m clearance the path must pass 0.03 m further out, on its own side
+    stance = np.array([0.0, 0.0, 0.0])
+    start, target = np.array([-0.3, 0.1, 0.0]), np.array([0.3, 0.1, 0.0])
+    clearance = 0.13
+    bow, s_pass = swing_bow(start, target, stance, clearance)
+    np.testing.assert_allclose(bow, [0.0, 0.03], atol=1e-12)
+    assert s_pass == pytest.approx(0.5)
+    # the mirror case (a right swing foot) bows to -y
+    bow_r, _ = swing_bow(start * [1, -1, 1], target * [1, -1, 1], stance, clearance)
+    np.testing.assert_allclose(bow_r, [0.0, -0.03], atol=1e-12)
+    # a swing foot far enough away, or one that does not pass the stance foot, does not bow
+    side = np.array([0.0, 0.05, 0.0])
+    assert not np.any(swing_bow(start + side, target + side, stance, clearance)[0])
+    ahead = np.array([0.5, 0.0, 0.0])
+    assert not np.any(swing_bow(start, start + 0.4 * ahead, stance + ahead, clearance)[0])
+    # along the whole reference: the ends are unchanged, the path never comes closer than the
+    # straight one, and where it passes the stance foot (x = 0) it is the clearance away
+    apex, rise, descend = 0.05, 0.35, 0.65
+    tau = np.linspace(0.0, 1.0, 401)
+    path = np.array(
+        [swing_reference(t, start, target, apex, rise, descend, stance, clearance)[0] for t in tau]
+    )
+    straight = np.array([swing_reference(t, start, target, apex, rise, descend)[0] for t in tau])
+    np.testing.assert_allclose(path[[0, -1]], straight[[0, -1]], atol=1e-12)
+    np.testing.assert_allclose(path[:, [0, 2]], straight[:, [0, 2]], atol=1e-12)
+    assert np.all(path[:, 1] >= straight[:, 1] - 1e-12)
+    passing = int(np.argmin(np.abs(path[:, 0])))
+    assert abs(path[passing, 0]) < 0.01
+    assert path[passing, 1] == pytest.approx(clearance, abs=1e-3)
+    # the lateral path is smooth: no jump between samples larger than the straight path's steps
+    assert np.max(np.abs(np.diff(path[:, 1]))) < 0.01
 
 
 def _steps() -> np.ndarray:

@@ -385,3 +385,32 @@ def test_walk_plan_cache_round_trip_keeps_the_region_margin(tmp_path) -> None:  
     assert loaded.region_margin == made.region_margin
     np.testing.assert_array_equal(loaded.footsteps, made.footsteps)
     np.testing.assert_array_equal(loaded.states, made.states)
+
+
+def test_plan_for_walk_plans_on_the_riser_inset_regions(monkeypatch: pytest.MonkeyPatch) -> None:
+    # the planner sees stairs_slope_gap's treads below a riser moved in by the landing tolerance
+    # at that edge only, and keeps its uniform half-sole region margin (the planner is unchanged)
+    import footfall.planning.run as run
+    from footfall.sim.biped_compare import plan_for_walk
+    from footfall.sim.biped_walk import RISER_LANDING_TOLERANCE
+
+    seen = {}
+
+    def capture(scene, planner, n_steps, options, robot):  # type: ignore[no-untyped-def]
+        seen["scene"], seen["options"] = scene, options
+        raise RuntimeError("captured")
+
+    monkeypatch.setattr(run, "make_plan", capture)
+    scene = builtin_scene("stairs_slope_gap")
+    with pytest.raises(RuntimeError, match="captured"):
+        plan_for_walk(scene, "miqcqp", 15)
+    planned = seen["scene"].terrain
+    # stair1 (z 0.16) spans x 2.2-2.5 below top (z 0.24): its back edge moves in, its front
+    # edge (a step down to stair2) and its sides do not
+    v = planned["stair1"].vertices
+    assert v[:, 0].min() == pytest.approx(2.2 + RISER_LANDING_TOLERANCE)
+    assert v[:, 0].max() == pytest.approx(2.5)
+    assert (v[:, 1].min(), v[:, 1].max()) == pytest.approx((-0.5, 0.5))
+    assert planned["top"] is scene.terrain["top"]
+    assert planned["landing"] is scene.terrain["landing"]
+    assert seen["options"].region_margin == pytest.approx(planner_params().foot_length / 2)

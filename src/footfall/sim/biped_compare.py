@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -20,8 +21,9 @@ from footfall._validate import non_negative
 from footfall.errors import InputError
 from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
 from footfall.sim.biped_model import BipedModel, WalkerModel, planner_params
-from footfall.sim.biped_walk import Push, WalkOptions, WalkResult, walk
+from footfall.sim.biped_walk import RISER_LANDING_TOLERANCE, Push, WalkOptions, WalkResult, walk
 from footfall.sim.plan_cache import cache_key, load_plan, save_plan
+from footfall.terrain.edges import inset_riser_edges
 from footfall.terrain.scene import Scene, builtin_scene
 
 #: robots the walker can walk (``footfall walk --robot``): our biped and the Unitree G1 of
@@ -64,6 +66,11 @@ def plan_for_walk(
     With ``cache_dir`` the plan is stored as ``plan_<scene>_<planner>.json`` (another robot than
     our biped: ``plan_<scene>_<planner>_<robot name>.json``) and reused while the scene, planner,
     N and robot parameters are unchanged (MIQCQP plans take minutes).
+
+    Beyond the document: the plan is made on the scene's regions with their riser edges moved in
+    by ``RISER_LANDING_TOLERANCE`` (:func:`footfall.terrain.edges.inset_riser_edges`) and with a
+    ``region_margin`` of half the sole length: footsteps stay half a sole plus the tolerance from
+    the edge of a tread below a riser (a step down lands there) and half a sole from other edges.
     """
     from footfall.planning.run import make_plan
 
@@ -72,6 +79,7 @@ def plan_for_walk(
     # the sole is not a point: keep its centre half a foot length inside every region, so the
     # whole sole stands on the block (at the plan's headings, which stay near the scene's)
     margin = robot.foot_length / 2.0
+    scene = replace(scene, terrain=inset_riser_edges(scene.terrain, RISER_LANDING_TOLERANCE))
     key = cache_key(scene.name, planner, n_steps, robot, margin)
     suffix = "" if model is None or model.name == "biped" else f"_{model.name}"
     path = (

@@ -53,6 +53,7 @@ from footfall.sim.biped_model import (
     require_mujoco,
 )
 from footfall.sim.terrain_mjcf import terrain_xml
+from footfall.terrain.edges import inset_riser_edges
 from footfall.terrain.region import Region
 from footfall.terrain.scene import Scene
 
@@ -94,6 +95,10 @@ SOLE_TORQUE_SHARE = 0.9
 #: corrected footsteps stay this far inside the reach trapezoid [m]; the planners use its
 #: boundary (the first lateral step of the reactive plan lies on it), so no margin
 REACH_MARGIN = 0.0
+#: landing error [m] the walk leaves room for at riser edges (:mod:`footfall.terrain.edges`):
+#: landings fall 2-4 cm short of their targets, and on stairs_slope_gap a heel that landed on the
+#: edge of the tread above (step down from ``top``, footstep 0.10 m from the riser) tipped the foot
+RISER_LANDING_TOLERANCE = 0.04
 
 
 # ============================================================================= options
@@ -132,6 +137,21 @@ class WalkOptions:
             physics step.
         ik_iterations: differential-IK QP solves per control tick.
         swing_clearance: height of the swing sole above the highest region it passes over [m].
+        heel_strike: the swing sole turns toe-up by this angle [rad] about its lateral axis
+            (relative to lying flat on the landing region) as it moves, so it touches down heel
+            first and the limp ankle (``passive_landing``) lets it roll flat; beyond the document.
+            Landing flat, the sole met the ground toe-first (about 1 deg toe-down from the IK's
+            lag) and stayed on its toe through double support: the CoP sat at the toe for the
+            first 1-3 ticks of the next single support, costing 0.03-0.09 m/s of walking speed
+            per step, and on stairs_slope_gap (N = 15, one footstep per tread) the robot stalled
+            on stair2 and fell. With 1.5-4 deg it walks to the goal (1 deg falls). The angle
+            trades against push recovery on discrete_steps N = 18 (seeded 20 N pushes: 0 deg
+            23/24, 1.5 deg 24/24, 2.5 deg 19/24; 30 N: 8/12 at 1.5 deg, 12/12 before any); 1.5 deg
+            kept the unpushed battery (discrete_steps N = 16/18/20, flat_long, flat) at the goal.
+            0 = land flat.
+        swing_side_gap: the swing sole passes the stance sole at least this far apart sideways
+            [m]: their centres at least the sole width plus this (:func:`swing_bow`; beyond the
+            document). 0 = straight swing paths.
         com_feedback: share in [0, 1] by which the ALIP reference is pulled toward the measured
             state every tick: 0 tracks the planned CoM motion stiffly (the ankle absorbs every
             error), 1 lets the CoM move as an ALIP from the measured state (errors are corrected
@@ -162,6 +182,13 @@ class WalkOptions:
             than the plan did (its ``region_margin``, half the sole length for
             :func:`footfall.sim.biped_compare.plan_for_walk`) [m]: landings fall ~2 cm short of
             their targets, and a heel over a block's edge on a step down tipped the landing foot.
+        riser_tolerance: the MPC keeps each footstep in its region with the riser edges moved
+            in by :func:`footfall.terrain.edges.inset_riser_edges` with this landing tolerance
+            [m] (on top of ``region_margin`` + ``landing_margin``), as
+            :func:`footfall.sim.biped_compare.plan_for_walk` plans; 0 = the regions as they are.
+            Without it the MPC moved the footstep below ``top``'s riser of stairs_slope_gap
+            (N = 15) from the plan's 0.147 m to 0.12 m from the riser, the heel landed on the
+            riser edge and the robot fell at 6.4 s (8 steps); with it, at 7.5 s (10 steps).
         passive_landing: the swing ankle goes limp (torque mode, zero torque) from the first
             contact of the swing sole during its descent until the double support, where the
             landing ankle is passive anyway. A position-servoed ankle (5000 N m / rad) met the
@@ -181,6 +208,8 @@ class WalkOptions:
     control_dt: float = 0.01
     ik_iterations: int = 2
     swing_clearance: float = 0.05
+    swing_side_gap: float = 0.03
+    heel_strike: float = math.radians(1.5)
     com_feedback: float = 0.0
     settle_time: float = 0.3
     shift_time: float = 2.0
@@ -194,12 +223,21 @@ class WalkOptions:
     stop_on_fall: bool = True
     closed_loop_ik: bool = True
     landing_margin: float = 0.02
+    riser_tolerance: float = RISER_LANDING_TOLERANCE
     passive_landing: bool = True
 
     def __post_init__(self) -> None:
         for name in ("control_dt", "swing_clearance", "shift_time", "stop_time"):
             object.__setattr__(self, name, positive(name, getattr(self, name)))
-        for name in ("settle_time", "hold_time", "com_gain", "landing_margin"):
+        for name in (
+            "settle_time",
+            "hold_time",
+            "com_gain",
+            "landing_margin",
+            "swing_side_gap",
+            "heel_strike",
+            "riser_tolerance",
+        ):
             object.__setattr__(self, name, non_negative(name, getattr(self, name)))
         fb = non_negative("com_feedback", self.com_feedback)
         if fb > 1.0:
@@ -659,23 +697,77 @@ def swing_reference(
     apex: float,
     rise: float = 0.35,
     descend: float = 0.65,
+    stance: FloatArray | None = None,
+    side_clearance: float = 0.0,
 ) -> tuple[FloatArray, float]:
     """Swing sole position (3,) [m] at phase share ``tau`` and the horizontal progress in [0, 1].
 
     The sole rises to ``apex`` in the first ``rise`` share of the swing, moves horizontally during
     ``SWING_MOVE`` and descends from the ``descend`` share on, so it crosses every step edge at
     the apex height; every profile is a quintic smoothstep (zero velocity at lift-off and
-    touchdown).
+    touchdown). With the ``stance`` sole centre (3,) [m] the horizontal path bows sideways, away
+    from it, so that it passes the stance sole centre at least ``side_clearance`` [m] apart
+    (:func:`swing_bow`; beyond the document).
     """
     s_h = smoothstep((tau - SWING_MOVE[0]) / (SWING_MOVE[1] - SWING_MOVE[0]))
-    if tau < rise:
-        z = start[2] + (apex - start[2]) * smoothstep(tau / rise)
-    elif tau < descend:
-        z = apex
-    else:
-        z = apex + (target[2] - apex) * smoothstep((tau - descend) / (1.0 - descend))
+    if stance is not None and side_clearance > 0.0:
+        bow, s_pass = swing_bow(start, target, stance, side_clearance)
+        if s_h <= s_pass:
+            w = math.sin(0.5 * math.pi * s_h / s_pass) if s_pass > 0.0 else 1.0
+        else:
+            w = math.sin(0.5 * math.pi * (1.0 - s_h) / (1.0 - s_pass)) if s_pass < 1.0 else 1.0
+        xy = start[:2] + (target[:2] - start[:2]) * s_h + bow * w
+        z = _swing_height(tau, start, target, apex, rise, descend)
+        return np.array([xy[0], xy[1], z]), s_h
+    z = _swing_height(tau, start, target, apex, rise, descend)
     xy = start[:2] + (target[:2] - start[:2]) * s_h
     return np.array([xy[0], xy[1], z]), s_h
+
+
+def _swing_height(
+    tau: float, start: FloatArray, target: FloatArray, apex: float, rise: float, descend: float
+) -> float:
+    if tau < rise:
+        return float(start[2] + (apex - start[2]) * smoothstep(tau / rise))
+    if tau < descend:
+        return float(apex)
+    return float(apex + (target[2] - apex) * smoothstep((tau - descend) / (1.0 - descend)))
+
+
+def swing_bow(
+    start: FloatArray, target: FloatArray, stance: FloatArray, clearance: float
+) -> tuple[FloatArray, float]:
+    """Sideways bow of a swing path that passes the stance sole centre too closely.
+
+    The straight horizontal path ``start -> target`` passes ``stance`` (all (2,) or (3,) [m],
+    horizontal parts used) at the share ``s`` in [0, 1] of its length where ``stance`` projects
+    onto it, at the distance ``d``. When ``s`` is strictly inside the path and ``d <
+    clearance``, the path must move ``clearance - d`` further from ``stance`` there, along the
+    path's normal pointing away from it (the swing foot's side of the path when ``stance`` lies
+    on it, the left of the path).
+    :func:`swing_reference` adds ``bow * w(s_h)`` with ``w`` a quarter sine rising from 0 at the
+    start to 1 at ``s`` and falling back to 0 at the target, so lift-off and touchdown points are
+    unchanged.
+
+    Returns:
+        ``(bow (2,) [m], s)``: the bow at its peak (zero when none is needed) and where it peaks.
+    """
+    p0, p1, c = (np.asarray(v, dtype=float)[:2] for v in (start, target, stance))
+    e = p1 - p0
+    length = float(np.linalg.norm(e))
+    if length < 1e-9:
+        return np.zeros(2), 0.5
+    u = e / length
+    s = float((c - p0) @ u) / length
+    if not 0.0 < s < 1.0:
+        return np.zeros(2), min(max(s, 0.0), 1.0)
+    normal = np.array([-u[1], u[0]])  # left of the path
+    side = float((p0 - c) @ normal)
+    d = abs(side)
+    if d >= clearance:
+        return np.zeros(2), s
+    away = normal if side >= 0.0 else -normal
+    return away * (clearance - d), s
 
 
 def swing_shares(rise_height: float, fall_height: float, t_ss: float) -> tuple[float, float]:
@@ -1184,12 +1276,13 @@ def walk(
         )
     dt = opts.control_dt
     regions = {r.name: r for r in scene.terrain.regions}
+    inner = inset_riser_edges(scene.terrain, opts.riser_tolerance) if opts.riser_tolerance else None
     src: FootstepAdjuster = (
         adjuster
         if adjuster is not None
         else MPCAdjuster(
             plan,
-            regions,
+            {r.name: r for r in inner.regions} if inner is not None else regions,
             region_margin=plan.region_margin + opts.landing_margin,
             control_dt=dt,
             stop_steps=opts.stop_steps,
@@ -1353,9 +1446,18 @@ def walk(
                 ankle_u = u
                 x_ref = ad_tick @ x_ref + bd_tick @ u
                 tau = min(1.0, (tp + dt) / t_ss)
-                pos, s_h = swing_reference(tau, swing_start, nxt, apex, rise, descend)
+                pos, s_h = swing_reference(
+                    tau,
+                    swing_start,
+                    nxt,
+                    apex,
+                    rise,
+                    descend,
+                    stance,
+                    robot.foot_width + opts.swing_side_gap if opts.swing_side_gap > 0 else 0.0,
+                )
                 rot1 = foot_rotation(normals[i + 1], plan.headings[i + 1])
-                rot = _blend_rot(swing_rot0, rot1, s_h)
+                rot = _blend_rot(swing_rot0, rot1 @ _pitch_about_y(-opts.heel_strike), s_h)
                 targets_now = {stance_side: (stance, foot_rot[stance_side]), swing_side: (pos, rot)}
                 yaw = float(
                     plan.headings[i] + (plan.headings[i + 1] - plan.headings[i]) * 0.5 * s_h
@@ -1576,6 +1678,12 @@ def ankle_joint_torque(
     tau_y = float(np.clip(local[1], -lim_y, lim_y))
     dx, dy = params.ankle_offset
     return np.array([-tau_y + dx * weight, -tau_x - dy * weight])
+
+
+def _pitch_about_y(angle: float) -> FloatArray:
+    """Rotation (3, 3) by ``angle`` [rad] about the y axis (in a sole frame: toe down for > 0)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 def _blend_rot(r0: FloatArray, r1: FloatArray, s: float) -> FloatArray:

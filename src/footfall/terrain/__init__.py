@@ -3,6 +3,7 @@
 The scene file schema is in ``SCHEMA.md`` next to this file.
 """
 
+from footfall.terrain.edges import inset_riser_edges, riser_edge_insets
 from footfall.terrain.region import Region
 from footfall.terrain.scene import (
     Goal,
@@ -24,7 +25,9 @@ __all__ = [
     "Terrain",
     "builtin_scene",
     "builtin_scene_names",
+    "inset_riser_edges",
     "load_scene",
     "random_stepping_stones",
+    "riser_edge_insets",
     "scene_to_yaml",
 ]
