@@ -263,6 +263,11 @@ def plan(
         help="Beyond the document: each step also in the reach set of the landing foot's frame "
         "(no trailing foot beside or across the new stance foot when headings differ).",
     ),
+    swing_max: float | None = typer.Option(
+        None,
+        help="Beyond the document: bound each foot's horizontal swing (consecutive footholds of "
+        "the same foot) to this length [m]; omitted: no bound.",
+    ),
     out: Path = typer.Option(Path("out/plan"), help="Output folder for plan.json and plan.png."),
 ) -> None:
     """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists."""
@@ -282,6 +287,7 @@ def plan(
         threads=threads,
         region_margin=region_margin,
         reach_both_frames=reach_both_frames,
+        swing_max=swing_max,
     )
     with console.status(f"planning {sc.name} with {planner} ...") as status:
 
