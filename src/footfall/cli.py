@@ -763,6 +763,8 @@ def walk_cmd(
     Writes walk.json (fell or not, time to goal, footstep tracking error, single-support ZMP
     offset statistics per step), walk.png, walk.mp4 and the plan (cached as plan_<scene>_<planner>
     .json in --out and reused on the next run). Exit 1 when the robot falls or misses the goal.
+    The optimising planners plan for this robot beyond the document: each step in the reach set
+    of both feet's frames and every swing at most ``SWING_MAX`` (``plan_for_walk``).
     """
     import os
 
