@@ -268,6 +268,11 @@ def plan(
         help="Plan for a MuJoCo walker model: biped or g1 (mass, CoM height, stance width and "
         "foot size measured on the model, the rest from the scene); omitted: the scene's robot.",
     ),
+    swing_max: float | None = typer.Option(
+        None,
+        help="Beyond the document: bound each foot's horizontal swing (consecutive footholds of "
+        "the same foot) to this length [m]; omitted: no bound.",
+    ),
     out: Path = typer.Option(Path("out/plan"), help="Output folder for plan.json and plan.png."),
 ) -> None:
     """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists."""
@@ -287,6 +292,7 @@ def plan(
         threads=threads,
         region_margin=region_margin,
         reach_both_frames=reach_both_frames,
+        swing_max=swing_max,
     )
     robot_params = None
     if robot is not None:
@@ -773,6 +779,8 @@ def walk_cmd(
     Writes walk.json (fell or not, time to goal, footstep tracking error, single-support ZMP
     offset statistics per step), walk.png, walk.mp4 and the plan (cached as plan_<scene>_<planner>
     .json in --out and reused on the next run). Exit 1 when the robot falls or misses the goal.
+    The optimising planners plan for this robot beyond the document: each step in the reach set
+    of both feet's frames and every swing at most ``SWING_MAX`` (``plan_for_walk``).
     """
     import os
 

@@ -326,3 +326,66 @@ def test_reach_both_frames_holds_each_step_in_both_feet_frames() -> None:
         PlannerOptions(reach_both_frames="yes")  # type: ignore[arg-type]
     with pytest.raises(InputError, match="reach_both_frames"):
         make_plan(sc, "reactive", options=replace(OPTS, reach_both_frames=True))
+
+
+def _swings(plan, sc) -> np.ndarray:  # type: ignore[no-untyped-def]
+    """Horizontal swing of every footstep from the same foot's previous foothold [m]."""
+    start = sc.start.foot(plan.sides[1])[None, :2]
+    prev = np.vstack([start, plan.footsteps[:-2, :2]])
+    return np.linalg.norm(plan.footsteps[1:, :2] - prev, axis=1)
+
+
+def test_swing_max_bounds_every_swing_for_bnb_and_scip() -> None:
+    """The swing bound (beyond the document) is built once, so both backends find the same
+    optimum; the checker holds the plan to the true disc, and refuses a plan that breaks it."""
+    sc = scene(SHORT_FLAT)
+    free = plan_footsteps(sc, n_steps=4, options=OPTS)
+    assert free.status is SolveStatus.OPTIMAL and free.swing_max is None
+    longest = float(_swings(free, sc).max())
+    limit = round(0.9 * longest, 3)  # binds: the document's optimum swings further
+    opts = replace(OPTS, swing_max=limit)
+    bnb = plan_footsteps(sc, n_steps=4, options=opts)
+    direct = plan_footsteps(sc, n_steps=4, options=replace(opts, solver="scip"))
+    assert bnb.status is SolveStatus.OPTIMAL and direct.status is SolveStatus.OPTIMAL
+    assert bnb.swing_max == limit
+    assert direct.objective == pytest.approx(bnb.objective, rel=1e-4)
+    for plan in (bnb, direct):
+        assert _swings(plan, sc).max() <= limit + 1e-6
+        report = check_plan(plan, sc)
+        assert report.ok, report.summary()
+        assert "swing" in report.checked
+    # a restriction of the document's problem: never a better objective
+    assert bnb.objective >= free.objective - 1e-6
+    # the document's plan held to the bound: the checker names the long swing
+    report = check_plan(replace(free, swing_max=limit), sc)
+    bad = [v for v in report.violations if v.kind == "swing"]
+    assert bad and max(v.amount for v in bad) == pytest.approx(longest - limit, abs=1e-9)
+    # the kinematic planner builds the same rows
+    kin = plan_kinematic(sc, n_steps=4, options=opts)
+    assert kin.swing_max == limit and _swings(kin, sc).max() <= limit + 1e-6
+
+
+def test_swing_max_raises_the_step_lower_bound() -> None:
+    # 0.6 m to the goal: with 0.35 m swings each foot needs two, so the stance (right) foot,
+    # which swings at footsteps 2 and 4, needs N >= 4; N = 3 is refused before any search
+    from footfall.planning.diagnose import min_steps_lower_bound
+
+    sc = scene(SHORT_FLAT)
+    assert min_steps_lower_bound(sc, sc.robot) < 4
+    assert min_steps_lower_bound(sc, sc.robot, swing_max=0.35) == 4
+    plan = plan_footsteps(sc, n_steps=3, options=replace(OPTS, swing_max=0.35))
+    assert plan.status is SolveStatus.INFEASIBLE and "at least 4 footsteps" in plan.message
+
+
+@pytest.mark.parametrize("value", [-0.1, 0.0, math.nan, math.inf, "0.5", True])
+def test_swing_max_must_be_a_positive_length(value: object) -> None:
+    with pytest.raises(InputError) as err:
+        PlannerOptions(swing_max=value)  # type: ignore[arg-type]
+    assert err.value.field == "swing_max"
+
+
+def test_reactive_planner_refuses_the_swing_bound() -> None:
+    sc = scene(SHORT_FLAT)
+    with pytest.raises(InputError) as err:
+        make_plan(sc, "reactive", options=replace(OPTS, swing_max=0.5))
+    assert err.value.field == "swing_max"

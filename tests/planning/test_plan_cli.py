@@ -48,6 +48,17 @@ def test_smallest_n_search(tmp_path: Path) -> None:
     assert data["stats"]["tried"] == [{"n_steps": 2, "status": "infeasible"}]
 
 
+def test_swing_bound_is_planned_checked_and_recorded(tmp_path: Path) -> None:
+    # 0.6 m ahead with swings of at most 0.35 m: each foot swings twice, so N = 4 (3 without)
+    scene_file = tmp_path / "flat.yaml"
+    scene_file.write_text(SHORT_FLAT)
+    res = run("plan", str(scene_file), "--swing-max", "0.35", "--out", str(tmp_path))
+    assert res.returncode == 0, res.stderr
+    data = json.loads((tmp_path / "plan.json").read_text())
+    assert data["swing_max"] == 0.35 and data["check"]["ok"] is True
+    assert len(data["footsteps"]) - 1 == 4
+
+
 def test_reactive_on_builtin_scene(tmp_path: Path) -> None:
     res = run("plan", "--scene", "flat", "--planner", "reactive", "--out", str(tmp_path))
     assert res.returncode == 0, res.stderr
@@ -73,6 +84,8 @@ def test_infeasible_exits_1_with_diagnosis(tmp_path: Path) -> None:
         (["--scene", "flat", "--steps", "0"], "steps"),
         (["--scene", "flat", "--time-limit", "-3", "--steps", "4"], "time_limit"),
         (["--scene", "flat", "--solver", "cplex", "--steps", "4"], "scip, gurobi"),
+        (["--scene", "flat", "--swing-max", "-0.2", "--steps", "4"], "swing_max"),
+        (["--scene", "flat", "--swing-max", "nan", "--steps", "4"], "swing_max"),
         ([], "SCENE.yaml"),
     ],
 )

@@ -414,3 +414,27 @@ def test_plan_for_walk_plans_on_the_riser_inset_regions(monkeypatch: pytest.Monk
     assert planned["top"] is scene.terrain["top"]
     assert planned["landing"] is scene.terrain["landing"]
     assert seen["options"].region_margin == pytest.approx(planner_params().foot_length / 2)
+
+
+def test_walk_plans_are_robot_aware_and_cached_with_their_options(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    # the walk's plans use the options beyond the document (both reach frames, the measured
+    # swing bound); the cache gives a plan back with them, and never for other options
+    from footfall.planning import check_plan
+    from footfall.sim.biped_compare import plan_for_walk
+    from footfall.sim.biped_model import SWING_MAX
+
+    scene = builtin_scene("flat")
+    scene = replace(scene, goal=Goal(np.array([0.6, 0.0, 0.0]), 0.0))
+    made = plan_for_walk(scene, "kinematic", 4, 60.0, tmp_path)
+    assert made.reach_both_frames and made.swing_max == SWING_MAX
+    report = check_plan(made, scene)  # (a kinematic plan may need more torque than U_max)
+    assert {"reach", "swing"} <= set(report.checked) and not {"reach", "swing"} & report.kinds()
+    loaded = plan_for_walk(scene, "kinematic", 4, 60.0, tmp_path)
+    assert "loaded from cache" in loaded.message
+    assert loaded.reach_both_frames and loaded.swing_max == SWING_MAX
+    plain = plan_for_walk(scene, "kinematic", 4, 60.0, tmp_path, robot_aware=False)
+    assert "loaded from cache" not in plain.message
+    assert not plain.reach_both_frames and plain.swing_max is None
+    # the reactive planner cannot honour them and plans without
+    reactive = plan_for_walk(scene, "reactive", None, 60.0, None)
+    assert not reactive.reach_both_frames and reactive.swing_max is None

@@ -144,8 +144,9 @@ def check_plan(plan: FootstepPlan, scene: Scene, robot: BipedParams | None = Non
     """Check every constraint of the planning problem on ``plan``, independently of the planners.
 
     Checks: start pose and state, regions (inside polygon and on the plane), reachability with the
-    true sin/cos, step height, heading rate, torque bound, ALIP dynamics and resets (re-simulated),
-    and the goal (last two footsteps at the goal pose).
+    true sin/cos (in both feet's frames when the plan was made so), step height, the swing length
+    (when the plan was made with ``swing_max``), heading rate, torque bound, ALIP dynamics and
+    resets (re-simulated), and the goal (last two footsteps at the goal pose).
     """
     robot = robot or plan.robot
     out: list[Violation] = []
@@ -214,6 +215,17 @@ def check_plan(plan: FootstepPlan, scene: Scene, robot: BipedParams | None = Non
         dz = abs(feet[i + 1, 2] - feet[i, 2])
         if dz > robot.step_height_max + GEOM_TOL:
             out.append(Violation("step_height", i + 1, dz, f"step height {dz:.3f} m"))
+
+    if plan.swing_max is not None:
+        # beyond the document: each foot's horizontal swing from its previous foothold (the
+        # scene's start position for the first swing of each foot), against the true disc
+        checked.append("swing")
+        for i in range(1, n + 1):
+            prev = feet[i - 2, :2] if i >= 2 else start.foot(plan.sides[i])[:2]
+            length = float(np.hypot(*(feet[i, :2] - prev)))
+            if length > plan.swing_max + GEOM_TOL:
+                msg = f"swing of {length:.3f} m, longer than {plan.swing_max:g} m"
+                out.append(Violation("swing", i, length - plan.swing_max, msg))
 
     checked.append("heading_rate")
     rates = np.abs(np.diff(plan.headings))

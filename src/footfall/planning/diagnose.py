@@ -18,8 +18,13 @@ def _regions_at(scene: Scene, xy: np.ndarray, margin: float = 0.0) -> list[str]:
     return [r.name for r in scene.terrain if float(r.signed_distance(xy)) <= 1e-9 - margin]
 
 
-def min_steps_lower_bound(scene: Scene, robot: BipedParams) -> int:
-    """A lower bound on the number of footsteps any plan needs (distance and heading change)."""
+def min_steps_lower_bound(scene: Scene, robot: BipedParams, swing_max: float | None = None) -> int:
+    """A lower bound on the number of footsteps any plan needs (distance and heading change).
+
+    With ``swing_max`` (the planner option, L_swing [m]) also the swings: a foot that must move
+    a distance D to its goal spot needs ``ceil(D / L_swing)`` swings; the first swing foot
+    swings at footsteps 1, 3, ..., the stance foot at footsteps 2, 4, ....
+    """
     reach = robot.reach.radius
     start = scene.start
     theta_goal = wrap_near(scene.goal.heading, start.heading)
@@ -31,7 +36,14 @@ def min_steps_lower_bound(scene: Scene, robot: BipedParams) -> int:
     )
     by_distance = math.ceil(far / reach - 1e-9)
     by_heading = math.ceil(abs(theta_goal - start.heading) / robot.theta_max - 1e-9) + 1
-    return max(2, by_distance, by_heading)
+    by_swing = 0
+    if swing_max is not None:
+        for side in (Side.LEFT, Side.RIGHT):
+            travel = float(np.linalg.norm(feet[side][:2] - start.foot(side)[:2]))
+            swings = math.ceil(travel / swing_max - 1e-9)
+            # swing s of the first swing foot is footstep 2 s - 1, of the stance foot 2 s
+            by_swing = max(by_swing, 2 * swings - (1 if side is not start.stance else 0))
+    return max(2, by_distance, by_heading, by_swing)
 
 
 def reachable_regions(
@@ -83,14 +95,18 @@ def _goal_regions(
 
 
 def geometric_infeasibility(
-    scene: Scene, robot: BipedParams, n_steps: int | None = None, region_margin: float = 0.0
+    scene: Scene,
+    robot: BipedParams,
+    n_steps: int | None = None,
+    region_margin: float = 0.0,
+    swing_max: float | None = None,
 ) -> str | None:
     """Why no plan can exist, from geometry alone, or None if geometry does not rule it out.
 
     Checked before any solve: a goal foot outside every region, goal regions that no sequence of
     steps reaches (for any N), and, with ``n_steps``, too few steps for the distance, heading
-    change or region hops. A solver would need to prove these by search, which for the mixed-
-    integer planner can take longer than any time limit.
+    change (and swings, with ``swing_max`` [m]) or region hops. A solver would need to prove
+    these by search, which for the mixed-integer planner can take longer than any time limit.
     """
     reasons: list[str] = []
     goal_regions = _goal_regions(scene, robot, region_margin, reasons)
@@ -104,7 +120,7 @@ def geometric_infeasibility(
             f"{', '.join(sorted(seen)) or 'none'}"
         )
     if n_steps is not None:
-        bound = min_steps_lower_bound(scene, robot)
+        bound = min_steps_lower_bound(scene, robot, swing_max)
         hops = [seen[g] for g in goal_regions if g in seen]
         if hops:
             bound = max(bound, min(hops))
@@ -114,10 +130,14 @@ def geometric_infeasibility(
 
 
 def diagnose_infeasible(
-    scene: Scene, robot: BipedParams, n_steps: int, region_margin: float = 0.0
+    scene: Scene,
+    robot: BipedParams,
+    n_steps: int,
+    region_margin: float = 0.0,
+    swing_max: float | None = None,
 ) -> str:
     """Say what is known about why ``n_steps`` footsteps cannot reach the goal of ``scene``."""
-    found = geometric_infeasibility(scene, robot, n_steps, region_margin)
+    found = geometric_infeasibility(scene, robot, n_steps, region_margin, swing_max)
     if found is not None:
         return found
     return (

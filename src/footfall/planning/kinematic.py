@@ -34,7 +34,9 @@ def plan_kinematic(
     options = options or PlannerOptions()
     solver_opts = options.solver_options()
     kin = build_footstep_problem(scene, robot, n_steps, options, dynamics=False)
-    early = geometric_infeasibility(scene, kin.robot, n_steps, options.region_margin)
+    early = geometric_infeasibility(
+        scene, kin.robot, n_steps, options.region_margin, options.swing_max
+    )
     if early is not None:
         return FootstepPlan.empty(
             "kinematic", SolveStatus.INFEASIBLE, kin.robot, early, solver=options.solver
@@ -43,7 +45,7 @@ def plan_kinematic(
     meta = result_meta(res)
     if res.x is None:
         msg = (
-            diagnose_infeasible(scene, kin.robot, n_steps, options.region_margin)
+            diagnose_infeasible(scene, kin.robot, n_steps, options.region_margin, options.swing_max)
             if res.status is SolveStatus.INFEASIBLE
             else f"kinematic planner found no plan ({res.stats.get('raw_status')})"
         )

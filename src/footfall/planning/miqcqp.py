@@ -32,6 +32,17 @@ could overestimate reach.)
 
 Big-M constants are computed per row from tight variable bounds (terrain bounding box, heading
 range ``theta_0 +- i theta_max``).
+
+Beyond the document (:class:`PlannerOptions`, all off by default): ``region_margin`` (eq. 5.18 with
+the edges moved inward), ``reach_both_frames`` (eq. 5.12f also in the landing foot's frame) and
+``swing_max``, a bound L_swing on the horizontal swing ``||p_{i+1} - p_{i-1}||_2`` of each foot.
+The swing bound is a second-order cone on a difference of footsteps; it is imposed as the
+regular ``SWING_SIDES``-gon inscribed in that disc, ``n_j^T (p_{i+1} - p_{i-1}) <= L cos(pi / M)``
+with the M facet normals ``n_j``: linear rows that every backend (and ``bnb``'s plain-row path)
+takes as they are, conservative like the linear reach (a planned swing is never longer than
+L_swing, at most ``1 - cos(pi / M)`` shorter in the worst direction). A cone would need auxiliary
+difference variables, which ``bnb`` condenses away with the ALIP states (dropping the cone from
+its node relaxations).
 """
 
 from __future__ import annotations
@@ -59,6 +70,10 @@ from footfall.terrain.scene import Scene
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
+
+#: sides M of the regular polygon inscribed in the swing disc ``||d|| <= L_swing`` (option
+#: ``swing_max``): 16 facets lose at most 1 - cos(pi / 16) = 1.9 % of L_swing (about 1 cm)
+SWING_SIDES = 16
 
 
 @dataclass(frozen=True)
@@ -143,14 +158,22 @@ def build_footstep_problem(
     # Footsteps (3-D). Tight bounds, all implied by the constraints (so the optimum is unchanged):
     # inside the terrain box, within i steps of reach of footstep 0 and within N - i (N - 1 - i) of
     # the final footstep N (N - 1), whose positions the goal fixes; heights likewise.
+    # With ``swing_max`` a foot is also within L_swing per swing of its previous and next
+    # position of the same foot (its start position and its goal spot).
+    swing_from = start.foot(sides[1])[:2] if n >= 1 else p0[:2]
     p = b.add_vars("p", (n + 1, 3), lb=lo_box, ub=hi_box)
     for i in range(n + 1):
-        anchors = [(p0[:2], i), (feet[sides[n]], n - i)]
+        anchors = [(p0[:2], float(i) * reach), (feet[sides[n]], float(n - i) * reach)]
         if i <= n - 1:
-            anchors.append((feet[sides[n - 1]], n - 1 - i))
+            anchors.append((feet[sides[n - 1]], float(n - 1 - i) * reach))
+        if options.swing_max is not None and i >= 1:
+            home = p0[:2] if i % 2 == 0 else swing_from
+            goal_i = n if (n - i) % 2 == 0 else n - 1
+            anchors.append((home, math.ceil(i / 2) * options.swing_max))
+            anchors.append((feet[sides[goal_i]], (goal_i - i) // 2 * options.swing_max))
         for j in range(2):
-            lo = max(float(centre[j]) - k * reach for centre, k in anchors)
-            hi = min(float(centre[j]) + k * reach for centre, k in anchors)
+            lo = max(float(centre[j]) - r for centre, r in anchors)
+            hi = min(float(centre[j]) + r for centre, r in anchors)
             b.set_bounds(int(p[i, j]), lo, hi)
         b.set_bounds(
             int(p[i, 2]), p0[2] - i * robot.step_height_max, p0[2] + i * robot.step_height_max
@@ -286,6 +309,23 @@ def build_footstep_problem(
                         label = f"5.12f reach {i} frame {k} segment {ell} row {j}"
                         b.add_le_big_m(row, h_eff, z, label)
 
+    # Swing bound (beyond the document, option ``swing_max``): footstep i within L_swing of the
+    # same foot's previous position, through the rows of the inscribed SWING_SIDES-gon.
+    if options.swing_max is not None:
+        m_sides = SWING_SIDES
+        rhs = options.swing_max * math.cos(math.pi / m_sides)
+        for i in range(1, n + 1):
+            for j in range(m_sides):
+                phi = 2.0 * math.pi * j / m_sides
+                nx, ny = math.cos(phi), math.sin(phi)
+                row = {int(p[i, 0]): nx, int(p[i, 1]): ny}
+                if i >= 2:
+                    row[int(p[i - 2, 0])] = -nx
+                    row[int(p[i - 2, 1])] = -ny
+                    b.add_le(row, rhs, f"swing {i} row {j}")
+                else:  # the first swing starts at the scene's start position of that foot
+                    b.add_le(row, rhs + nx * swing_from[0] + ny * swing_from[1], f"swing 1 row {j}")
+
     # (5.12i-k) region assignment for footsteps 1..N. A region whose bounding box misses the
     # footstep's bounds can never hold it, so it gets no binary (H fixed to 0).
     regions = np.full((n + 1, len(terrain)), -1, dtype=np.int64)
@@ -399,6 +439,7 @@ def extract_plan(fp: FootstepProblem, x: FloatArray, **meta: Any) -> FootstepPla
         sin_cos=np.stack([x[fp.s], x[fp.c]], axis=1),
         region_margin=fp.options.region_margin,
         reach_both_frames=fp.options.reach_both_frames,
+        swing_max=fp.options.swing_max,
         **meta,
     )
 
@@ -433,7 +474,9 @@ def plan_footsteps(
 
     options = options or PlannerOptions()
     fp = build_footstep_problem(scene, robot, n_steps, options)
-    early = geometric_infeasibility(scene, fp.robot, n_steps, options.region_margin)
+    early = geometric_infeasibility(
+        scene, fp.robot, n_steps, options.region_margin, options.swing_max
+    )
     if early is not None:
         # proven by geometry: no search (a branch and bound can take longer than any limit)
         return FootstepPlan.empty(
@@ -445,14 +488,16 @@ def plan_footsteps(
             "miqcqp",
             SolveStatus.INFEASIBLE,
             fp.robot,
-            diagnose_infeasible(scene, fp.robot, n_steps, options.region_margin),
+            diagnose_infeasible(scene, fp.robot, n_steps, options.region_margin, options.swing_max),
             solver=options.solver,
         )
     result = solve(fp.problem, options.solver, options.solver_options())
     meta = result_meta(result)
     if result.x is None:
         if result.status is SolveStatus.INFEASIBLE:
-            message = diagnose_infeasible(scene, fp.robot, n_steps, options.region_margin)
+            message = diagnose_infeasible(
+                scene, fp.robot, n_steps, options.region_margin, options.swing_max
+            )
         elif result.status is SolveStatus.TIME_LIMIT:
             message = f"no feasible plan found within the time limit of {options.time_limit:g} s"
         else:

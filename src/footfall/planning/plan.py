@@ -82,6 +82,14 @@ class PlannerOptions:
             foot's. False is the document's problem. With headings that differ between the
             feet, eq. (5.12f) alone lets the trailing foot end up beside or across the new
             stance foot in that foot's frame, and the next swing then passes through it.
+        swing_max: beyond the document: bound L_swing [m] on every swing, the horizontal
+            distance between consecutive footholds of the same foot,
+            ``||p_{i+1} - p_{i-1}||_2 <= L_swing`` (i = 1..N; ``p_{-1}`` is the start position of
+            the first swing foot). None (the default) is the document's problem. Eq. (5.12f)
+            bounds each step from the other foot, so a swing may be almost twice the forward
+            reach; a legged robot's swing, which must move the foot that far in T_ss + T_ds
+            while the stance leg carries the body, may not allow that. Imposed as the inscribed
+            regular ``SWING_SIDES``-gon (linear rows, never longer than L_swing).
     """
 
     weights: PlannerWeights = field(default_factory=PlannerWeights)
@@ -94,6 +102,7 @@ class PlannerOptions:
     momentum_bound: float = 3.0
     region_margin: float = 0.0
     reach_both_frames: bool = False
+    swing_max: float | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.heading_segments, int) or self.heading_segments < 4:
@@ -108,6 +117,8 @@ class PlannerOptions:
         object.__setattr__(self, "region_margin", non_negative("region_margin", self.region_margin))
         if not isinstance(self.reach_both_frames, bool):
             raise InputError("reach_both_frames", self.reach_both_frames, "True or False")
+        if self.swing_max is not None:
+            object.__setattr__(self, "swing_max", positive("swing_max", self.swing_max))
 
     def solver_options(self) -> SolverOptions:
         """The backend options these planner options imply."""
@@ -158,6 +169,8 @@ class FootstepPlan:
         message: human-readable explanation (diagnosis when infeasible).
         sin_cos: the piecewise-linear (sin, cos) of each heading, shape (N + 1, 2), when the
             planner models them (eq. 5.12g-h); empty otherwise.
+        region_margin, reach_both_frames, swing_max: the :class:`PlannerOptions` the plan was
+            made with (the checker holds the plan to them).
     """
 
     planner: str
@@ -180,6 +193,7 @@ class FootstepPlan:
     sin_cos: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
     region_margin: float = 0.0
     reach_both_frames: bool = False
+    swing_max: float | None = None
 
     @property
     def n_steps(self) -> int:

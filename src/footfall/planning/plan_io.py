@@ -17,7 +17,8 @@ def plan_to_dict(plan: FootstepPlan, scene_name: str = "") -> dict[str, Any]:
     """Plain-JSON dict of a plan, SI units (m, rad, s, N m, kg m^2/s).
 
     Keys: ``status``, ``planner``, ``scene``, ``message``, ``objective``, ``bound``, ``gap``,
-    ``solve_time_s``, ``solver``, ``region_margin`` [m], ``reach_both_frames``, ``stats``, ``footsteps`` (``index``, ``side``, ``position``,
+    ``solve_time_s``, ``solver``, ``region_margin`` [m], ``reach_both_frames``, ``swing_max`` [m]
+    (null: no swing bound), ``stats``, ``footsteps`` (``index``, ``side``, ``position``,
     ``heading``, ``region``; index 0 is the initial stance foot) and ``alip`` (``states`` per step:
     K states of 4; ``torques`` per step: K - 1 torques of 2; ``final_state``; the state layout).
     """
@@ -34,6 +35,7 @@ def plan_to_dict(plan: FootstepPlan, scene_name: str = "") -> dict[str, Any]:
         "solver": plan.solver,
         "region_margin": plan.region_margin,
         "reach_both_frames": plan.reach_both_frames,
+        "swing_max": plan.swing_max,
         "stats": stats,
         "robot": {
             "mass": plan.robot.mass,

@@ -42,6 +42,12 @@ def make_plan(
             raise InputError(
                 "reach_both_frames", True, "False for the reactive planner (miqcqp or kinematic)"
             )
+        if options.swing_max is not None:
+            raise InputError(
+                "swing_max",
+                options.swing_max,
+                "None for the reactive planner (miqcqp or kinematic)",
+            )
 
         return plan_reactive(
             scene, robot, max_steps=n_steps or 40, region_margin=options.region_margin
@@ -73,7 +79,8 @@ def plan_min_steps(
     if planner == "reactive":
         raise InputError("planner", planner, "miqcqp or kinematic (reactive has no N to search)")
     robot = robot or scene.robot
-    start = min_steps_lower_bound(scene, robot)
+    options = options or PlannerOptions()
+    start = min_steps_lower_bound(scene, robot, options.swing_max)
     n_max = n_max if n_max is not None else start + MIN_STEPS_SPAN
     if n_max < start:
         raise InputError("n_max", n_max, f"at least the lower bound {start}")

@@ -20,7 +20,7 @@ import numpy as np
 from footfall._validate import non_negative
 from footfall.errors import InputError
 from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
-from footfall.sim.biped_model import BipedModel, WalkerModel, planner_params
+from footfall.sim.biped_model import SWING_MAX, BipedModel, WalkerModel, planner_params
 from footfall.sim.biped_walk import RISER_LANDING_TOLERANCE, Push, WalkOptions, WalkResult, walk
 from footfall.sim.plan_cache import cache_key, load_plan, save_plan
 from footfall.terrain.edges import inset_riser_edges
@@ -59,13 +59,20 @@ def plan_for_walk(
     time_limit: float = 300.0,
     cache_dir: Path | None = None,
     model: WalkerModel | None = None,
+    robot_aware: bool = True,
 ) -> FootstepPlan:
     """The plan of ``scene`` for the MuJoCo biped or another walker model (robot parameters from
     :func:`planner_params`).
 
+    With ``robot_aware`` (the default) the optimising planners (miqcqp, kinematic) also get the
+    options beyond the document that this robot needs (:func:`walk_planner_options`): the reach
+    set in both feet's frames and the swing bound ``SWING_MAX`` (measured on our biped, used for
+    every walker model). The reactive planner cannot honour them and plans without.
+    ``robot_aware=False`` plans the document's problem (with the region margin only).
+
     With ``cache_dir`` the plan is stored as ``plan_<scene>_<planner>.json`` (another robot than
     our biped: ``plan_<scene>_<planner>_<robot name>.json``) and reused while the scene, planner,
-    N and robot parameters are unchanged (MIQCQP plans take minutes).
+    N, robot parameters and planner options are unchanged (MIQCQP plans take minutes).
 
     Beyond the document: the plan is made on the scene's regions with their riser edges moved in
     by ``RISER_LANDING_TOLERANCE`` (:func:`footfall.terrain.edges.inset_riser_edges`) and with a
@@ -80,7 +87,11 @@ def plan_for_walk(
     # whole sole stands on the block (at the plan's headings, which stay near the scene's)
     margin = robot.foot_length / 2.0
     scene = replace(scene, terrain=inset_riser_edges(scene.terrain, RISER_LANDING_TOLERANCE))
-    key = cache_key(scene.name, planner, n_steps, robot, margin)
+    aware = walk_planner_options(planner) if robot_aware else {}
+    opts = PlannerOptions(time_limit=time_limit, region_margin=margin, **aware)
+    key = cache_key(
+        scene.name, planner, n_steps, robot, margin, opts.reach_both_frames, opts.swing_max
+    )
     suffix = "" if model is None or model.name == "biped" else f"_{model.name}"
     path = (
         cache_dir / f"plan_{scene.name}_{planner}{suffix}.json" if cache_dir is not None else None
@@ -89,11 +100,25 @@ def plan_for_walk(
         cached = load_plan(path, robot, key, margin)
         if cached is not None:
             return cached
-    opts = PlannerOptions(time_limit=time_limit, region_margin=margin)
     plan = make_plan(scene, planner, n_steps, opts, robot)
     if path is not None and plan.has_solution:
         save_plan(path, plan, scene.name, key)
     return plan
+
+
+def walk_planner_options(planner: str) -> dict[str, Any]:
+    """The :class:`PlannerOptions` beyond the document that the MuJoCo biped's walks use.
+
+    ``reach_both_frames``: with eq. (5.12f) alone the minimum-N plans stretch their reach by
+    zig-zagging the headings (turn: 0, 22.5, 0, 30, 60, 90 deg; discrete_steps N = 13: up to
+    22.5 deg on block2) and the legs cross or the swing gets long. ``swing_max``: the swing bound
+    ``SWING_MAX`` measured for this robot (see there). The reactive planner gets neither (it
+    refuses both).
+    """
+    check_planner_name(planner)
+    if planner == "reactive":
+        return {}
+    return {"reach_both_frames": True, "swing_max": SWING_MAX}
 
 
 def random_push(seed: int, magnitude: float, plan: FootstepPlan, options: WalkOptions) -> Push:

@@ -35,6 +35,17 @@ FloatArray = NDArray[np.float64]
 #: share of the half foot width the planner's ankle-torque bound may use: U_max = share * m g * w/2
 #: keeps the planned ZMP (eq. 5.12d) inside the sole in every direction, with a margin
 U_MAX_FOOT_SHARE = 0.8
+#: the planner's swing bound L_swing for this biped [m] (``PlannerOptions.swing_max``, beyond the
+#: document; :func:`footfall.sim.biped_compare.plan_for_walk` uses it): the longest swing this
+#: biped has walked. Measured (walker of 6f8c4b6, plans with ``reach_both_frames``): the swings
+#: of walks that reached the goal were at most 0.684 m (flat, N = 8) and 0.611 m (discrete_steps
+#: N = 16); the N = 13 plan of the one-frame reach swings 0.60-0.71 m and falls. 0.70 m keeps
+#: 0.684 m inside the inscribed 16-gon. Tighter bounds did not walk better on discrete_steps
+#: (goal reached without a push and with 6 seeds of 10 and 20 N each: 0.55-0.60 m: N = 16,
+#: 1 of 13, 10 falls; 0.50 m: N = 17, 12 of 13; 0.45 m: N = 18, 13 of 13; 0.70 m: N = 16,
+#: 13 of 13) and 0.50 m made the turn fall, so the bound is the measured range, not a tuning
+#: knob.
+SWING_MAX = 0.70
 
 
 def require_mujoco() -> Any:

@@ -1,7 +1,8 @@
 """Footstep plans cached as JSON next to a walk's outputs, so a slow MIQCQP plan is solved once.
 
 The file is the ``plan.json`` format of ``footfall plan`` (:func:`plan_to_dict`) plus a ``cache_key``
-naming the scene, planner, step count and the robot parameters; :func:`load_plan` rebuilds the
+naming the scene, planner, step count, robot parameters and the planner options beyond the
+document; :func:`load_plan` rebuilds the
 :class:`FootstepPlan` for the given robot and refuses a file whose key differs.
 """
 
@@ -23,14 +24,23 @@ from footfall.solvers.base import SolveStatus
 
 
 def cache_key(
-    scene: str, planner: str, n_steps: int | None, robot: BipedParams, margin: float = 0.0
+    scene: str,
+    planner: str,
+    n_steps: int | None,
+    robot: BipedParams,
+    margin: float = 0.0,
+    both_frames: bool = False,
+    swing_max: float | None = None,
 ) -> str:
-    """A string that changes whenever anything the plan depends on changes."""
+    """A string that changes whenever anything the plan depends on changes (``both_frames`` and
+    ``swing_max`` are the planner options ``reach_both_frames`` and ``swing_max`` [m])."""
     r = robot
+    swing = "none" if swing_max is None else f"{swing_max:.6g}"
     return (
         f"{scene}|{planner}|N={n_steps}|margin={margin:.6g}|m={r.mass:.6g}|zH={r.com_height:.6g}|tss={r.t_ss:.6g}|"
         f"tds={r.t_ds:.6g}|K={r.n_nodes}|umax={r.u_max:.6g}|w={r.stance_width:.6g}|"
-        f"reach={np.round(r.reach.vertices, 6).tolist()}"
+        f"reach={np.round(r.reach.vertices, 6).tolist()}|both_frames={bool(both_frames)}|"
+        f"swing={swing}"
     )
 
 
@@ -90,4 +100,5 @@ def load_plan(
         message=d.get("message", "") + " (loaded from cache)",
         region_margin=region_margin,
         reach_both_frames=bool(d.get("reach_both_frames", False)),
+        swing_max=None if d.get("swing_max") is None else float(d["swing_max"]),
     )
