@@ -773,6 +773,12 @@ def walk_cmd(
         help="biped (ours) or g1 (Unitree G1 from example-robot-data: pip install "
         "'footfall[robots]'); the plan is made for its measured mass, CoM height and feet.",
     ),
+    robot_aware: bool = typer.Option(
+        True,
+        "--robot-aware/--document-reach",
+        help="Plan miqcqp/kinematic with the options beyond the document (reach in both feet's "
+        "frames, swing bound); --document-reach: eq. (5.12f) in the stance foot's frame only.",
+    ),
 ) -> None:
     """Walk a footstep plan with the MuJoCo biped (document 000, section 5.5).
 
@@ -780,7 +786,8 @@ def walk_cmd(
     offset statistics per step), walk.png, walk.mp4 and the plan (cached as plan_<scene>_<planner>
     .json in --out and reused on the next run). Exit 1 when the robot falls or misses the goal.
     The optimising planners plan for this robot beyond the document: each step in the reach set
-    of both feet's frames and every swing at most ``SWING_MAX`` (``plan_for_walk``).
+    of both feet's frames and every swing at most ``SWING_MAX`` (``plan_for_walk``), unless
+    ``--document-reach``.
     """
     import os
 
@@ -799,7 +806,9 @@ def walk_cmd(
     model = robot_model(robot)
     sc = resolve_scene(scene_file, scene)
     with console.status(f"planning {sc.name} with {planner} for the {robot} ..."):
-        plan = plan_for_walk(sc, planner, steps, time_limit, out, model=model)
+        plan = plan_for_walk(
+            sc, planner, steps, time_limit, out, model=model, robot_aware=robot_aware
+        )
     if not plan.has_solution:
         console.print(f"{sc.name}: {planner} found no plan ({plan.status.value}). {plan.message}")
         raise typer.Exit(1)

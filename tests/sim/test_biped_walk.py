@@ -438,3 +438,28 @@ def test_walk_plans_are_robot_aware_and_cached_with_their_options(tmp_path) -> N
     # the reactive planner cannot honour them and plans without
     reactive = plan_for_walk(scene, "reactive", None, 60.0, None)
     assert not reactive.reach_both_frames and reactive.swing_max is None
+
+
+@pytest.mark.parametrize(("flag", "both_frames"), [([], True), (["--document-reach"], False)])
+def test_cli_walk_plans_robot_aware_unless_document_reach(  # type: ignore[no-untyped-def]
+    flag: list[str], both_frames: bool, tmp_path
+) -> None:
+    # `walk` plans with both reach frames and the swing bound by default; --document-reach plans
+    # the document's problem (eq. 5.12f in the stance frame only); plan.json says which
+    import json
+
+    from footfall.sim.biped_model import SWING_MAX
+    from footfall.terrain.scene import scene_to_yaml
+
+    scene = replace(builtin_scene("flat"), goal=Goal(np.array([0.6, 0.0, 0.0]), 0.0))
+    path = tmp_path / "short.yaml"
+    path.write_text(scene_to_yaml(scene))
+    out = tmp_path / "out"
+    args = ["walk", str(path), "--planner", "kinematic", "--steps", "4", "--no-video"]
+    res = CliRunner().invoke(app, [*args, "--out", str(out), *flag])
+    assert res.exit_code == 0, res.output
+    (plan_file,) = out.glob("plan_*_kinematic.json")
+    saved = json.loads(plan_file.read_text())
+    assert saved["reach_both_frames"] is both_frames
+    assert saved.get("swing_max") == (SWING_MAX if both_frames else None)
+    assert json.loads((out / "walk.json").read_text())["metrics"]["reached_goal"]
