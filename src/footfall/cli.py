@@ -580,6 +580,12 @@ def compare_command(
         help="reduced: the ALIP plant (fast, --trials disturbed trials); mujoco: the 30 kg biped "
         "in MuJoCo (--trials seeded walks, each with one push of push_max N s over 0.1 s).",
     ),
+    robot_aware: bool = typer.Option(
+        True,
+        "--robot-aware/--document-reach",
+        help="--sim mujoco: plan miqcqp/kinematic with the options beyond the document (as "
+        "`walk`); --document-reach: the document's problem (the reduced simulation always is).",
+    ),
 ) -> None:
     """Section 5.5: every planner through the same MPC and plant over seeded disturbed trials."""
     import os
@@ -588,7 +594,7 @@ def compare_command(
         raise InputError("sim", sim, "reduced or mujoco")
     n_steps = _steps_arg(steps)
     if sim == "mujoco":
-        _compare_mujoco(scenes, planners, trials, push_max, time_limit, out, n_steps)
+        _compare_mujoco(scenes, planners, trials, push_max, time_limit, out, n_steps, robot_aware)
         return
 
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -679,6 +685,7 @@ def _compare_mujoco(
     time_limit: float,
     out: Path,
     n_steps: int | dict[str, int] | None = None,
+    robot_aware: bool = True,
 ) -> None:
     """``compare --sim mujoco``: the section 5.5 table from MuJoCo walks (issue 7)."""
     from footfall.planning.plan import PLANNERS
@@ -715,6 +722,7 @@ def _compare_mujoco(
             time_limit=time_limit,
             cache_dir=out / "plans",
             progress=lambda line: status.update(line),
+            robot_aware=robot_aware,
         )
     table = compare_table(rows)
     header = (

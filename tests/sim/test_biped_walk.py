@@ -463,3 +463,23 @@ def test_cli_walk_plans_robot_aware_unless_document_reach(  # type: ignore[no-un
     assert saved["reach_both_frames"] is both_frames
     assert saved.get("swing_max") == (SWING_MAX if both_frames else None)
     assert json.loads((out / "walk.json").read_text())["metrics"]["reached_goal"]
+
+
+@pytest.mark.parametrize(("flag", "aware"), [([], True), (["--document-reach"], False)])
+def test_cli_compare_mujoco_passes_the_reach_choice_to_its_plans(  # type: ignore[no-untyped-def]
+    flag: list[str], aware: bool, tmp_path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # compare --sim mujoco plans through plan_for_walk like `walk`, with the same choice
+    import footfall.sim.biped_compare as bc
+
+    seen = []
+
+    def capture(*args, **kwargs):  # type: ignore[no-untyped-def]
+        seen.append(kwargs.get("robot_aware"))
+        raise RuntimeError("captured")
+
+    monkeypatch.setattr(bc, "plan_for_walk", capture)
+    args = ["compare", "--sim", "mujoco", "--scenes", "flat", "--planners", "kinematic"]
+    res = CliRunner().invoke(app, [*args, "--trials", "1", "--out", str(tmp_path), *flag])
+    assert isinstance(res.exception, RuntimeError)
+    assert seen == [aware]

@@ -172,6 +172,7 @@ def compare_mujoco(
     time_limit: float = 300.0,
     cache_dir: Path | None = None,
     progress: Callable[[str], None] | None = None,
+    robot_aware: bool = True,
 ) -> list[dict[str, Any]]:
     """Walk every scene x planner x seed in MuJoCo with a seeded push; one row per walk.
 
@@ -184,6 +185,8 @@ def compare_mujoco(
         time_limit: planner time limit [s].
         cache_dir: folder for cached plans (strongly advised for miqcqp).
         progress: called with a line of text after each walk.
+        robot_aware: plan miqcqp/kinematic with the options beyond the document
+            (:func:`plan_for_walk`); False: the document's problem.
 
     Returns:
         Rows of :func:`walk_row` plus ``plan_status`` and ``plan_time_s``; a scene/planner
@@ -197,7 +200,7 @@ def compare_mujoco(
         for planner in planners:
             n = (n_steps or {}).get((name, planner))
             t0 = time.perf_counter()
-            plan = plan_for_walk(scene, planner, n, time_limit, cache_dir)
+            plan = plan_for_walk(scene, planner, n, time_limit, cache_dir, robot_aware=robot_aware)
             plan_time = time.perf_counter() - t0
             if not plan.has_solution:
                 rows.append({"scene": name, "planner": planner, "plan_status": plan.status.value})
