@@ -483,3 +483,20 @@ def test_cli_compare_mujoco_passes_the_reach_choice_to_its_plans(  # type: ignor
     res = CliRunner().invoke(app, [*args, "--trials", "1", "--out", str(tmp_path), *flag])
     assert isinstance(res.exception, RuntimeError)
     assert seen == [aware]
+
+
+def test_walk_plan_cache_is_not_reused_for_an_edited_scene_of_the_same_name(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    # the cache file is named after the scene; a scene edited under the same name (here its goal)
+    # must be planned again, not served the old plan
+    from footfall.sim.biped_compare import plan_for_walk
+
+    scene = replace(builtin_scene("flat"), goal=Goal(np.array([0.6, 0.0, 0.0]), 0.0))
+    first = plan_for_walk(scene, "kinematic", 4, 60.0, tmp_path)
+    again = plan_for_walk(scene, "kinematic", 4, 60.0, tmp_path)
+    assert "loaded from cache" in again.message
+    edited = replace(scene, goal=Goal(np.array([0.7, 0.0, 0.0]), 0.0))
+    other = plan_for_walk(edited, "kinematic", 4, 60.0, tmp_path)
+    assert "loaded from cache" not in other.message
+    mid = 0.5 * (other.footsteps[-1, :2] + other.footsteps[-2, :2])
+    assert mid == pytest.approx([0.7, 0.0], abs=1e-6)
+    assert first.footsteps[-1, 0] != pytest.approx(other.footsteps[-1, 0])

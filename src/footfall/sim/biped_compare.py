@@ -22,7 +22,7 @@ from footfall.errors import InputError
 from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
 from footfall.sim.biped_model import SWING_MAX, BipedModel, WalkerModel, planner_params
 from footfall.sim.biped_walk import RISER_LANDING_TOLERANCE, Push, WalkOptions, WalkResult, walk
-from footfall.sim.plan_cache import cache_key, load_plan, save_plan
+from footfall.sim.plan_cache import cache_key, load_plan, save_plan, scene_fingerprint
 from footfall.terrain.edges import inset_riser_edges
 from footfall.terrain.scene import Scene, builtin_scene
 
@@ -72,7 +72,9 @@ def plan_for_walk(
 
     With ``cache_dir`` the plan is stored as ``plan_<scene>_<planner>.json`` (another robot than
     our biped: ``plan_<scene>_<planner>_<robot name>.json``) and reused while the scene, planner,
-    N, robot parameters and planner options are unchanged (MIQCQP plans take minutes).
+    N, robot parameters and planner options are unchanged and the scene's contents too (its
+    regions after the riser insets, start, goal: :func:`scene_fingerprint`; MIQCQP plans take
+    minutes).
 
     Beyond the document: the plan is made on the scene's regions with their riser edges moved in
     by ``RISER_LANDING_TOLERANCE`` (:func:`footfall.terrain.edges.inset_riser_edges`) and with a
@@ -90,7 +92,13 @@ def plan_for_walk(
     aware = walk_planner_options(planner) if robot_aware else {}
     opts = PlannerOptions(time_limit=time_limit, region_margin=margin, **aware)
     key = cache_key(
-        scene.name, planner, n_steps, robot, margin, opts.reach_both_frames, opts.swing_max
+        scene_fingerprint(scene),
+        planner,
+        n_steps,
+        robot,
+        margin,
+        opts.reach_both_frames,
+        opts.swing_max,
     )
     suffix = "" if model is None or model.name == "biped" else f"_{model.name}"
     path = (

@@ -1,13 +1,14 @@
 """Footstep plans cached as JSON next to a walk's outputs, so a slow MIQCQP plan is solved once.
 
 The file is the ``plan.json`` format of ``footfall plan`` (:func:`plan_to_dict`) plus a ``cache_key``
-naming the scene, planner, step count, robot parameters and the planner options beyond the
-document; :func:`load_plan` rebuilds the
+naming the scene (with a digest of its contents, :func:`scene_fingerprint`), planner, step count,
+robot parameters and the planner options beyond the document; :func:`load_plan` rebuilds the
 :class:`FootstepPlan` for the given robot and refuses a file whose key differs.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 from pathlib import Path
@@ -21,6 +22,14 @@ from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import FootstepPlan
 from footfall.planning.plan_io import plan_to_dict
 from footfall.solvers.base import SolveStatus
+from footfall.terrain.scene import Scene, scene_to_yaml
+
+
+def scene_fingerprint(scene: Scene) -> str:
+    """``<name>#<digest>``: the scene's name and a digest of everything in it (regions, start, goal,
+    robot), so an edited scene under the same name does not reuse a plan made for the old one."""
+    digest = hashlib.sha256(scene_to_yaml(scene).encode()).hexdigest()[:16]
+    return f"{scene.name}#{digest}"
 
 
 def cache_key(
