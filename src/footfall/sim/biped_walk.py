@@ -710,28 +710,21 @@ def swing_reference(
     (:func:`swing_bow`; beyond the document).
     """
     s_h = smoothstep((tau - SWING_MOVE[0]) / (SWING_MOVE[1] - SWING_MOVE[0]))
+    xy = start[:2] + (target[:2] - start[:2]) * s_h
     if stance is not None and side_clearance > 0.0:
         bow, s_pass = swing_bow(start, target, stance, side_clearance)
         if s_h <= s_pass:
             w = math.sin(0.5 * math.pi * s_h / s_pass) if s_pass > 0.0 else 1.0
         else:
             w = math.sin(0.5 * math.pi * (1.0 - s_h) / (1.0 - s_pass)) if s_pass < 1.0 else 1.0
-        xy = start[:2] + (target[:2] - start[:2]) * s_h + bow * w
-        z = _swing_height(tau, start, target, apex, rise, descend)
-        return np.array([xy[0], xy[1], z]), s_h
-    z = _swing_height(tau, start, target, apex, rise, descend)
-    xy = start[:2] + (target[:2] - start[:2]) * s_h
-    return np.array([xy[0], xy[1], z]), s_h
-
-
-def _swing_height(
-    tau: float, start: FloatArray, target: FloatArray, apex: float, rise: float, descend: float
-) -> float:
+        xy = xy + bow * w
     if tau < rise:
-        return float(start[2] + (apex - start[2]) * smoothstep(tau / rise))
-    if tau < descend:
-        return float(apex)
-    return float(apex + (target[2] - apex) * smoothstep((tau - descend) / (1.0 - descend)))
+        z = start[2] + (apex - start[2]) * smoothstep(tau / rise)
+    elif tau < descend:
+        z = apex
+    else:
+        z = apex + (target[2] - apex) * smoothstep((tau - descend) / (1.0 - descend))
+    return np.array([xy[0], xy[1], z]), s_h
 
 
 def swing_bow(
