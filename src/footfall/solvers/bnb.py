@@ -1991,14 +1991,21 @@ class _Workers:
         end = time.perf_counter() + grace
         from multiprocessing.connection import wait
 
-        # read what the workers still send, so none blocks on a full pipe while exiting
-        while any(p.is_alive() for p in self.procs) and time.perf_counter() < end:
-            live = [c for c, p in zip(self.conns, self.procs, strict=True) if p.is_alive()]
-            sentinels = [p.sentinel for p in self.procs if p.is_alive()]
-            for obj in wait([*live, *sentinels], timeout=max(end - time.perf_counter(), 0.0)):
-                if obj in live:
+        # read what the workers still send, so none blocks on a full pipe while exiting; a worker
+        # whose sentinel is ready has exited (is_alive() may lag until it is reaped, so join it:
+        # waiting on an empty list instead would sleep out the whole grace)
+        while time.perf_counter() < end:
+            alive = [i for i, p in enumerate(self.procs) if p.is_alive()]
+            if not alive:
+                break
+            conns = {self.conns[i]: i for i in alive}
+            sentinels = {self.procs[i].sentinel: i for i in alive}
+            for obj in wait([*conns, *sentinels], timeout=max(end - time.perf_counter(), 0.0)):
+                if obj in sentinels:
+                    self.procs[sentinels[obj]].join()
+                else:
                     try:
-                        self.conns[self.conns.index(obj)].recv()
+                        obj.recv()
                     except (EOFError, OSError):
                         pass
         for proc in self.procs:
