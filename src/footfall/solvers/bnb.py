@@ -2005,7 +2005,7 @@ class _Workers:
                     self.procs[sentinels[obj]].join()
                 else:
                     try:
-                        obj.recv()
+                        self.conns[conns[obj]].recv()
                     except (EOFError, OSError):
                         pass
         for proc in self.procs:
