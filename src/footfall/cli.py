@@ -554,6 +554,13 @@ def simulate_command(
 
 
 # --- compare (issue 4) ---
+#: help of the walks' ``--heading-segments`` (``walk``, ``compare --sim mujoco``)
+_WALK_SEGMENTS_HELP = (
+    "Heading segments L of the miqcqp plan (eq. 5.12g-h; 16: the document's). 64 keeps straight "
+    "robot-aware plans from stepping wide at theta = 0, a breakpoint of the 16 (see plan_for_walk)."
+)
+
+
 @app.command("compare")
 def compare_command(
     scenes: str = typer.Option(
@@ -586,6 +593,7 @@ def compare_command(
         help="--sim mujoco: plan miqcqp/kinematic with the options beyond the document (as "
         "`walk`); --document-reach: the document's problem (the reduced simulation always is).",
     ),
+    heading_segments: int = typer.Option(16, help="--sim mujoco: " + _WALK_SEGMENTS_HELP),
 ) -> None:
     """Section 5.5: every planner through the same MPC and plant over seeded disturbed trials."""
     import os
@@ -594,7 +602,17 @@ def compare_command(
         raise InputError("sim", sim, "reduced or mujoco")
     n_steps = _steps_arg(steps)
     if sim == "mujoco":
-        _compare_mujoco(scenes, planners, trials, push_max, time_limit, out, n_steps, robot_aware)
+        _compare_mujoco(
+            scenes,
+            planners,
+            trials,
+            push_max,
+            time_limit,
+            out,
+            n_steps,
+            robot_aware,
+            heading_segments,
+        )
         return
 
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -686,6 +704,7 @@ def _compare_mujoco(
     out: Path,
     n_steps: int | dict[str, int] | None = None,
     robot_aware: bool = True,
+    heading_segments: int = 16,
 ) -> None:
     """``compare --sim mujoco``: the section 5.5 table from MuJoCo walks (issue 7)."""
     from footfall.planning.plan import PLANNERS
@@ -723,6 +742,7 @@ def _compare_mujoco(
             cache_dir=out / "plans",
             progress=lambda line: status.update(line),
             robot_aware=robot_aware,
+            heading_segments=heading_segments,
         )
     table = compare_table(rows)
     header = (
@@ -787,6 +807,7 @@ def walk_cmd(
         help="Plan miqcqp/kinematic with the options beyond the document (reach in both feet's "
         "frames, swing bound); --document-reach: eq. (5.12f) in the stance foot's frame only.",
     ),
+    heading_segments: int = typer.Option(16, help=_WALK_SEGMENTS_HELP),
 ) -> None:
     """Walk a footstep plan with the MuJoCo biped (document 000, section 5.5).
 
@@ -815,7 +836,14 @@ def walk_cmd(
     sc = resolve_scene(scene_file, scene)
     with console.status(f"planning {sc.name} with {planner} for the {robot} ..."):
         plan = plan_for_walk(
-            sc, planner, steps, time_limit, out, model=model, robot_aware=robot_aware
+            sc,
+            planner,
+            steps,
+            time_limit,
+            out,
+            model=model,
+            robot_aware=robot_aware,
+            heading_segments=heading_segments,
         )
     if not plan.has_solution:
         console.print(f"{sc.name}: {planner} found no plan ({plan.status.value}). {plan.message}")

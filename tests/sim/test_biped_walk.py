@@ -440,6 +440,47 @@ def test_walk_plans_are_robot_aware_and_cached_with_their_options(tmp_path) -> N
     assert not reactive.reach_both_frames and reactive.swing_max is None
 
 
+def test_walk_plans_record_their_heading_segments_and_cache_by_them(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    # plan_for_walk(heading_segments=L): the plan, plan.json and the cache key keep L, and a plan
+    # made with another L is not served from the cache
+    import json
+
+    from footfall.sim.biped_compare import plan_for_walk
+
+    scene = replace(builtin_scene("flat"), goal=Goal(np.array([0.6, 0.0, 0.0]), 0.0))
+    made = plan_for_walk(scene, "miqcqp", 4, 60.0, tmp_path, heading_segments=64)
+    assert made.has_solution and made.heading_segments == 64
+    stored = json.loads((tmp_path / "plan_flat_miqcqp.json").read_text())
+    assert stored["heading_segments"] == 64 and stored["cache_key"].endswith("|L=64")
+    again = plan_for_walk(scene, "miqcqp", 4, 60.0, tmp_path, heading_segments=64)
+    assert "loaded from cache" in again.message and again.heading_segments == 64
+    default = plan_for_walk(scene, "miqcqp", 4, 60.0, tmp_path)
+    assert "loaded from cache" not in default.message and default.heading_segments == 16
+    with pytest.raises(InputError, match="heading_segments"):
+        plan_for_walk(scene, "miqcqp", 4, 60.0, None, heading_segments=2)
+
+
+@pytest.mark.parametrize(("segments", "widest"), [(16, (0.22, 0.26)), (64, (0.12, 0.18))])
+def test_straight_plans_with_both_frames_step_wide_only_with_coarse_segments(
+    segments: int, widest: tuple[float, float]
+) -> None:
+    # why walks offer --heading-segments 64: a straight walk holds theta = 0, a breakpoint of the
+    # 16 segments, where each segment's reach (eq. 5.12f at both segment ends) loses most of one
+    # side's forward reach; with both frames the plan then alternates narrow and ~0.24 m wide
+    # steps. With 64 segments the steps stay near the inner width 0.12 m. (The last step is the
+    # goal stance, 0.20 m.)
+    from footfall.planning import PlannerOptions
+
+    scene = replace(builtin_scene("flat"), goal=Goal(np.array([1.2, 0.0, 0.0]), 0.0))
+    opts = PlannerOptions(reach_both_frames=True, heading_segments=segments, gap=1e-3)
+    plan = make_plan(scene, "miqcqp", 6, opts, scene.robot)
+    # straight: every heading at 0 (within the interior-point accuracy)
+    assert plan.has_solution and np.allclose(plan.headings, 0.0, atol=1e-3)
+    widths = np.abs(np.diff(plan.footsteps[:, 1]))[:-1]
+    assert widths.min() >= 0.12 - 1e-6  # the inner reach bound
+    assert widest[0] <= widths.max() <= widest[1]
+
+
 @pytest.mark.parametrize(("flag", "both_frames"), [([], True), (["--document-reach"], False)])
 def test_cli_walk_plans_robot_aware_unless_document_reach(  # type: ignore[no-untyped-def]
     flag: list[str], both_frames: bool, tmp_path
@@ -465,24 +506,42 @@ def test_cli_walk_plans_robot_aware_unless_document_reach(  # type: ignore[no-un
     assert json.loads((out / "walk.json").read_text())["metrics"]["reached_goal"]
 
 
-@pytest.mark.parametrize(("flag", "aware"), [([], True), (["--document-reach"], False)])
+@pytest.mark.parametrize(
+    ("flag", "aware", "segments"),
+    [([], True, 16), (["--document-reach"], False, 16), (["--heading-segments", "64"], True, 64)],
+)
 def test_cli_compare_mujoco_passes_the_reach_choice_to_its_plans(  # type: ignore[no-untyped-def]
-    flag: list[str], aware: bool, tmp_path, monkeypatch: pytest.MonkeyPatch
+    flag: list[str], aware: bool, segments: int, tmp_path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    # compare --sim mujoco plans through plan_for_walk like `walk`, with the same choice
+    # compare --sim mujoco plans through plan_for_walk like `walk`, with the same choices
     import footfall.sim.biped_compare as bc
 
     seen = []
 
     def capture(*args, **kwargs):  # type: ignore[no-untyped-def]
-        seen.append(kwargs.get("robot_aware"))
+        seen.append((kwargs.get("robot_aware"), kwargs.get("heading_segments")))
         raise RuntimeError("captured")
 
     monkeypatch.setattr(bc, "plan_for_walk", capture)
     args = ["compare", "--sim", "mujoco", "--scenes", "flat", "--planners", "kinematic"]
     res = CliRunner().invoke(app, [*args, "--trials", "1", "--out", str(tmp_path), *flag])
     assert isinstance(res.exception, RuntimeError)
-    assert seen == [aware]
+    assert seen == [(aware, segments)]
+
+
+def test_cli_walk_rejects_too_few_heading_segments(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    import subprocess
+    import sys
+
+    args = ["walk", "--scene", "flat", "--heading-segments", "3", "--no-video"]
+    res = subprocess.run(
+        [sys.executable, "-m", "footfall", *args, "--out", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    said = res.stdout + res.stderr
+    assert res.returncode == 2 and "heading_segments: got 3" in said and "Traceback" not in said
 
 
 def test_walk_plan_cache_is_not_reused_for_an_edited_scene_of_the_same_name(tmp_path) -> None:  # type: ignore[no-untyped-def]

@@ -440,6 +440,7 @@ def extract_plan(fp: FootstepProblem, x: FloatArray, **meta: Any) -> FootstepPla
         region_margin=fp.options.region_margin,
         reach_both_frames=fp.options.reach_both_frames,
         swing_max=fp.options.swing_max,
+        heading_segments=fp.options.heading_segments,
         **meta,
     )
 

@@ -171,6 +171,9 @@ class FootstepPlan:
             planner models them (eq. 5.12g-h); empty otherwise.
         region_margin, reach_both_frames, swing_max: the :class:`PlannerOptions` the plan was
             made with (the checker holds the plan to them).
+        heading_segments: L of the :class:`PlannerOptions` a miqcqp plan was made with (the
+            conservative reach rows of each segment, eq. 5.12f-h, depend on it); None for the
+            planners without heading segments.
     """
 
     planner: str
@@ -194,6 +197,7 @@ class FootstepPlan:
     region_margin: float = 0.0
     reach_both_frames: bool = False
     swing_max: float | None = None
+    heading_segments: int | None = None
 
     @property
     def n_steps(self) -> int:

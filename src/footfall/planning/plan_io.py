@@ -36,6 +36,7 @@ def plan_to_dict(plan: FootstepPlan, scene_name: str = "") -> dict[str, Any]:
         "region_margin": plan.region_margin,
         "reach_both_frames": plan.reach_both_frames,
         "swing_max": plan.swing_max,
+        "heading_segments": plan.heading_segments,
         "stats": stats,
         "robot": {
             "mass": plan.robot.mass,

@@ -40,16 +40,18 @@ def cache_key(
     margin: float = 0.0,
     both_frames: bool = False,
     swing_max: float | None = None,
+    heading_segments: int = 16,
 ) -> str:
-    """A string that changes whenever anything the plan depends on changes (``both_frames`` and
-    ``swing_max`` are the planner options ``reach_both_frames`` and ``swing_max`` [m])."""
+    """A string that changes whenever anything the plan depends on changes (``both_frames``,
+    ``swing_max`` [m] and ``heading_segments`` are the planner options ``reach_both_frames``,
+    ``swing_max`` and ``heading_segments``)."""
     r = robot
     swing = "none" if swing_max is None else f"{swing_max:.6g}"
     return (
         f"{scene}|{planner}|N={n_steps}|margin={margin:.6g}|m={r.mass:.6g}|zH={r.com_height:.6g}|tss={r.t_ss:.6g}|"
         f"tds={r.t_ds:.6g}|K={r.n_nodes}|umax={r.u_max:.6g}|w={r.stance_width:.6g}|"
         f"reach={np.round(r.reach.vertices, 6).tolist()}|both_frames={bool(both_frames)}|"
-        f"swing={swing}"
+        f"swing={swing}|L={int(heading_segments)}"
     )
 
 
@@ -110,4 +112,5 @@ def load_plan(
         region_margin=region_margin,
         reach_both_frames=bool(d.get("reach_both_frames", False)),
         swing_max=None if d.get("swing_max") is None else float(d["swing_max"]),
+        heading_segments=None if d.get("heading_segments") is None else int(d["heading_segments"]),
     )
