@@ -556,8 +556,9 @@ def simulate_command(
 # --- compare (issue 4) ---
 #: help of the walks' ``--heading-segments`` (``walk``, ``compare --sim mujoco``)
 _WALK_SEGMENTS_HELP = (
-    "Heading segments L of the miqcqp plan (eq. 5.12g-h; 16: the document's). 64 keeps straight "
-    "robot-aware plans from stepping wide at theta = 0, a breakpoint of the 16 (see plan_for_walk)."
+    "Heading segments L of the miqcqp / kinematic plans (eq. 5.12g-h; 16: the document's). 64 "
+    "keeps straight robot-aware plans from stepping wide at theta = 0, a breakpoint of the 16 "
+    "(see plan_for_walk)."
 )
 
 
