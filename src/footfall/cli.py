@@ -556,9 +556,9 @@ def simulate_command(
 # --- compare (issue 4) ---
 #: help of the walks' ``--heading-segments`` (``walk``, ``compare --sim mujoco``)
 _WALK_SEGMENTS_HELP = (
-    "Heading segments L of the miqcqp / kinematic plans (eq. 5.12g-h; 16: the document's). 64 "
-    "keeps straight robot-aware plans from stepping wide at theta = 0, a breakpoint of the 16 "
-    "(see plan_for_walk)."
+    "Heading segments L of the miqcqp / kinematic plans (eq. 5.12g-h); default: 64 for the "
+    "robot-aware plans (with 16, straight plans step wide at theta = 0, a breakpoint of the 16; "
+    "see plan_for_walk), the document's 16 with --document-reach."
 )
 
 
@@ -594,7 +594,7 @@ def compare_command(
         help="--sim mujoco: plan miqcqp/kinematic with the options beyond the document (as "
         "`walk`); --document-reach: the document's problem (the reduced simulation always is).",
     ),
-    heading_segments: int = typer.Option(16, help="--sim mujoco: " + _WALK_SEGMENTS_HELP),
+    heading_segments: int | None = typer.Option(None, help="--sim mujoco: " + _WALK_SEGMENTS_HELP),
 ) -> None:
     """Section 5.5: every planner through the same MPC and plant over seeded disturbed trials."""
     import os
@@ -705,7 +705,7 @@ def _compare_mujoco(
     out: Path,
     n_steps: int | dict[str, int] | None = None,
     robot_aware: bool = True,
-    heading_segments: int = 16,
+    heading_segments: int | None = None,
 ) -> None:
     """``compare --sim mujoco``: the section 5.5 table from MuJoCo walks (issue 7)."""
     from footfall.planning.plan import PLANNERS
@@ -808,7 +808,7 @@ def walk_cmd(
         help="Plan miqcqp/kinematic with the options beyond the document (reach in both feet's "
         "frames, swing bound); --document-reach: eq. (5.12f) in the stance foot's frame only.",
     ),
-    heading_segments: int = typer.Option(16, help=_WALK_SEGMENTS_HELP),
+    heading_segments: int | None = typer.Option(None, help=_WALK_SEGMENTS_HELP),
 ) -> None:
     """Walk a footstep plan with the MuJoCo biped (document 000, section 5.5).
 

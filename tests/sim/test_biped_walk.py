@@ -454,8 +454,14 @@ def test_walk_plans_record_their_heading_segments_and_cache_by_them(tmp_path) ->
     assert stored["heading_segments"] == 64 and stored["cache_key"].endswith("|L=64")
     again = plan_for_walk(scene, "miqcqp", 4, 60.0, tmp_path, heading_segments=64)
     assert "loaded from cache" in again.message and again.heading_segments == 64
-    default = plan_for_walk(scene, "miqcqp", 4, 60.0, tmp_path)
-    assert "loaded from cache" not in default.message and default.heading_segments == 16
+    coarse = plan_for_walk(scene, "miqcqp", 4, 60.0, tmp_path, heading_segments=16)
+    assert "loaded from cache" not in coarse.message and coarse.heading_segments == 16
+    # defaults: WALK_HEADING_SEGMENTS for the robot-aware plans, the document's 16 otherwise
+    from footfall.sim.biped_model import WALK_HEADING_SEGMENTS
+
+    assert plan_for_walk(scene, "miqcqp", 4, 60.0, None).heading_segments == WALK_HEADING_SEGMENTS
+    document = plan_for_walk(scene, "miqcqp", 4, 60.0, None, robot_aware=False)
+    assert document.heading_segments == 16
     with pytest.raises(InputError, match="heading_segments"):
         plan_for_walk(scene, "miqcqp", 4, 60.0, None, heading_segments=2)
 
@@ -464,13 +470,15 @@ def test_walk_plans_record_their_heading_segments_and_cache_by_them(tmp_path) ->
 def test_straight_plans_with_both_frames_step_wide_only_with_coarse_segments(
     segments: int, widest: tuple[float, float]
 ) -> None:
-    # why walks offer --heading-segments 64: a straight walk holds theta = 0, a breakpoint of the
-    # 16 segments, where each segment's reach (eq. 5.12f at both segment ends) loses most of one
+    # why walks plan with WALK_HEADING_SEGMENTS = 64: a straight walk holds theta = 0, a breakpoint
+    # of the 16 segments, where each segment's reach (eq. 5.12f at both segment ends) loses most of one
     # side's forward reach; with both frames the plan then alternates narrow and ~0.24 m wide
     # steps. With 64 segments the steps stay near the inner width 0.12 m. (The last step is the
     # goal stance, 0.20 m.)
     from footfall.planning import PlannerOptions
+    from footfall.sim.biped_model import WALK_HEADING_SEGMENTS
 
+    assert segments in (16, WALK_HEADING_SEGMENTS)
     scene = replace(builtin_scene("flat"), goal=Goal(np.array([1.2, 0.0, 0.0]), 0.0))
     opts = PlannerOptions(reach_both_frames=True, heading_segments=segments, gap=1e-3)
     plan = make_plan(scene, "miqcqp", 6, opts, scene.robot)
@@ -508,10 +516,14 @@ def test_cli_walk_plans_robot_aware_unless_document_reach(  # type: ignore[no-un
 
 @pytest.mark.parametrize(
     ("flag", "aware", "segments"),
-    [([], True, 16), (["--document-reach"], False, 16), (["--heading-segments", "64"], True, 64)],
+    [
+        ([], True, None),
+        (["--document-reach"], False, None),
+        (["--heading-segments", "32"], True, 32),
+    ],
 )
 def test_cli_compare_mujoco_passes_the_reach_choice_to_its_plans(  # type: ignore[no-untyped-def]
-    flag: list[str], aware: bool, segments: int, tmp_path, monkeypatch: pytest.MonkeyPatch
+    flag: list[str], aware: bool, segments: int | None, tmp_path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # compare --sim mujoco plans through plan_for_walk like `walk`, with the same choices
     import footfall.sim.biped_compare as bc

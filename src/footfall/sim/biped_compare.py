@@ -20,7 +20,13 @@ import numpy as np
 from footfall._validate import non_negative
 from footfall.errors import InputError
 from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
-from footfall.sim.biped_model import SWING_MAX, BipedModel, WalkerModel, planner_params
+from footfall.sim.biped_model import (
+    SWING_MAX,
+    WALK_HEADING_SEGMENTS,
+    BipedModel,
+    WalkerModel,
+    planner_params,
+)
 from footfall.sim.biped_walk import RISER_LANDING_TOLERANCE, Push, WalkOptions, WalkResult, walk
 from footfall.sim.plan_cache import cache_key, load_plan, save_plan, scene_fingerprint
 from footfall.terrain.edges import inset_riser_edges
@@ -60,7 +66,7 @@ def plan_for_walk(
     cache_dir: Path | None = None,
     model: WalkerModel | None = None,
     robot_aware: bool = True,
-    heading_segments: int = 16,
+    heading_segments: int | None = None,
 ) -> FootstepPlan:
     """The plan of ``scene`` for the MuJoCo biped or another walker model (robot parameters from
     :func:`planner_params`).
@@ -71,8 +77,8 @@ def plan_for_walk(
     every walker model). The reactive planner cannot honour them and plans without.
     ``robot_aware=False`` plans the document's problem (with the region margin only).
 
-    ``heading_segments``: L of the miqcqp and kinematic plans (eq. 5.12g-h; 16 is the
-    document's and the default). Each segment's linear reach (eq. 5.12f) holds for every heading
+    ``heading_segments``: L of the miqcqp and kinematic plans (eq. 5.12g-h); None:
+    ``WALK_HEADING_SEGMENTS`` (64) for robot-aware plans, the document's 16 otherwise. Each segment's linear reach (eq. 5.12f) holds for every heading
     in it, so a heading held on a breakpoint (a straight walk at theta = 0 sits on the one between
     two 22.5 deg segments) gets the trapezoid intersected with its copy rotated a whole segment
     away: from a right stance foot, a left step at the inner width 0.12 m may reach 0.342 m
@@ -103,6 +109,8 @@ def plan_for_walk(
     margin = robot.foot_length / 2.0
     scene = replace(scene, terrain=inset_riser_edges(scene.terrain, RISER_LANDING_TOLERANCE))
     aware = walk_planner_options(planner) if robot_aware else {}
+    if heading_segments is None:
+        heading_segments = WALK_HEADING_SEGMENTS if robot_aware else 16
     opts = PlannerOptions(
         time_limit=time_limit, region_margin=margin, heading_segments=heading_segments, **aware
     )
@@ -197,7 +205,7 @@ def compare_mujoco(
     cache_dir: Path | None = None,
     progress: Callable[[str], None] | None = None,
     robot_aware: bool = True,
-    heading_segments: int = 16,
+    heading_segments: int | None = None,
 ) -> list[dict[str, Any]]:
     """Walk every scene x planner x seed in MuJoCo with a seeded push; one row per walk.
 
@@ -212,7 +220,8 @@ def compare_mujoco(
         progress: called with a line of text after each walk.
         robot_aware: plan miqcqp/kinematic with the options beyond the document
             (:func:`plan_for_walk`); False: the document's problem.
-        heading_segments: L of the miqcqp and kinematic plans (:func:`plan_for_walk`).
+        heading_segments: L of the miqcqp and kinematic plans (:func:`plan_for_walk`; None: its
+            default).
 
     Returns:
         Rows of :func:`walk_row` plus ``plan_status`` and ``plan_time_s``; a scene/planner

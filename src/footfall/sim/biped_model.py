@@ -47,6 +47,14 @@ U_MAX_FOOT_SHARE = 0.8
 #: knob.
 SWING_MAX = 0.70
 
+#: Heading segments L (eq. 5.12g-h) of the robot-aware miqcqp / kinematic plans this biped walks
+#: (the document's problem and the :class:`PlannerOptions` default: 16). See
+#: :func:`footfall.sim.biped_compare.plan_for_walk`: with 16, straight plans with both reach
+#: frames alternate 0.12 and 0.24 m wide steps and drift sideways, and the stairs walks fell at
+#: the step-downs (stairs_slope_gap N = 16-20 all fell); with 64 the smallest N (16) reaches the
+#: goal.
+WALK_HEADING_SEGMENTS = 64
+
 
 def require_mujoco() -> Any:
     """Import MuJoCo or raise a FootfallError saying how to install it."""

@@ -72,9 +72,12 @@ EDGE_TOL = 0.005
 GOAL_TOL = 0.10
 #: video frame rate [1/s]
 VIDEO_FPS = 30
-#: extra footsteps after the plan's last one, taken where the feet already are and corrected by
-#: foot placement toward zero momentum: they absorb the momentum the walk ends with
-STOP_STEPS = 0
+#: extra footsteps after the plan's last one, onto the plan's final footholds (the goal stance),
+#: corrected by foot placement toward zero momentum: they absorb the momentum the walk ends with
+#: and finish a walk whose last steps the MPC shortened (discrete_steps, smallest N = 15 with 64
+#: heading segments: 0.139 m short of the goal with none, 0.029 m with 2; flat_long N = 20:
+#: 0.004 / 0.024 m, both at the goal)
+STOP_STEPS = 2
 #: sole-pose and CoM costs of the inverse kinematics: the feet must be where they are (the stance
 #: foot cannot move), the CoM is the ALIP's; torso and posture are secondary
 FOOT_POSITION_COST = 10.0
