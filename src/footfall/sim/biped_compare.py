@@ -78,16 +78,17 @@ def plan_for_walk(
     ``robot_aware=False`` plans the document's problem (with the region margin only).
 
     ``heading_segments``: L of the miqcqp and kinematic plans (eq. 5.12g-h); None:
-    ``WALK_HEADING_SEGMENTS`` (64) for robot-aware plans, the document's 16 otherwise. Each segment's linear reach (eq. 5.12f) holds for every heading
-    in it, so a heading held on a breakpoint (a straight walk at theta = 0 sits on the one between
-    two 22.5 deg segments) gets the trapezoid intersected with its copy rotated a whole segment
-    away: from a right stance foot, a left step at the inner width 0.12 m may reach 0.342 m
-    forward in the segment below 0 but not forward at all (-0.024 m) in the one above. With both
-    reach frames each foot's segment must serve its incoming and its outgoing step, which need
-    opposite segments, so straight robot-aware plans alternate 0.12 and about 0.24 m wide steps
-    and drift sideways (stairs_slope_gap N = 16: to y = 0.39 m). 64 segments (5.6 deg) lose at
-    most 4 cm of width there (0.329 m forward at 0.16 m); the plans take longer
-    (stairs_slope_gap N = 16: 38 s instead of 4 s).
+    ``WALK_HEADING_SEGMENTS`` (64) for robot-aware plans, the document's 16 otherwise. Each
+    segment's linear reach (eq. 5.12f) holds for every heading in it, so a heading held on a
+    breakpoint (a straight walk at theta = 0 sits on the one between two 22.5 deg segments) gets
+    the trapezoid intersected with its copy rotated a whole segment away: from a right stance
+    foot, a left step at the inner width 0.12 m may reach 0.342 m forward in the segment below 0
+    but not forward at all (-0.024 m) in the one above. With both reach frames each foot's segment
+    must serve its incoming and its outgoing step, which need opposite segments, so straight
+    robot-aware plans alternate 0.12 and about 0.24 m wide steps and drift sideways
+    (stairs_slope_gap N = 16: to y = 0.39 m). 64 segments (5.6 deg) lose at most 4 cm of width
+    there (0.329 m forward at 0.16 m); the plans take longer (stairs_slope_gap N = 16: 38 s
+    instead of 4 s).
 
     With ``cache_dir`` the plan is stored as ``plan_<scene>_<planner>.json`` (another robot than
     our biped: ``plan_<scene>_<planner>_<robot name>.json``) and reused while the scene, planner,
@@ -110,7 +111,7 @@ def plan_for_walk(
     scene = replace(scene, terrain=inset_riser_edges(scene.terrain, RISER_LANDING_TOLERANCE))
     aware = walk_planner_options(planner) if robot_aware else {}
     if heading_segments is None:
-        heading_segments = WALK_HEADING_SEGMENTS if robot_aware else 16
+        heading_segments = WALK_HEADING_SEGMENTS if robot_aware else PlannerOptions.heading_segments
     opts = PlannerOptions(
         time_limit=time_limit, region_margin=margin, heading_segments=heading_segments, **aware
     )

@@ -285,7 +285,7 @@ class FootstepAdjuster(Protocol):
 
 
 def extend_plan(plan: FootstepPlan, extra: int = STOP_STEPS) -> FootstepPlan:
-    """``plan`` with ``extra`` stopping steps appended (in place: each foot steps where it stands).
+    """``plan`` with ``extra`` stopping steps appended (each foot steps onto its last foothold).
 
     Their ALIP states and torques are zero (the CoM at rest over the stance foot): as a foot
     placement reference this asks to end the next phase with zero momentum, i.e. to capture the
