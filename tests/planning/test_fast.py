@@ -8,6 +8,7 @@ relaxation (a valid lower bound, exact at a fixed assignment) and of the fallbac
 from __future__ import annotations
 
 import math
+import time
 from typing import ClassVar
 
 import numpy as np
@@ -35,21 +36,34 @@ ROBOT = BipedParams(n_nodes=3)
 CASES = [(4, 0, 4), (4, 1, 4), (5, 0, 5), (5, 1, 5), (5, 2, 6), (5, 3, 6), (6, 0, 6)]
 
 
+def _force_probing(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Probe at the root of every search (small searches never reach it), without a budget."""
+    monkeypatch.setattr(bnb, "PROBE_AFTER", 0)
+    monkeypatch.setattr(bnb, "PROBE_BUDGET", math.inf)
+
+
 def _scene(regions: int, seed: int):  # type: ignore[no-untyped-def]
     return random_stepping_stones(seed, regions, robot=ROBOT)
 
 
 @pytest.mark.parametrize(("regions", "seed", "n"), CASES)
-def test_fast_objective_equals_direct(regions: int, seed: int, n: int) -> None:
+def test_fast_objective_equals_direct(
+    regions: int, seed: int, n: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
     scene = _scene(regions, seed)
     opts = PlannerOptions(gap=GAP, time_limit=60.0)
     direct = plan_footsteps(scene, ROBOT, n, opts)
     fast = plan_footsteps_fast(scene, ROBOT, n, opts)
+    # these searches are too small to reach probing: force it at the root (and its heuristics)
+    _force_probing(monkeypatch)
+    probed = plan_footsteps_fast(scene, ROBOT, n, opts)
+    assert probed.stats["probes"] > 0
     assert direct.status is SolveStatus.OPTIMAL, direct.message
-    assert fast.status is SolveStatus.OPTIMAL, fast.message
-    assert fast.solver == FAST_SOLVER
-    assert fast.objective == pytest.approx(direct.objective, rel=OBJ_RTOL)
-    for plan in (direct, fast):
+    for plan in (fast, probed):
+        assert plan.status is SolveStatus.OPTIMAL, plan.message
+        assert plan.solver == FAST_SOLVER
+        assert plan.objective == pytest.approx(direct.objective, rel=OBJ_RTOL)
+    for plan in (direct, fast, probed):
         report = check_plan(plan, scene)
         assert report.ok, report.summary()
     # the fast plan's proven bound is a valid lower bound on the direct optimum
@@ -139,7 +153,12 @@ def test_fixed_binaries_are_respected() -> None:
         assert worse.status is SolveStatus.INFEASIBLE
 
 
-def test_time_limit_returns_an_honest_gap() -> None:
+@pytest.mark.parametrize("probe_at_root", [False, True])
+def test_time_limit_returns_an_honest_gap(
+    probe_at_root: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    if probe_at_root:
+        _force_probing(monkeypatch)
     scene = random_stepping_stones(0, 8, robot=ROBOT)
     fp = build_footstep_problem(scene, ROBOT, 10)
     res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.3, gap=0.0))
@@ -335,8 +354,14 @@ def test_bench_plan_cli_writes_the_table(tmp_path) -> None:  # type: ignore[no-u
     assert bad.returncode == 2 and "steps" in bad.stderr
 
 
-def test_parallel_time_limit_returns_an_honest_gap() -> None:
-    # the asynchronous search stops with solves (and possibly the dive) in flight
+@pytest.mark.parametrize("probe_at_root", [False, True])
+def test_parallel_time_limit_returns_an_honest_gap(
+    probe_at_root: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # the asynchronous search stops with solves (and possibly the dive) in flight; with probing
+    # at the root, the time limit falls in probing or its heuristics
+    if probe_at_root:
+        _force_probing(monkeypatch)
     scene = random_stepping_stones(0, 8, robot=ROBOT)
     fp = build_footstep_problem(scene, ROBOT, 10)
     res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.5, gap=0.0, threads=2))
@@ -575,3 +600,91 @@ def test_compact_node_problems_are_the_same_relaxation(monkeypatch: pytest.Monke
                 v = np.flatnonzero(np.isin(compact.condensed.col, dropped))
                 assert np.all(fp.problem.lb[v] <= got.x[v]) and np.all(got.x[v] <= fp.problem.ub[v])
     assert "solved" in statuses
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+@pytest.mark.parametrize(("seed", "n"), [(1, 8), (3, 8)])
+def test_probing_and_heuristics_keep_the_optimum(
+    seed: int, n: int, threads: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    fp = build_footstep_problem(random_stepping_stones(seed, 8, robot=ROBOT), ROBOT, n)
+    monkeypatch.setattr(bnb, "PROBE_ROUNDS", 0)
+    plain = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads))
+    monkeypatch.setattr(bnb, "PROBE_ROUNDS", 8)
+    _force_probing(monkeypatch)
+    probed = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads))
+    assert plain.status is probed.status is SolveStatus.OPTIMAL
+    assert plain.stats["probes"] == 0
+    assert probed.stats["probes"] > 0 and probed.stats["probe_dropped"] > 0
+    assert probed.stats["heuristic_nodes"] + probed.stats["local_search_solves"] > 0
+    assert probed.objective == pytest.approx(plain.objective, rel=OBJ_RTOL)
+    assert probed.x is not None and fp.problem.violation(probed.x) <= bnb.FEAS_TOL
+    assert probed.bound <= probed.objective * (1 + BOUND_RTOL)
+
+
+def test_probing_drops_only_members_no_better_plan_uses(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every member probing kills is checked by SCIP (an independent solver) on the problem with
+    that binary fixed to 1: infeasible, or no better than the plan the search returned."""
+    fp = build_footstep_problem(_scene(5, 1), ROBOT, 5)
+    _force_probing(monkeypatch)
+    search = bnb._Search(bnb.analyse(fp.problem), SolverOptions(gap=GAP), time.perf_counter())
+    res = search.run()
+    assert res.status is SolveStatus.OPTIMAL
+    dead = sorted(search.dead)
+    assert dead, "probing killed nothing: the test checks nothing"
+    for z in dead[:: max(1, len(dead) // 6)]:
+        fixed = solve(
+            fix_variables(fp.problem, np.array([z]), np.array([1.0])),
+            "scip",
+            SolverOptions(gap=GAP, time_limit=60.0),
+        )
+        assert fixed.status in (SolveStatus.OPTIMAL, SolveStatus.INFEASIBLE), fp.problem.names[z]
+        if fixed.status is SolveStatus.OPTIMAL:
+            assert fixed.objective >= res.objective * (1 - OBJ_RTOL), fp.problem.names[z]
+
+
+def test_worker_map_keeps_many_tasks_flowing_and_stops_at_its_deadline() -> None:
+    # all tasks sent at once filled both pipes and deadlocked the search and its workers
+    structure = bnb.analyse(_branching_problem())
+    relax = bnb.HullRelaxation(structure)
+    root = bnb._root_allowed(structure)
+    pool = bnb._Workers(relax, 2)
+    try:
+        out = pool.map("node", [(root, False)] * 300)
+        assert len(out) == 300 and all(r.status == "solved" for r in out)
+        assert len({round(r.bound, 9) for r in out}) == 1
+        assert pool.map("node", [(root, False)] * 5, deadline=0.0) == [None] * 5
+        assert pool.busy == 0
+    finally:
+        pool.close()
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_probing_in_the_middle_of_a_search_keeps_the_optimum(
+    threads: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # probing after some nodes: the open nodes lose the killed members and are solved again
+    fp = build_footstep_problem(random_stepping_stones(1, 8, robot=ROBOT), ROBOT, 8)
+    monkeypatch.setattr(bnb, "PROBE_ROUNDS", 0)
+    plain = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads))
+    monkeypatch.setattr(bnb, "PROBE_ROUNDS", 8)
+    monkeypatch.setattr(bnb, "PROBE_AFTER", 0.2)
+    monkeypatch.setattr(bnb, "PROBE_BUDGET", math.inf)
+    probed = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads))
+    assert plain.status is probed.status is SolveStatus.OPTIMAL
+    assert probed.stats["probed_at_node"] > 1 and probed.stats["probes"] > 0
+    assert probed.stats["probe_dropped"] > 0
+    assert probed.objective == pytest.approx(plain.objective, rel=OBJ_RTOL)
+    assert probed.x is not None and fp.problem.violation(probed.x) <= bnb.FEAS_TOL
+
+
+def test_probing_stays_within_its_budget(monkeypatch: pytest.MonkeyPatch) -> None:
+    fp = build_footstep_problem(random_stepping_stones(1, 8, robot=ROBOT), ROBOT, 8)
+    monkeypatch.setattr(bnb, "PROBE_AFTER", 1.0)
+    res = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=1))
+    assert res.status is SolveStatus.OPTIMAL
+    at = res.stats["probed_at_node"]
+    assert at is not None, "the search ended before probing: the test checks nothing"
+    for key in ("probes", "local_search_solves", "heuristic_nodes"):
+        assert res.stats[key] <= bnb.PROBE_BUDGET * at, key
+    assert res.stats["probes"] > 0

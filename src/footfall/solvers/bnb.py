@@ -52,7 +52,15 @@ group is a feasible point of the MIQCQP (the binaries are then set to those memb
 is solved exactly even when the interior-point weights are spread. Otherwise the group whose nearest
 member is violated most is split where the cumulative weight of its members (in index order, the
 angle order for segments) crosses 1/2 (SOS1 branching). Incumbents come from such nodes and a dive
-from the root (periodic rounding is available, off). With ``threads >= 2`` forked worker processes
+from the root (periodic rounding is available, off).
+
+Probing (``PROBE_ROUNDS``). A search still open after ``PROBE_AFTER`` nodes per undecided root member
+solves the root once with each member fixed and kills the members whose bound reaches the
+incumbent (or that are infeasible): no better point uses them, so every open node drops them (a
+node that loses any is solved again before it is branched), and the node problems shrink. One
+round ranks the members; two primal heuristics then look for a better incumbent (a search of at
+most ``HEUR_NODES`` nodes over each group's ``HEUR_TOP`` members of the lowest probe bound, and a
+one-group-at-a-time local search), and further rounds probe with it until a round kills nothing. With ``threads >= 2`` forked worker processes
 (:class:`_Workers`) solve the nodes asynchronously: whenever one is free, the best open node is
 branched and its children submitted; the dive runs in a worker meanwhile. The queue, incumbent and
 pruning stay in the calling process, so the search is the serial one with the node solves moved
@@ -141,6 +149,31 @@ ASYNC = True
 #: with threads >= 2, the search process solves nodes too, beside ``threads - 1`` workers (each
 #: kept two tasks deep so that it never waits while the search process is busy solving)
 LOCAL_SOLVES = False
+#: probing at the root: rounds in which the root relaxation is solved once with each member of every
+#: undecided group fixed; a member whose bound reaches the incumbent (or that is infeasible) is
+#: dropped for the whole search (0: no probing)
+PROBE_ROUNDS = 8
+#: probing rounds before the primal heuristics (whose incumbent the other rounds then use)
+PROBE_FIRST_ROUNDS = 1
+#: probe once the search has solved this many nodes per member of the root's undecided groups
+#: without finishing
+PROBE_AFTER = 2
+#: probing, the restricted search and the local search each solve at most this many relaxations
+#: per node the search had solved before probing (a search that would have ended soon after
+#: probing pays at most a few times again)
+PROBE_BUDGET = 1.0
+#: stop probing when a round dropped less than this share of the members it probed (and found
+#: no better incumbent)
+PROBE_MIN_DROP = 0.0
+#: after probing, search the root restricted to each group's ``HEUR_TOP`` members of the lowest
+#: probe bound (a small problem) for an incumbent, at most ``HEUR_NODES`` nodes (0: off)
+HEUR_TOP = 2
+HEUR_NODES = 1000
+#: then improve the incumbent by moving one group to another allowed member at a time (best
+#: improvement per sweep), at most this many sweeps (0: off)
+LS_SWEEPS = 20
+#: tasks in flight per worker in :meth:`_Workers.map`
+MAP_DEPTH = 2
 #: at the end of a parallel search, give the workers this long [s] to finish their solves in flight
 #: and exit before they are terminated (a node solve takes milliseconds; dives stop on a flag)
 DRAIN_TIMEOUT = 1.0
@@ -1965,15 +1998,30 @@ class _Workers:
                 raise self._died(sentinels[obj])
         return out
 
-    def map(self, kind: str, tasks: list[Any]) -> list[Any]:
-        """Results of ``tasks`` in their order, solved in the workers (for synchronous batches)."""
+    def map(self, kind: str, tasks: list[Any], deadline: float = math.inf) -> list[Any]:
+        """Results of ``tasks`` in their order, solved in the workers (for synchronous batches);
+        None for the tasks not sent before ``deadline`` (``time.perf_counter`` seconds).
+
+        At most ``MAP_DEPTH`` tasks per worker are in flight: a worker blocks sending its result
+        while its pipe is full, so sending it every task at once could deadlock both ends."""
         base = 1 << 40  # ids apart from the asynchronous tasks
-        for k, task in enumerate(tasks):
-            self.submit(base + k, kind, task)
         got: dict[int, Any] = {}
-        while len(got) < len(tasks):
-            got.update(self.wait(60.0))
-        return [got[base + k] for k in range(len(tasks))]
+        sent = 0
+        limit = len(tasks)
+        while len(got) < sent or sent < limit:
+            if time.perf_counter() > deadline:
+                limit = sent  # send no more; wait for those in flight
+            while sent < limit and self.busy < MAP_DEPTH * len(self.conns):
+                self.submit(base + sent, kind, tasks[sent])
+                sent += 1
+            if len(got) < sent:
+                got.update(self.wait(60.0))
+        return [got.get(base + k) for k in range(len(tasks))]
+
+    def drain(self) -> None:
+        """Wait for every task in flight and drop its result (the workers are then idle)."""
+        while self.busy:
+            self.wait(60.0)
 
     def close(self, grace: float = DRAIN_TIMEOUT) -> None:
         """Stop every worker and reap it: dives end early (shared flag), each worker finishes its
@@ -2022,13 +2070,21 @@ class _Workers:
 class _Search:
     """State of one branch-and-bound run (see the module docstring)."""
 
-    def __init__(self, structure: _Structure, options: SolverOptions, start: float) -> None:
+    def __init__(
+        self,
+        structure: _Structure,
+        options: SolverOptions,
+        start: float,
+        relax: HullRelaxation | None = None,
+    ) -> None:
         self.s = structure
         self.problem = structure.problem
         self.options = options
         self.start = start
         self.deadline = start + options.time_limit
-        self.relax = HullRelaxation(structure)
+        #: the search stops (as at the time limit) after this many nodes
+        self.node_limit = math.inf
+        self.relax = HullRelaxation(structure) if relax is None else relax
         self.incumbent: FloatArray | None = None
         self.inc_obj = math.inf
         self.tried: set[tuple[tuple[int, ...], ...]] = set()
@@ -2041,6 +2097,28 @@ class _Search:
         self.lost_bound = math.inf
         self.fixed_by_duals = 0
         self.strong_solves = 0
+        #: probing at the root: relaxations solved, members dropped
+        self.probes = 0
+        self.probe_dropped = 0
+        self.probe_time = 0.0
+        #: the root node's allowed members and relaxation point (for probing)
+        self.root: tuple[tuple[tuple[int, ...], ...], FloatArray] | None = None
+        #: probing: due after this many nodes; done; the members it killed, and the incumbent
+        #: objective they were last updated for
+        self.probe_at = math.inf
+        self.probe_budget = math.inf
+        self.probed_at: int | None = None
+        self.probe_gap = math.nan
+        self.probed = False
+        self.dead: set[int] = set()
+        self.dead_at = math.inf
+        #: the primal heuristics after probing: nodes of the restricted search, local-search
+        #: solves, objective of the incumbent before them
+        self.heur_nodes = 0
+        self.ls_solves = 0
+        self.heur_from = math.nan
+        #: member -> its bound in the last probing round that probed it
+        self.probe_bound: dict[int, float] = {}
         #: worker processes of the search (0: the search process solves every node)
         self.workers = 0
         #: (nodes, seconds, incumbent or None, best bound) every 25 nodes
@@ -2133,7 +2211,11 @@ class _Search:
         return res
 
     def run(self) -> SolverResult:
-        """Best-first branch and bound; returns the best plan with an honest gap."""
+        """Best-first branch and bound; returns the best plan with an honest gap.
+
+        With probing (``PROBE_ROUNDS``), a search still open after ``PROBE_AFTER`` nodes per
+        member of the root's undecided groups probes the root once (see :meth:`probe_now`): small
+        searches never pay for probing, and a large one keeps the nodes it has."""
         root_allowed = _root_allowed(self.s)
         timed_out = False
         root = None
@@ -2145,11 +2227,16 @@ class _Search:
         self.workers = 0 if pool is None else len(pool.procs)
         try:
             dive_from = None
-            if root is not None and root.x is not None and DIVE:
-                if pool is not None and ASYNC:
-                    dive_from = (root.x, root_allowed)  # one worker dives while the others branch
-                else:
-                    self.dive(root.x, root_allowed)
+            if root is not None and root.x is not None:
+                self.root = (root_allowed, root.x)
+                if PROBE_ROUNDS:
+                    undecided = sum(len(m) for m in root_allowed if len(m) > 1)
+                    self.probe_at = PROBE_AFTER * undecided
+                if DIVE:
+                    if pool is not None and ASYNC:
+                        dive_from = (root.x, root_allowed)  # a worker dives, the others branch
+                    else:
+                        self.dive(root.x, root_allowed)
             if pool is None or not ASYNC:
                 timed_out = self._loop(pool)
             else:
@@ -2158,6 +2245,235 @@ class _Search:
             if pool is not None:
                 pool.close()
         return self.result(timed_out)
+
+    @property
+    def probe_due(self) -> bool:
+        """Probing is due (see :meth:`run`) and has not run yet."""
+        return not self.probed and self.nodes >= self.probe_at
+
+    def probe_now(self, pool: _Workers | None) -> None:
+        """Probe the root (:meth:`probe`) with the incumbent, run the primal heuristics
+        (:meth:`restricted_search`, :meth:`local_search`) and probe again if they found a better
+        incumbent. The members probing drops are dead for the rest of the search: an open node
+        loses them when it is next taken from the queue (:meth:`narrowed`), and one that loses
+        any is solved again before it is branched. Called with no node solve in flight."""
+        self.probed = True
+        if self.root is None:
+            return
+        self.probed_at = self.nodes
+        self.probe_budget = PROBE_BUDGET * self.nodes
+        self.probe_gap = self.gap_of(min(nd.bound for nd in self.heap)) if self.heap else 0.0
+        start, root_x = self.root
+        # one round ranks the members for the heuristics; the rest use their incumbent
+        allowed = self.probe(start, root_x, pool, PROBE_FIRST_ROUNDS)
+        if all(allowed) and self.heap and self.gap_of(self.heap[0].bound) > self.options.gap:
+            self.heur_from = self.inc_obj
+            self.restricted_search(allowed, pool)
+            self.local_search(allowed, pool)
+        allowed = self.probe(allowed, None, pool, PROBE_ROUNDS)
+        kept = {z for mem in allowed for z in mem}
+        self.dead |= {z for mem in start for z in mem if z not in kept}
+        self.dead_at = self.inc_obj
+
+    def narrowed(self, allowed: tuple[tuple[int, ...], ...]) -> tuple[tuple[int, ...], ...] | None:
+        """``allowed`` without the dead members (see :meth:`probe_now`); None when a group loses
+        all of its members (no point of the node beats the incumbent). A better incumbent since
+        the last call first kills every member whose probe bound reaches it."""
+        if self.inc_obj < self.dead_at:
+            self.dead |= {z for z, b in self.probe_bound.items() if b >= self.inc_obj}
+            self.dead_at = self.inc_obj
+        if not self.dead:
+            return allowed
+        out = tuple(tuple(z for z in mem if z not in self.dead) for mem in allowed)
+        return out if all(out) else None
+
+    def probe(
+        self,
+        allowed: tuple[tuple[int, ...], ...],
+        root_x: FloatArray | None,
+        pool: _Workers | None,
+        rounds: int,
+    ) -> tuple[tuple[int, ...], ...]:
+        """Probing: solve the root relaxation with each member of every undecided group fixed,
+        and drop the members whose bound reaches the incumbent or that are infeasible. Exact:
+        every point using a dropped member costs at least the incumbent, and every node's allowed
+        members are a subset of the root's. A probe whose relaxation point is integral offers it
+        as incumbent. First the bounds of earlier rounds drop what they can against the current
+        incumbent; rounds then repeat on the smaller root while they drop anything (at most
+        ``rounds``; without an incumbent, the next round dives first from the smaller root
+        ``root_x``). Returns the allowed members (some group may be left empty)."""
+        t0 = time.perf_counter()
+        try:
+            return self._probe_rounds(allowed, root_x, pool, rounds)
+        finally:
+            self.probe_time += time.perf_counter() - t0
+
+    def _narrow(
+        self, allowed: tuple[tuple[int, ...], ...], drop: set[int]
+    ) -> tuple[tuple[int, ...], ...]:
+        """``allowed`` without the members ``drop`` (groups with one member are kept as they are);
+        counts the dropped members."""
+        out = tuple(
+            mem if len(mem) == 1 else tuple(z for z in mem if z not in drop) for mem in allowed
+        )
+        self.probe_dropped += sum(map(len, allowed)) - sum(map(len, out))
+        return out
+
+    def _probe_rounds(
+        self,
+        allowed: tuple[tuple[int, ...], ...],
+        root_x: FloatArray | None,
+        pool: _Workers | None,
+        rounds: int,
+    ) -> tuple[tuple[int, ...], ...]:
+        """The body of :meth:`probe`."""
+        known = {z for z, b in self.probe_bound.items() if b >= self.inc_obj}
+        if known:
+            narrowed = self._narrow(allowed, known)
+            if narrowed != allowed:
+                allowed = narrowed
+                root_x = None
+        for rnd in range(rounds):
+            if not all(allowed) or time.perf_counter() > self.deadline:
+                break
+            if DIVE and not math.isfinite(self.inc_obj):
+                if root_x is None and rnd:
+                    top = self.relax.solve(allowed)
+                    root_x = top.x if top.status == "solved" else None
+                if root_x is not None and rnd:
+                    self.dive(root_x, allowed)  # the smaller root may lead the dive to a plan
+            before = self.inc_obj
+            tasks = [(g, z) for g, mem in enumerate(allowed) if len(mem) > 1 for z in mem]
+            if not tasks or self.probes + len(tasks) > self.probe_budget:
+                break
+            fixed = []
+            for g, z in tasks:
+                one = list(allowed)
+                one[g] = (z,)
+                fixed.append(tuple(one))
+            results = self._probe_solves(fixed, pool)
+            self.probes += sum(res is not None for res in results)
+            for (_, z), a, res in zip(tasks, fixed, results, strict=True):
+                if res is None:
+                    continue  # not solved before the time limit: kept
+                if res.status == "solved":
+                    self.probe_bound[z] = res.bound
+                elif res.status == "infeasible":
+                    self.probe_bound[z] = math.inf
+                if res.status == "solved" and res.x is not None:
+                    chosen = _choice(self.s, res.x, a, ROW_TOL)
+                    if chosen is not None:
+                        self.offer(_finish(self.s, res.x, chosen))
+            # against the best incumbent now (a probe may have found a better one)
+            drop = {z for _, z in tasks if self.probe_bound.get(z, -math.inf) >= self.inc_obj}
+            root_x = None
+            if drop:
+                allowed = self._narrow(allowed, drop)
+            few = len(drop) < PROBE_MIN_DROP * len(tasks)
+            if not drop or (few and self.inc_obj >= before and math.isfinite(self.inc_obj)):
+                break
+        return allowed
+
+    def _probe_solves(
+        self, fixed: list[tuple[tuple[int, ...], ...]], pool: _Workers | None
+    ) -> list[_Relaxation | None]:
+        """The relaxations of the probes ``fixed``, in the workers when there are any; None for a
+        probe not solved before the time limit."""
+        if pool is not None:
+            return pool.map("node", [(a, False) for a in fixed], self.deadline)
+        out: list[_Relaxation | None] = []
+        for a in fixed:
+            if time.perf_counter() > self.deadline:
+                out.append(None)
+                continue
+            res = self.relax.solve(a)
+            if res.status == "failed":  # as in _work
+                res = self.relax.solve(a, full=True)
+            out.append(res)
+        return out
+
+    def restricted_search(
+        self, allowed: tuple[tuple[int, ...], ...], pool: _Workers | None
+    ) -> None:
+        """Primal heuristic: branch and bound (at most ``HEUR_NODES`` nodes, cut off at the
+        incumbent) over ``allowed`` restricted to each group's ``HEUR_TOP`` members of the lowest
+        probe bound; its best point is offered as incumbent. The restricted problem is small, and
+        its optimum is often the full problem's (the probe bounds rank the members well)."""
+        if not (HEUR_TOP and HEUR_NODES):
+            return
+        rank = self.probe_bound
+        small = tuple(
+            mem if len(mem) <= HEUR_TOP
+            else tuple(sorted(mem, key=lambda z: (rank.get(z, -math.inf), z))[:HEUR_TOP])
+            for mem in allowed
+        )  # fmt: skip
+        if small == allowed:
+            return  # the restricted problem is the search itself
+        limit = min(HEUR_NODES, self.probe_budget)
+        sub = _Search(self.s, self.options, self.start, self.relax)
+        sub.deadline = self.deadline
+        sub.node_limit = limit
+        sub.incumbent, sub.inc_obj = self.incumbent, self.inc_obj
+        sub.tried = self.tried
+        sub.evaluate(small, -math.inf, 0, False)
+        try:
+            if pool is None or not ASYNC:
+                sub._loop(pool)
+            else:
+                sub._loop_async(pool, None)
+        finally:
+            if pool is not None:
+                pool.drain()  # the restricted search may leave solves in flight
+            self.heur_nodes += sub.nodes
+        if sub.incumbent is not None:
+            self.offer(sub.incumbent)
+
+    def local_search(self, allowed: tuple[tuple[int, ...], ...], pool: _Workers | None) -> None:
+        """Primal heuristic: from the incumbent's members, solve every assignment that moves one
+        group to another allowed member (all groups fixed: one convex solve each) and take the
+        best improvement; repeat for at most ``LS_SWEEPS`` sweeps."""
+        if self.incumbent is None or not LS_SWEEPS:
+            return
+        x = self.incumbent
+        cur = [mem[int(np.argmax(x[list(mem)]))] for mem in _root_allowed(self.s)]
+        for _ in range(LS_SWEEPS):
+            if time.perf_counter() > self.deadline:
+                return
+            moves: list[tuple[tuple[int, ...], ...]] = []
+            for g, mem in enumerate(allowed):
+                for z in mem:
+                    if z != cur[g]:
+                        one: list[tuple[int, ...]] = [(m,) for m in cur]
+                        one[g] = (z,)
+                        moves.append(tuple(one))
+            moves = [a for a in moves if a not in self.tried]
+            if not moves or self.ls_solves + len(moves) > self.probe_budget:
+                return
+            results = self._probe_solves(moves, pool)
+            self.ls_solves += sum(res is not None for res in results)
+            order = sorted(
+                (res.bound, k)
+                for k, res in enumerate(results)
+                if res is not None and res.status == "solved" and res.x is not None
+            )
+            before = self.inc_obj
+            for bound, k in order:
+                if bound >= self.inc_obj:
+                    break
+                a, res = moves[k], results[k]
+                assert res is not None and res.x is not None
+                self.tried.add(a)
+                if not self.offer(_finish(self.s, res.x, a)):
+                    # the condensed point broke a dropped bound: the full model decides
+                    self.tried.discard(a)
+                    self.solve_fixed(a)
+                if self.inc_obj < before:
+                    cur = [m[0] for m in a]
+                    break
+            else:
+                return
+            if self.inc_obj >= before:
+                return
 
     def _loop(self, pool: _Workers | None) -> bool:
         """The best-first loop; returns True when stopped by the time limit. With a ``pool``, the
@@ -2170,14 +2486,23 @@ class _Search:
                 self.trace.append((self.nodes, time.perf_counter() - self.start, inc, top))
             if self.gap_of(top) <= self.options.gap:
                 break
-            if time.perf_counter() > self.deadline:
+            if time.perf_counter() > self.deadline or self.nodes >= self.node_limit:
                 return True
+            if self.probe_due:
+                self.probe_now(pool)
+                continue
             tasks: list[tuple[tuple[tuple[int, ...], ...], _Node]] = []
             while self.heap and len(tasks) < 2 * batch:
                 node = heapq.heappop(self.heap)
                 if node.bound >= self.inc_obj:
                     continue
                 assert node.x is not None
+                narrowed = self.narrowed(node.allowed)
+                if narrowed is None:
+                    continue
+                if narrowed != node.allowed:  # it lost dead members: solve it again first
+                    tasks.append((narrowed, node))
+                    continue
                 allowed = node.allowed
                 if REDUCED_COST_FIXING and node.zdual is not None and math.isfinite(self.inc_obj):
                     allowed = _fix_by_duals(allowed, node.bound + node.zdual, self.inc_obj)
@@ -2253,11 +2578,20 @@ class _Search:
         while True:
             # Branch until every worker has a task: counting the tasks in flight instead left a
             # worker idle whenever both children of a node had gone to the other worker's queue.
-            while self.heap and (len(inflight) < threads if LOCAL_SOLVES else pool.idle):
+            due = self.probe_due
+            while (
+                self.heap and not due and (len(inflight) < threads if LOCAL_SOLVES else pool.idle)
+            ):
                 node = heapq.heappop(self.heap)
                 if node.bound >= self.inc_obj:
                     continue
                 assert node.x is not None
+                allowed = self.narrowed(node.allowed)
+                if allowed is None:
+                    continue
+                if allowed != node.allowed:  # it lost dead members: solve it again first
+                    submit("node", (allowed, node.full), allowed, node)
+                    continue
                 split = _branch(self.s, node.x, node.allowed, ROW_TOL)
                 if split is None:  # pragma: no cover - evaluate() resolved such nodes
                     continue
@@ -2280,6 +2614,11 @@ class _Search:
                 self.trace.append((self.nodes, time.perf_counter() - self.start, inc, top))
             if self.gap_of(top) <= self.options.gap:
                 return False
+            if self.nodes >= self.node_limit:
+                return True
+            if due and not inflight:
+                self.probe_now(pool)
+                continue
             if not answered and mine:
                 if time.perf_counter() > self.deadline:
                     return True
@@ -2377,6 +2716,14 @@ class _Search:
                 "condensed": self.relax.condensed is not None,
                 "fixed_by_duals": self.fixed_by_duals,
                 "strong_solves": self.strong_solves,
+                "probes": self.probes,
+                "probe_dropped": self.probe_dropped,
+                "probe_time_s": self.probe_time,
+                "probed_at_node": self.probed_at,
+                "gap_when_probed": self.probe_gap,
+                "heuristic_nodes": self.heur_nodes,
+                "local_search_solves": self.ls_solves,
+                "incumbent_before_heuristics": self.heur_from,
                 "workers": self.workers,
                 "trace": self.trace,
             },
