@@ -2265,12 +2265,16 @@ class _Search:
         self.probe_gap = self.gap_of(min(nd.bound for nd in self.heap)) if self.heap else 0.0
         start, root_x = self.root
         # one round ranks the members for the heuristics; the rest use their incumbent
+        t0 = time.perf_counter()
         allowed = self.probe(start, root_x, pool, PROBE_FIRST_ROUNDS)
+        self.probe_time += time.perf_counter() - t0
         if all(allowed) and self.heap and self.gap_of(self.heap[0].bound) > self.options.gap:
             self.heur_from = self.inc_obj
             self.restricted_search(allowed, pool)
             self.local_search(allowed, pool)
+        t0 = time.perf_counter()
         allowed = self.probe(allowed, None, pool, PROBE_ROUNDS)
+        self.probe_time += time.perf_counter() - t0
         kept = {z for mem in allowed for z in mem}
         self.dead |= {z for mem in start for z in mem if z not in kept}
         self.dead_at = self.inc_obj
@@ -2302,31 +2306,6 @@ class _Search:
         incumbent; rounds then repeat on the smaller root while they drop anything (at most
         ``rounds``; without an incumbent, the next round dives first from the smaller root
         ``root_x``). Returns the allowed members (some group may be left empty)."""
-        t0 = time.perf_counter()
-        try:
-            return self._probe_rounds(allowed, root_x, pool, rounds)
-        finally:
-            self.probe_time += time.perf_counter() - t0
-
-    def _narrow(
-        self, allowed: tuple[tuple[int, ...], ...], drop: set[int]
-    ) -> tuple[tuple[int, ...], ...]:
-        """``allowed`` without the members ``drop`` (groups with one member are kept as they are);
-        counts the dropped members."""
-        out = tuple(
-            mem if len(mem) == 1 else tuple(z for z in mem if z not in drop) for mem in allowed
-        )
-        self.probe_dropped += sum(map(len, allowed)) - sum(map(len, out))
-        return out
-
-    def _probe_rounds(
-        self,
-        allowed: tuple[tuple[int, ...], ...],
-        root_x: FloatArray | None,
-        pool: _Workers | None,
-        rounds: int,
-    ) -> tuple[tuple[int, ...], ...]:
-        """The body of :meth:`probe`."""
         known = {z for z, b in self.probe_bound.items() if b >= self.inc_obj}
         if known:
             narrowed = self._narrow(allowed, known)
@@ -2373,6 +2352,17 @@ class _Search:
             if not drop or (few and self.inc_obj >= before and math.isfinite(self.inc_obj)):
                 break
         return allowed
+
+    def _narrow(
+        self, allowed: tuple[tuple[int, ...], ...], drop: set[int]
+    ) -> tuple[tuple[int, ...], ...]:
+        """``allowed`` without the members ``drop`` (groups with one member are kept as they are);
+        counts the dropped members."""
+        out = tuple(
+            mem if len(mem) == 1 else tuple(z for z in mem if z not in drop) for mem in allowed
+        )
+        self.probe_dropped += sum(map(len, allowed)) - sum(map(len, out))
+        return out
 
     def _probe_solves(
         self, fixed: list[tuple[tuple[int, ...], ...]], pool: _Workers | None
