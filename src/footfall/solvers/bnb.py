@@ -1636,14 +1636,18 @@ def _choice(
     return tuple(out)
 
 
+def _without(allowed: tuple[tuple[int, ...], ...], drop: set[int]) -> tuple[tuple[int, ...], ...]:
+    """``allowed`` without the members ``drop``; a group with one member keeps it."""
+    return tuple(
+        mem if len(mem) == 1 else tuple(z for z in mem if z not in drop) for mem in allowed
+    )
+
+
 def _fix_by_duals(
     allowed: tuple[tuple[int, ...], ...], member_bound: FloatArray, incumbent: float
 ) -> tuple[tuple[int, ...], ...]:
     """Drop the members whose bound with ``z = 1`` (``member_bound[z]``) reaches the incumbent."""
-    return tuple(
-        mem if len(mem) == 1 else tuple(z for z in mem if member_bound[z] < incumbent)
-        for mem in allowed
-    )
+    return _without(allowed, {z for mem in allowed for z in mem if member_bound[z] >= incumbent})
 
 
 def _rounded(x: FloatArray, allowed: tuple[tuple[int, ...], ...]) -> tuple[tuple[int, ...], ...]:
@@ -2103,13 +2107,13 @@ class _Search:
         self.probe_time = 0.0
         #: the root node's allowed members and relaxation point (for probing)
         self.root: tuple[tuple[tuple[int, ...], ...], FloatArray] | None = None
-        #: probing: due after this many nodes; done; the members it killed, and the incumbent
-        #: objective they were last updated for
+        #: probing: due after this many nodes; its budget (relaxations per part, see
+        #: ``PROBE_BUDGET``); nodes solved when it ran (None: not yet) and the gap then; the
+        #: members it killed, and the incumbent objective they were last updated for
         self.probe_at = math.inf
         self.probe_budget = math.inf
         self.probed_at: int | None = None
         self.probe_gap = math.nan
-        self.probed = False
         self.dead: set[int] = set()
         self.dead_at = math.inf
         #: the primal heuristics after probing: nodes of the restricted search, local-search
@@ -2249,7 +2253,7 @@ class _Search:
     @property
     def probe_due(self) -> bool:
         """Probing is due (see :meth:`run`) and has not run yet."""
-        return not self.probed and self.nodes >= self.probe_at
+        return self.probed_at is None and self.nodes >= self.probe_at
 
     def probe_now(self, pool: _Workers | None) -> None:
         """Probe the root (:meth:`probe`) with the incumbent, run the primal heuristics
@@ -2257,12 +2261,11 @@ class _Search:
         incumbent. The members probing drops are dead for the rest of the search: an open node
         loses them when it is next taken from the queue (:meth:`narrowed`), and one that loses
         any is solved again before it is branched. Called with no node solve in flight."""
-        self.probed = True
+        self.probed_at = self.nodes
         if self.root is None:
             return
-        self.probed_at = self.nodes
         self.probe_budget = PROBE_BUDGET * self.nodes
-        self.probe_gap = self.gap_of(min(nd.bound for nd in self.heap)) if self.heap else 0.0
+        self.probe_gap = self.gap_of(self.heap[0].bound) if self.heap else 0.0
         start, root_x = self.root
         # one round ranks the members for the heuristics; the rest use their incumbent
         t0 = time.perf_counter()
@@ -2356,11 +2359,8 @@ class _Search:
     def _narrow(
         self, allowed: tuple[tuple[int, ...], ...], drop: set[int]
     ) -> tuple[tuple[int, ...], ...]:
-        """``allowed`` without the members ``drop`` (groups with one member are kept as they are);
-        counts the dropped members."""
-        out = tuple(
-            mem if len(mem) == 1 else tuple(z for z in mem if z not in drop) for mem in allowed
-        )
+        """:func:`_without`, counting the dropped members."""
+        out = _without(allowed, drop)
         self.probe_dropped += sum(map(len, allowed)) - sum(map(len, out))
         return out
 
