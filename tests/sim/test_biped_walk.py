@@ -571,3 +571,19 @@ def test_walk_plan_cache_is_not_reused_for_an_edited_scene_of_the_same_name(tmp_
     mid = 0.5 * (other.footsteps[-1, :2] + other.footsteps[-2, :2])
     assert mid == pytest.approx([0.7, 0.0], abs=1e-6)
     assert first.footsteps[-1, 0] != pytest.approx(other.footsteps[-1, 0])
+
+
+def test_a_plan_for_another_robot_is_refused_unless_asked_for() -> None:
+    # the scene's own robot (32 kg, CoM 0.60 m) is not the MuJoCo biped (30.1 kg, 0.67 m)
+    scene = builtin_scene("flat")
+    scene = replace(scene, goal=Goal(np.array([1.0, 0.0, 0.0]), 0.0))
+    plan = make_plan(scene, "reactive", robot=scene.robot)
+    with pytest.raises(InputError, match=r"plan\.robot\.mass: got 32\.0.*planner_params") as err:
+        walk(scene, plan)
+    assert "check_robot=False" in str(err.value)
+    # with the check off, the walk goes on to its next input check (a cheap way to show it ran)
+    with pytest.raises(InputError, match="control_dt"):
+        walk(scene, plan, WalkOptions(check_robot=False, control_dt=0.0105))
+    taller = replace(planner_params(base=scene.robot), com_height=0.80)
+    with pytest.raises(InputError, match=r"plan\.robot\.com_height"):
+        walk(scene, make_plan(scene, "reactive", robot=taller))

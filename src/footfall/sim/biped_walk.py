@@ -50,6 +50,7 @@ from footfall.sim.biped_model import (
     BipedModel,
     BipedSimSettings,
     WalkerModel,
+    measure_model,
     require_mujoco,
 )
 from footfall.sim.terrain_mjcf import terrain_xml
@@ -78,6 +79,9 @@ VIDEO_FPS = 30
 #: heading segments: 0.139 m short of the goal with none, 0.029 m with 2; flat_long N = 20:
 #: 0.004 / 0.024 m, both at the goal)
 STOP_STEPS = 2
+#: a plan's robot mass and CoM height may differ this much (relative) from the walker model's
+#: (:func:`~footfall.sim.biped_model.planner_params` measures them: 0.0 exactly)
+PLAN_ROBOT_RTOL = 0.01
 #: sole-pose and CoM costs of the inverse kinematics: the feet must be where they are (the stance
 #: foot cannot move), the CoM is the ALIP's; torso and posture are secondary
 FOOT_POSITION_COST = 10.0
@@ -206,6 +210,9 @@ class WalkOptions:
             its measured pose, leaving the horizontal CoM to the pendulum and the adjuster.
             False: the IK integrates its own kinematic copy (open loop; the robot fell within a
             few steps on every scene).
+        check_robot: refuse a plan whose robot mass or CoM height differs by more than
+            ``PLAN_ROBOT_RTOL`` from the walker model's (:func:`planner_params`): its ALIP motion
+            is then another pendulum's. False walks such a plan on purpose (a mismatch study).
     """
 
     control_dt: float = 0.01
@@ -228,6 +235,7 @@ class WalkOptions:
     landing_margin: float = 0.02
     riser_tolerance: float = RISER_LANDING_TOLERANCE
     passive_landing: bool = True
+    check_robot: bool = True
 
     def __post_init__(self) -> None:
         for name in ("control_dt", "swing_clearance", "shift_time", "stop_time"):
@@ -1219,6 +1227,25 @@ def _ds_propagator(alip: ALIP, dt: float) -> FloatArray:
     return np.asarray(expm(m * dt))
 
 
+def _check_plan_robot(robot: BipedParams, model: WalkerModel | None) -> None:
+    """Raise :class:`InputError` when the plan's robot is not the walker model's pendulum (mass
+    and CoM height within ``PLAN_ROBOT_RTOL``, see :func:`planner_params`)."""
+    info = measure_model(model)
+    name = (model if model is not None else BipedModel()).name
+    for field_name, planned, actual, unit in (
+        ("mass", robot.mass, info.mass, "kg"),
+        ("com_height", robot.com_height, info.com_height, "m"),
+    ):
+        if abs(planned - actual) > PLAN_ROBOT_RTOL * abs(actual):
+            raise InputError(
+                f"plan.robot.{field_name}",
+                planned,
+                f"the {name} model's {actual:.4g} {unit} within {PLAN_ROBOT_RTOL:.0%}: plan with "
+                "footfall.sim.biped_model.planner_params(model) as the robot, or walk a "
+                "mismatched plan on purpose with WalkOptions(check_robot=False)",
+            )
+
+
 def walk(
     scene: Scene,
     plan: FootstepPlan,
@@ -1250,7 +1277,8 @@ def walk(
         A :class:`WalkResult`.
 
     Raises:
-        InputError: when the plan has no footsteps or does not start on the scene's start feet.
+        InputError: when the plan has no footsteps, does not start on the scene's start feet, or
+            was made for another robot's mass or CoM height (see ``WalkOptions.check_robot``).
     """
     opts = options if options is not None else WalkOptions()
     if not plan.has_solution or plan.n_steps < 1:
@@ -1263,6 +1291,8 @@ def walk(
             plan.footsteps[0].tolist(),
             f"the scene's start stance foot {start_stance.tolist()}",
         )
+    if opts.check_robot:
+        _check_plan_robot(robot, model_params)
     sim = BipedSim(scene, model_params, settings)
     mj, m, d = sim.mujoco, sim.model, sim.data
     substeps = round(opts.control_dt / m.opt.timestep)
