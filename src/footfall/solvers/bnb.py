@@ -60,14 +60,17 @@ incumbent (or that are infeasible): no better point uses them, so every open nod
 node that loses any is solved again before it is branched), and the node problems shrink. One
 round ranks the members; two primal heuristics then look for a better incumbent (a search of at
 most ``HEUR_NODES`` nodes over each group's ``HEUR_TOP`` members of the lowest probe bound, and a
-one-group-at-a-time local search), and further rounds probe with it until a round kills nothing. With ``threads >= 2`` forked worker processes
-(:class:`_Workers`) solve the nodes asynchronously: whenever one is free, the best open node is
-branched and its children submitted; the dive runs in a worker meanwhile. The queue, incumbent and
-pruning stay in the calling process, so the search is the serial one with the node solves moved
-out (node order may differ, the optimum within the gap does not). A worker that dies or raises
-stops the search with :class:`WorkerError`; every worker is reaped however the search ends. The search stops when ``(incumbent - bound) / min(|incumbent|,
-|bound|) <= gap`` (SCIP's definition) or at the time limit, returning the best point and an honest
-gap; a node whose solve fails numerically makes the result ``feasible`` at best, never ``optimal``.
+one-group-at-a-time local search), and further rounds probe with it until a round kills nothing.
+
+With ``threads >= 2`` forked worker processes (:class:`_Workers`) solve the nodes asynchronously:
+whenever one is free, the best open node is branched and its children submitted; the dive runs in
+a worker meanwhile. The queue, incumbent and pruning stay in the calling process, so the search is
+the serial one with the node solves moved out (node order may differ, the optimum within the gap
+does not). A worker that dies or raises stops the search with :class:`WorkerError`; every worker
+is reaped however the search ends. The search stops when ``(incumbent - bound) /
+min(|incumbent|, |bound|) <= gap`` (SCIP's definition) or at the time limit, returning the best
+point and an honest gap; a node whose solve fails numerically makes the result ``feasible`` at
+best, never ``optimal``.
 """
 
 from __future__ import annotations
@@ -159,8 +162,8 @@ PROBE_FIRST_ROUNDS = 1
 #: without finishing
 PROBE_AFTER = 2
 #: probing, the restricted search and the local search each solve at most this many relaxations
-#: per node the search had solved before probing (a search that would have ended soon after
-#: probing pays at most a few times again)
+#: per node the search had solved before probing: together at most three times the work before
+#: probing, for a search that would have ended just after it
 PROBE_BUDGET = 1.0
 #: stop probing when a round dropped less than this share of the members it probed (and found
 #: no better incumbent)
