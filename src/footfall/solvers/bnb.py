@@ -2259,9 +2259,9 @@ class _Search:
         return self.probed_at is None and self.nodes >= self.probe_at
 
     def probe_now(self, pool: _Workers | None) -> None:
-        """Probe the root (:meth:`probe`) with the incumbent, run the primal heuristics
-        (:meth:`restricted_search`, :meth:`local_search`) and probe again if they found a better
-        incumbent. The members probing drops are dead for the rest of the search: an open node
+        """Probe the root (:meth:`probe`, ``PROBE_FIRST_ROUNDS`` rounds) with the incumbent, run
+        the primal heuristics (:meth:`restricted_search`, :meth:`local_search`), then probe on
+        (up to ``PROBE_ROUNDS`` rounds) with their incumbent. The members probing drops are dead for the rest of the search: an open node
         loses them when it is next taken from the queue (:meth:`narrowed`), and one that loses
         any is solved again before it is branched. Called with no node solve in flight."""
         self.probed_at = self.nodes
@@ -2290,12 +2290,16 @@ class _Search:
         all of its members (no point of the node beats the incumbent). A better incumbent since
         the last call first kills every member whose probe bound reaches it."""
         if self.inc_obj < self.dead_at:
-            self.dead |= {z for z, b in self.probe_bound.items() if b >= self.inc_obj}
+            self.dead |= self._beaten()
             self.dead_at = self.inc_obj
         if not self.dead:
             return allowed
         out = tuple(tuple(z for z in mem if z not in self.dead) for mem in allowed)
         return out if all(out) else None
+
+    def _beaten(self) -> set[int]:
+        """The probed members whose probe bound reaches the incumbent."""
+        return {z for z, b in self.probe_bound.items() if b >= self.inc_obj}
 
     def probe(
         self,
@@ -2312,7 +2316,7 @@ class _Search:
         incumbent; rounds then repeat on the smaller root while they drop anything (at most
         ``rounds``; without an incumbent, the next round dives first from the smaller root
         ``root_x``). Returns the allowed members (some group may be left empty)."""
-        known = {z for z, b in self.probe_bound.items() if b >= self.inc_obj}
+        known = self._beaten()
         if known:
             narrowed = self._narrow(allowed, known)
             if narrowed != allowed:
@@ -2321,12 +2325,13 @@ class _Search:
         for rnd in range(rounds):
             if not all(allowed) or time.perf_counter() > self.deadline:
                 break
-            if DIVE and not math.isfinite(self.inc_obj):
-                if root_x is None and rnd:
+            if rnd and DIVE and not math.isfinite(self.inc_obj):
+                # no incumbent yet: the smaller root may lead the dive to a plan
+                if root_x is None:
                     top = self.relax.solve(allowed)
                     root_x = top.x if top.status == "solved" else None
-                if root_x is not None and rnd:
-                    self.dive(root_x, allowed)  # the smaller root may lead the dive to a plan
+                if root_x is not None:
+                    self.dive(root_x, allowed)
             before = self.inc_obj
             tasks = [(g, z) for g, mem in enumerate(allowed) if len(mem) > 1 for z in mem]
             if not tasks or self.probes + len(tasks) > self.probe_budget:
