@@ -29,9 +29,9 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
 
-import footfall.sim.reduced as reduced
-from footfall.bench import bench_sim, bench_sim_options, format_sim_table
+import footfall.sim.reduced.closed_loop as reduced
 from footfall.control import MPC, CondensedMPC, build_mpc
+from footfall.experiments.bench import bench_sim, bench_sim_options, format_sim_table
 from footfall.planning.reactive import plan_reactive
 from footfall.sim import simulate
 from footfall.terrain import builtin_scene

@@ -4,7 +4,7 @@ Usage (from the repository root):
 
     PYTHONPATH=src python benchmarks/bench_plan.py --steps 6,10,15 --nodes 5,10 --seeds 0,1,2
 
-Prints the markdown table of :func:`footfall.bench.format_table` and, with ``--json``, writes every
+Prints the markdown table of :func:`footfall.experiments.bench.format_table` and, with ``--json``, writes every
 run. Same as ``footfall bench plan``.
 """
 
@@ -15,7 +15,7 @@ import json
 import sys
 from pathlib import Path
 
-from footfall.bench import bench_plan, format_table, rows_to_dict
+from footfall.experiments.bench import bench_plan, format_table, rows_to_dict
 
 
 def _ints(text: str) -> list[int]:

@@ -11,8 +11,8 @@ import sys
 import time
 from pathlib import Path
 
-from footfall.sim.biped_compare import plan_for_walk
-from footfall.sim.biped_walk import walk
+from footfall.sim.biped.plans import plan_for_walk
+from footfall.sim.biped.walk import walk
 from footfall.terrain import builtin_scene
 
 

@@ -15,10 +15,10 @@ from pathlib import Path
 import numpy as np
 
 from footfall.planning import make_plan
-from footfall.sim.biped_model import planner_params
-from footfall.sim.biped_plot import plot_walk
-from footfall.sim.biped_walk import walk
+from footfall.sim.biped.model import planner_params
+from footfall.sim.biped.walk import walk
 from footfall.terrain import builtin_scene
+from footfall.viz.walk_plot import plot_walk
 
 N_STEPS = 20
 

@@ -6,13 +6,41 @@ first vertex. "CCW" means a positive signed (shoelace) area.
 
 from __future__ import annotations
 
-import numpy as np
-from numpy.typing import ArrayLike, NDArray
+import math
 
-FloatArray = NDArray[np.float64]
+import numpy as np
+from numpy.typing import ArrayLike
+
+from footfall._typing import FloatArray
 
 #: turning angles smaller than this [rad] count as straight (collinear vertices are allowed)
 ANGLE_TOL = 1e-9
+
+
+def rot2(theta: float) -> FloatArray:
+    """2-D rotation matrix Rot(theta) (2, 2) of eq. (5.13): ``rot2(theta) @ v`` turns ``v`` by
+    ``theta`` [rad] counter-clockwise."""
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s], [s, c]])
+
+
+def project_to_polygon(q: FloatArray, vertices: FloatArray) -> FloatArray:
+    """Closest point (2,) of a convex CCW polygon (V, 2) to ``q`` (2,) [m] (``q`` itself inside)."""
+    v = np.asarray(vertices, dtype=float)
+    nxt = np.roll(v, -1, axis=0)
+    edge = nxt - v
+    # inside when left of every CCW edge
+    cross = edge[:, 0] * (q[1] - v[:, 1]) - edge[:, 1] * (q[0] - v[:, 0])
+    if np.all(cross >= 0.0):
+        return np.array(q, dtype=float)
+    best, best_d = np.array(q, dtype=float), math.inf
+    for a, e in zip(v, edge, strict=True):
+        s = float(np.clip((q - a) @ e / (e @ e), 0.0, 1.0))
+        p = a + s * e
+        dist = float(np.linalg.norm(q - p))
+        if dist < best_d:
+            best, best_d = p, dist
+    return best
 
 
 def signed_area(vertices: FloatArray) -> float:

@@ -60,3 +60,14 @@ def finite_vector(field: str, value: object, length: int | None = None) -> NDArr
     if not np.all(np.isfinite(arr)):
         raise InputError(field, value, "finite numbers (no NaN or inf)")
     return arr
+
+
+def names_in(field: str, names: Sequence[str], valid: Sequence[str]) -> list[str]:
+    """``names`` stripped of blanks, each checked to be one of ``valid`` (at least one name)."""
+    out = [n.strip() for n in names if n.strip()]
+    if not out:
+        raise InputError(field, ",".join(names), f"one or more of {', '.join(valid)}")
+    for n in out:
+        if n not in valid:
+            raise InputError(field, n, f"one of {', '.join(valid)}")
+    return out

@@ -14,7 +14,7 @@ import typer
 from rich.console import Console
 
 from footfall._io import write_json
-from footfall._validate import non_negative
+from footfall._validate import names_in, non_negative
 from footfall.errors import FootfallError, InputError
 
 app = typer.Typer(
@@ -143,7 +143,7 @@ def lip(
 @app.command()
 def demo(out: Path = typer.Option(Path("out/demo"), help="Output folder.")) -> None:
     """Run the main demo on built-in defaults and write figures and JSON into OUT."""
-    from footfall.demo import run_demo
+    from footfall.experiments.demo import run_demo
 
     labels = {
         "lip": "LIP walks (document 004)",
@@ -278,7 +278,6 @@ def plan(
     """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists."""
     from footfall.planning import PlannerOptions, check_plan, make_plan, plan_min_steps
     from footfall.planning.plan import check_planner_name
-    from footfall.planning.plan_io import plan_to_dict
     from footfall.viz.plan_plot import plot_plan
 
     check_planner_name(planner)
@@ -296,8 +295,8 @@ def plan(
     )
     robot_params = None
     if robot is not None:
-        from footfall.sim.biped_compare import robot_model
-        from footfall.sim.biped_model import planner_params
+        from footfall.sim.biped.model import planner_params
+        from footfall.sim.biped.plans import robot_model
 
         robot_params = planner_params(robot_model(robot), base=sc.robot)
     with console.status(f"planning {sc.name} with {planner} ...") as status:
@@ -309,7 +308,7 @@ def plan(
             result = plan_min_steps(sc, planner, options, progress=progress, robot=robot_params)
         else:
             result = make_plan(sc, planner, steps, options, robot_params)
-    payload = plan_to_dict(result, sc.name)
+    payload = result.to_dict(sc.name)
     if result.has_solution:
         report = check_plan(result, sc)
         payload["check"] = {"ok": report.ok, "violations": report.summary().splitlines()}
@@ -350,7 +349,7 @@ def quadruped_cmd(
         # must be chosen before MuJoCo is imported; EGL works headless here
         os.environ.setdefault("MUJOCO_GL", "egl")
     from footfall.quadruped import GaitParams, QuadrupedRobot, ZmpStrategy, plan_gait
-    from footfall.sim.quadruped_sim import simulate
+    from footfall.sim.quadruped.sim import simulate
     from footfall.viz import quadruped_plots as qp
 
     if not math.isfinite(slope_deg) or not 0.0 <= slope_deg <= 60.0:
@@ -464,6 +463,7 @@ def simulate_command(
         None, help="Footsteps N of miqcqp/kinematic (default: the smallest N with a miqcqp plan)."
     ),
     time_limit: float = typer.Option(60.0, "--time-limit", help="Planner time limit [s]."),
+    threads: int = typer.Option(2, help="Worker processes of the bnb backend / solver threads."),
     push: float = typer.Option(0.0, help="Push impulse [N s]; 0 for none."),
     push_time: float = typer.Option(1.0, help="Push start time [s]."),
     push_direction: float = typer.Option(90.0, help="Push direction [deg] (0 = +x, 90 = +y)."),
@@ -483,9 +483,9 @@ def simulate_command(
     """Plan a scene, walk it in closed loop (MPC eq. 5.19 on the ALIP plant), write sim.json + figures."""
     import math
 
+    from footfall.planning import PlannerOptions, make_plan
     from footfall.planning.plan import check_planner_name
     from footfall.sim import Push, SimOptions, simulate
-    from footfall.sim.compare import make_plan
     from footfall.terrain.scene import Scene
     from footfall.viz.sim_plots import save_sim_figures
 
@@ -496,7 +496,7 @@ def simulate_command(
         noise_vel=noise_vel,
         mass_scale=mass_scale,
         com_height_scale=com_height_scale,
-        pushes=(Push(push_time, push, math.radians(push_direction), push_duration),)
+        pushes=(Push.horizontal(push_time, push, math.radians(push_direction), push_duration),)
         if push != 0
         else (),
         placement_error=placement_error,
@@ -505,7 +505,9 @@ def simulate_command(
     )
     sc = _scene_arg(scene)
     assert isinstance(sc, Scene)
-    plan = make_plan(sc, planner, steps, time_limit)
+    # the reactive planner walks until the goal: --steps is for the horizon planners
+    n = None if planner == "reactive" else steps
+    plan = make_plan(sc, planner, n, PlannerOptions(time_limit=time_limit, threads=threads))
     if not plan.has_solution:
         from footfall.errors import InfeasibleError
 
@@ -576,6 +578,7 @@ def compare_command(
         "(default: the smallest N with a miqcqp plan).",
     ),
     time_limit: float = typer.Option(60.0, "--time-limit", help="Planner time limit [s]."),
+    threads: int = typer.Option(2, help="Worker processes of the bnb backend / solver threads."),
     push_max: float = typer.Option(15.0, help="Push impulses uniform in [0, push_max] [N s]."),
     noise_pos: float = typer.Option(0.002, help="CoM position estimate noise (std) [m]."),
     noise_vel: float = typer.Option(0.02, help="CoM velocity estimate noise (std) [m/s]."),
@@ -618,13 +621,13 @@ def compare_command(
 
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from footfall.planning.plan import PLANNERS
-    from footfall.sim.compare import TrialSpec, check_names, run_compare, write_outputs
+    from footfall.experiments.compare import TrialSpec, run_compare, write_outputs
+    from footfall.planning.plan import PLANNERS, PlannerOptions
     from footfall.terrain.scene import Scene
 
     _positive_int("trials", trials)
     _positive_int("workers", workers)
-    names = check_names("planners", planners.split(","), PLANNERS)
+    names = names_in("planners", planners.split(","), PLANNERS)
     spec = TrialSpec(
         push_max=push_max,
         noise_pos=noise_pos,
@@ -654,8 +657,9 @@ def compare_command(
         def progress(what: str, done: int, total: int) -> None:
             bar.update(task, description=what, completed=done, total=total or None)
 
+        options = PlannerOptions(time_limit=time_limit, threads=threads)
         rows, table, plans = run_compare(
-            scene_objs, names, trials, out, spec, workers, n_steps, time_limit, progress
+            scene_objs, names, trials, out, spec, workers, n_steps, options, progress
         )
     header = (
         f"{trials} trials per scene and planner; pushes uniform in [0, {push_max:g}] N s "
@@ -708,20 +712,19 @@ def _compare_mujoco(
     heading_segments: int | None = None,
 ) -> None:
     """``compare --sim mujoco``: the section 5.5 table from MuJoCo walks (issue 7)."""
-    from footfall.planning.plan import PLANNERS
-    from footfall.sim.biped_compare import (
-        PUSH_DURATION,
+    from footfall.experiments.compare_mujoco import (
         compare_mujoco,
         compare_table,
         write_mujoco_outputs,
     )
-    from footfall.sim.compare import check_names
+    from footfall.planning.plan import PLANNERS
+    from footfall.sim.biped.plans import PUSH_DURATION
     from footfall.terrain.scene import builtin_scene_names
 
     _positive_int("trials", trials)
     push_max = non_negative("push_max", push_max)
-    names = check_names("planners", planners.split(","), PLANNERS)
-    scene_names = check_names(
+    names = names_in("planners", planners.split(","), PLANNERS)
+    scene_names = names_in(
         "scenes", [s.strip() for s in scenes.split(",") if s.strip()], builtin_scene_names()
     )
     force = push_max / PUSH_DURATION
@@ -813,8 +816,8 @@ def walk_cmd(
     """Walk a footstep plan with the MuJoCo biped (document 000, section 5.5).
 
     Writes walk.json (fell or not, time to goal, footstep tracking error, single-support ZMP
-    offset statistics per step), walk.png, walk.mp4 and the plan (cached as plan_<scene>_<planner>
-    .json in --out and reused on the next run). Exit 1 when the robot falls or misses the goal.
+    offset statistics per step), walk.png, walk.mp4 and plan.json (the plan walked; plans are
+    cached in --out/plans and reused while nothing they depend on changes). Exit 1 when the robot falls or misses the goal.
     The optimising planners plan for this robot beyond the document: each step in the reach set
     of both feet's frames and every swing at most ``SWING_MAX`` (``plan_for_walk``), unless
     ``--document-reach``.
@@ -825,9 +828,9 @@ def walk_cmd(
         # headless offscreen rendering; MuJoCo picks its GL backend when it is first imported
         os.environ.setdefault("MUJOCO_GL", "egl")
     from footfall.planning.plan import check_planner_name
-    from footfall.sim.biped_compare import plan_for_walk, random_push, robot_model
-    from footfall.sim.biped_plot import plot_walk
-    from footfall.sim.biped_walk import WalkOptions, walk
+    from footfall.sim.biped.plans import plan_for_walk, random_push, robot_model
+    from footfall.sim.biped.walk import WalkOptions, walk
+    from footfall.viz.walk_plot import plot_walk
 
     check_planner_name(planner)
     if steps is not None and steps < 1:
@@ -841,11 +844,12 @@ def walk_cmd(
             planner,
             steps,
             time_limit,
-            out,
+            out / "plans",
             model=model,
             robot_aware=robot_aware,
             heading_segments=heading_segments,
         )
+    write_json(out / "plan.json", plan.to_dict(sc.name))
     if not plan.has_solution:
         console.print(f"{sc.name}: {planner} found no plan ({plan.status.value}). {plan.message}")
         raise typer.Exit(1)
@@ -917,7 +921,7 @@ def bench_plan_cmd(
     out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_plan.json/.md."),
 ) -> None:
     """Direct SCIP model vs the fast planner on the same instances: a table of times and gaps."""
-    from footfall.bench import bench_plan, format_table, rows_to_dict
+    from footfall.experiments.bench import bench_plan, format_table, rows_to_dict
 
     def ints(field: str, text: str) -> list[int]:
         vals = parse_floats(field, text)
@@ -971,9 +975,14 @@ def bench_sim_cmd(
 
     The walk has estimate noise and two pushes; the engines run alternately in the same run.
     """
-    from footfall.bench import bench_sim, bench_sim_options, format_sim_table, sim_speed_to_dict
+    from footfall.experiments.bench import (
+        bench_sim,
+        bench_sim_options,
+        format_sim_table,
+        sim_speed_to_dict,
+    )
+    from footfall.planning import PlannerOptions, make_plan
     from footfall.planning.plan import check_planner_name
-    from footfall.sim.compare import make_plan
     from footfall.terrain.scene import Scene
 
     check_planner_name(planner)
@@ -989,7 +998,7 @@ def bench_sim_cmd(
             )
     sc = _scene_arg(scene)
     assert isinstance(sc, Scene)
-    plan = make_plan(sc, planner)
+    plan = make_plan(sc, planner, None, PlannerOptions(threads=2))
     if not plan.has_solution:
         from footfall.errors import InfeasibleError
 
@@ -1012,7 +1021,7 @@ def bench_quadruped_cmd(
     out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_quadruped.json."),
 ) -> None:
     """Quadruped slope walk: simulated s per wall s vs bare mj_step, and gait-plan time."""
-    from footfall.sim.quadruped_sim import benchmark_quadruped
+    from footfall.sim.quadruped.sim import benchmark_quadruped
 
     result = benchmark_quadruped(slope_deg=slope_deg, body_deg=body_deg)
     write_json(out / "bench_quadruped.json", result)

@@ -6,6 +6,20 @@ one type. Input errors name the offending field, the value given and what was ex
 
 from __future__ import annotations
 
+import reprlib
+
+#: how much of an offending value an error message shows: a value read from a file may be huge
+#: (a YAML alias bomb expands to gigabytes), so its repr is bounded in length and depth
+_VALUE_REPR = reprlib.Repr()
+for _name, _limit in (("maxlevel", 3), ("maxlist", 8), ("maxtuple", 8), ("maxdict", 8),
+                      ("maxset", 8), ("maxstring", 120), ("maxother", 120), ("maxlong", 40)):  # fmt: skip
+    setattr(_VALUE_REPR, _name, _limit)
+
+
+def value_repr(value: object) -> str:
+    """``repr(value)`` bounded in length and nesting depth (at most a few hundred characters)."""
+    return _VALUE_REPR.repr(value)
+
 
 class FootfallError(Exception):
     """Root of every error footfall raises on purpose."""
@@ -24,7 +38,7 @@ class InputError(FootfallError, ValueError):
         self.field = field
         self.value = value
         self.expected = expected
-        super().__init__(f"{field}: got {value!r}, expected {expected}")
+        super().__init__(f"{field}: got {value_repr(value)}, expected {expected}")
 
 
 class SceneError(InputError):

@@ -263,7 +263,7 @@ def test_sampled_joints_reproduce_the_planned_feet(osp_plan: fq.GaitPlan) -> Non
 
 
 def test_osp_sways_less_than_per_triangle_incentre() -> None:
-    from footfall.sim.quadruped_sim import body_sway
+    from footfall.sim.quadruped.sim import body_sway
 
     out = {}
     for strat in (ZmpStrategy.OSP, ZmpStrategy.INCENTRE):

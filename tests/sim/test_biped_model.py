@@ -11,15 +11,15 @@ mujoco = pytest.importorskip("mujoco")
 
 from footfall.errors import InputError  # noqa: E402
 from footfall.models.biped import BipedParams, Side  # noqa: E402
-from footfall.sim import biped_names as nm  # noqa: E402
-from footfall.sim.biped_model import (  # noqa: E402
+from footfall.sim.biped import names as nm  # noqa: E402
+from footfall.sim.biped.model import (  # noqa: E402
     U_MAX_FOOT_SHARE,
     BipedModel,
     biped_mjcf,
     measure_model,
     planner_params,
 )
-from footfall.sim.terrain_mjcf import terrain_xml  # noqa: E402
+from footfall.sim.biped.terrain_mjcf import terrain_xml  # noqa: E402
 from footfall.terrain import Region, Terrain, builtin_scene, builtin_scene_names  # noqa: E402
 
 #: masses are summed in double precision

@@ -16,8 +16,8 @@ from footfall.cli import app  # noqa: E402
 from footfall.errors import FootfallError, InputError  # noqa: E402
 from footfall.models.biped import Side  # noqa: E402
 from footfall.planning import make_plan  # noqa: E402
-from footfall.sim.biped_model import planner_params  # noqa: E402
-from footfall.sim.biped_walk import (  # noqa: E402
+from footfall.sim.biped.model import planner_params  # noqa: E402
+from footfall.sim.biped.walk import (  # noqa: E402
     BipedSim,
     MPCAdjuster,
     PlanFollower,
@@ -64,7 +64,7 @@ def test_ankle_torque_sign_follows_the_alip_convention() -> None:
     # a ZMP to the left (tau_x > 0) needs the ankle roll to push the foot's left edge down:
     # joint torque -tau_x on the foot about +x
     sim_weight = 300.0
-    from footfall.sim.biped_model import BipedModel
+    from footfall.sim.biped.model import BipedModel
 
     tau = ankle_joint_torque(np.array([3.0, -2.0]), np.eye(3), sim_weight, BipedModel())
     assert tau == pytest.approx([2.0, -3.0])  # (pitch, roll)
@@ -374,7 +374,7 @@ def test_cli_compare_mujoco_writes_the_table(tmp_path) -> None:  # type: ignore[
 def test_walk_plan_cache_round_trip_keeps_the_region_margin(tmp_path) -> None:  # type: ignore[no-untyped-def]
     # the walker keeps footsteps the plan's region margin (plus the landing margin) inside their
     # regions: a cached plan must come back with the margin it was made with
-    from footfall.sim.biped_compare import plan_for_walk
+    from footfall.sim.biped.plans import plan_for_walk
 
     scene = builtin_scene("flat")
     scene = replace(scene, goal=Goal(np.array([0.6, 0.0, 0.0]), 0.0))
@@ -390,9 +390,9 @@ def test_walk_plan_cache_round_trip_keeps_the_region_margin(tmp_path) -> None:  
 def test_plan_for_walk_plans_on_the_riser_inset_regions(monkeypatch: pytest.MonkeyPatch) -> None:
     # the planner sees stairs_slope_gap's treads below a riser moved in by the landing tolerance
     # at that edge only, and keeps its uniform half-sole region margin (the planner is unchanged)
-    import footfall.planning.run as run
-    from footfall.sim.biped_compare import plan_for_walk
-    from footfall.sim.biped_walk import RISER_LANDING_TOLERANCE
+    import footfall.planning.cache as run
+    from footfall.sim.biped.plans import plan_for_walk
+    from footfall.sim.biped.walk import RISER_LANDING_TOLERANCE
 
     seen = {}
 
@@ -420,8 +420,8 @@ def test_walk_plans_are_robot_aware_and_cached_with_their_options(tmp_path) -> N
     # the walk's plans use the options beyond the document (both reach frames, the measured
     # swing bound); the cache gives a plan back with them, and never for other options
     from footfall.planning import check_plan
-    from footfall.sim.biped_compare import plan_for_walk
-    from footfall.sim.biped_model import SWING_MAX
+    from footfall.sim.biped.model import SWING_MAX
+    from footfall.sim.biped.plans import plan_for_walk
 
     scene = builtin_scene("flat")
     scene = replace(scene, goal=Goal(np.array([0.6, 0.0, 0.0]), 0.0))
@@ -445,19 +445,20 @@ def test_walk_plans_record_their_heading_segments_and_cache_by_them(tmp_path) ->
     # made with another L is not served from the cache
     import json
 
-    from footfall.sim.biped_compare import plan_for_walk
+    from footfall.sim.biped.plans import plan_for_walk
 
     scene = replace(builtin_scene("flat"), goal=Goal(np.array([0.6, 0.0, 0.0]), 0.0))
     made = plan_for_walk(scene, "miqcqp", 4, 60.0, tmp_path, heading_segments=64)
     assert made.has_solution and made.heading_segments == 64
-    stored = json.loads((tmp_path / "plan_flat_miqcqp.json").read_text())
-    assert stored["heading_segments"] == 64 and stored["cache_key"].endswith("|L=64")
+    (path,) = tmp_path.glob("plan-*.json")
+    stored = json.loads(path.read_text())
+    assert stored["heading_segments"] == 64
     again = plan_for_walk(scene, "miqcqp", 4, 60.0, tmp_path, heading_segments=64)
     assert "loaded from cache" in again.message and again.heading_segments == 64
     coarse = plan_for_walk(scene, "miqcqp", 4, 60.0, tmp_path, heading_segments=16)
     assert "loaded from cache" not in coarse.message and coarse.heading_segments == 16
     # defaults: WALK_HEADING_SEGMENTS for the robot-aware plans, the document's 16 otherwise
-    from footfall.sim.biped_model import WALK_HEADING_SEGMENTS
+    from footfall.sim.biped.model import WALK_HEADING_SEGMENTS
 
     assert plan_for_walk(scene, "miqcqp", 4, 60.0, None).heading_segments == WALK_HEADING_SEGMENTS
     document = plan_for_walk(scene, "miqcqp", 4, 60.0, None, robot_aware=False)
@@ -476,7 +477,7 @@ def test_straight_plans_with_both_frames_step_wide_only_with_coarse_segments(
     # steps. With 64 segments the steps stay near the inner width 0.12 m. (The last step is the
     # goal stance, 0.20 m.)
     from footfall.planning import PlannerOptions
-    from footfall.sim.biped_model import WALK_HEADING_SEGMENTS
+    from footfall.sim.biped.model import WALK_HEADING_SEGMENTS
 
     assert segments in (16, WALK_HEADING_SEGMENTS)
     scene = replace(builtin_scene("flat"), goal=Goal(np.array([1.2, 0.0, 0.0]), 0.0))
@@ -497,7 +498,7 @@ def test_cli_walk_plans_robot_aware_unless_document_reach(  # type: ignore[no-un
     # the document's problem (eq. 5.12f in the stance frame only); plan.json says which
     import json
 
-    from footfall.sim.biped_model import SWING_MAX
+    from footfall.sim.biped.model import SWING_MAX
     from footfall.terrain.scene import scene_to_yaml
 
     scene = replace(builtin_scene("flat"), goal=Goal(np.array([0.6, 0.0, 0.0]), 0.0))
@@ -507,8 +508,7 @@ def test_cli_walk_plans_robot_aware_unless_document_reach(  # type: ignore[no-un
     args = ["walk", str(path), "--planner", "kinematic", "--steps", "4", "--no-video"]
     res = CliRunner().invoke(app, [*args, "--out", str(out), *flag])
     assert res.exit_code == 0, res.output
-    (plan_file,) = out.glob("plan_*_kinematic.json")
-    saved = json.loads(plan_file.read_text())
+    saved = json.loads((out / "plan.json").read_text())
     assert saved["reach_both_frames"] is both_frames
     assert saved.get("swing_max") == (SWING_MAX if both_frames else None)
     assert json.loads((out / "walk.json").read_text())["metrics"]["reached_goal"]
@@ -526,7 +526,7 @@ def test_cli_compare_mujoco_passes_the_reach_choice_to_its_plans(  # type: ignor
     flag: list[str], aware: bool, segments: int | None, tmp_path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # compare --sim mujoco plans through plan_for_walk like `walk`, with the same choices
-    import footfall.sim.biped_compare as bc
+    import footfall.experiments.compare_mujoco as bc
 
     seen = []
 
@@ -559,7 +559,7 @@ def test_cli_walk_rejects_too_few_heading_segments(tmp_path) -> None:  # type: i
 def test_walk_plan_cache_is_not_reused_for_an_edited_scene_of_the_same_name(tmp_path) -> None:  # type: ignore[no-untyped-def]
     # the cache file is named after the scene; a scene edited under the same name (here its goal)
     # must be planned again, not served the old plan
-    from footfall.sim.biped_compare import plan_for_walk
+    from footfall.sim.biped.plans import plan_for_walk
 
     scene = replace(builtin_scene("flat"), goal=Goal(np.array([0.6, 0.0, 0.0]), 0.0))
     first = plan_for_walk(scene, "kinematic", 4, 60.0, tmp_path)

@@ -58,7 +58,8 @@ def test_compare_runs_trials_and_writes_the_table(tmp_path: Path) -> None:
     assert len(rows) == 3  # header + 2 trials
     assert "| flat | reactive |" in (tmp_path / "compare.md").read_text()
     assert (tmp_path / "compare_zmp_mean.png").is_file()
-    assert list((tmp_path / "plans").glob("flat_reactive_*.pkl"))
+    assert list((tmp_path / "plans").glob("plan-*.json"))
+    assert not list((tmp_path / "plans").glob("*.pkl"))
 
 
 @pytest.mark.parametrize(

@@ -28,12 +28,12 @@ except importlib.metadata.PackageNotFoundError:
 
 from footfall.errors import FootfallError, InputError  # noqa: E402
 from footfall.models.biped import Side  # noqa: E402
-from footfall.sim import biped_names as nm  # noqa: E402
-from footfall.sim import g1_model  # noqa: E402
-from footfall.sim.biped_compare import robot_model  # noqa: E402
-from footfall.sim.biped_model import measure_model, planner_params  # noqa: E402
-from footfall.sim.biped_walk import BipedSim, ankle_joint_torque  # noqa: E402
-from footfall.sim.g1_model import G1Model, g1_urdf_path, urdf_joint  # noqa: E402
+from footfall.sim.biped import g1 as g1_model  # noqa: E402
+from footfall.sim.biped import names as nm  # noqa: E402
+from footfall.sim.biped.g1 import G1Model, g1_urdf_path, urdf_joint  # noqa: E402
+from footfall.sim.biped.model import measure_model, planner_params  # noqa: E402
+from footfall.sim.biped.plans import robot_model  # noqa: E402
+from footfall.sim.biped.walk import BipedSim, ankle_joint_torque  # noqa: E402
 from footfall.terrain import builtin_scene  # noqa: E402
 
 pytestmark = pytest.mark.robots
@@ -232,7 +232,7 @@ def test_g1_walks_a_short_flat_plan_made_for_it() -> None:
     from dataclasses import replace
 
     from footfall.planning import PlannerOptions, make_plan
-    from footfall.sim.biped_walk import walk
+    from footfall.sim.biped.walk import walk
     from footfall.terrain import Goal
 
     scene = builtin_scene("flat")

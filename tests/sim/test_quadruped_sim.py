@@ -24,9 +24,9 @@ from footfall.quadruped import (  # noqa: E402
 )
 from footfall.quadruped.kinematics import body_rotation  # noqa: E402
 from footfall.quadruped.stability import centre_of_pressure  # noqa: E402
-from footfall.sim import quadruped_names as nm  # noqa: E402
-from footfall.sim.quadruped_mjcf import stairs_scene  # noqa: E402
-from footfall.sim.quadruped_sim import QuadrupedSim, simulate  # noqa: E402
+from footfall.sim.quadruped import names as nm  # noqa: E402
+from footfall.sim.quadruped.mjcf import stairs_scene  # noqa: E402
+from footfall.sim.quadruped.sim import QuadrupedSim, simulate  # noqa: E402
 
 ROBOT = QuadrupedRobot()
 SLOPE = math.radians(15.0)

@@ -14,7 +14,7 @@ from footfall.errors import InputError
 from footfall.planning.plan import FootstepPlan, goal_feet
 from footfall.planning.reactive import plan_reactive
 from footfall.sim import Push, SimOptions, simulate
-from footfall.sim.reduced import viability_bounds
+from footfall.sim.reduced.closed_loop import viability_bounds
 from footfall.terrain import builtin_scene
 from tests.conftest import IVP_ATOL, IVP_RTOL, first_steps
 
@@ -39,13 +39,13 @@ def short_plan(flat_plan: FootstepPlan) -> FootstepPlan:
 
 def test_plant_matches_solve_ivp_of_the_com_dynamics(short_plan: FootstepPlan) -> None:
     robot = short_plan.robot
-    push = Push(time=0.15, impulse=6.0, direction=1.0, duration=0.05)
+    push = Push.horizontal(0.15, 6.0, 1.0, 0.05)
     opts = SimOptions(pushes=(push,), mass_scale=1.1, com_height_scale=0.95, substeps=4)
     res = simulate(short_plan, opts)
     m, zh, g = robot.mass * 1.1, robot.com_height * 0.95, robot.g
     x0 = short_plan.states[0, 0]
     vel0 = np.array([x0[3], -x0[2]]) / (m * zh)
-    f = push.force
+    f = push.force[:2]
     t, cop = res.t, res.cop
     n = t.shape[0]
     dt_ss = t[1] - t[0]
@@ -61,14 +61,14 @@ def test_plant_matches_solve_ivp_of_the_com_dynamics(short_plan: FootstepPlan) -
 
     def rhs(s: float, y: np.ndarray) -> np.ndarray:
         acc = g / zh * (y[:2] - cop_at(s))
-        if push.time <= s < push.time + push.duration:
+        if push.start <= s < push.start + push.duration:
             acc = acc + f / m
         return np.concatenate([y[2:], acc])
 
     # integrate sample by sample so that the piecewise inputs are resolved exactly
     y = np.concatenate([res.com[0], vel0])
     edges = [*t.tolist(), t[-1] + (t[-1] - t[-2])]
-    breaks = sorted({push.time, push.time + push.duration})
+    breaks = sorted({push.start, push.start + push.duration})
     for j in range(n - 1):
         np.testing.assert_allclose(y[:2], res.com[j], atol=PLANT_TOL)
         pts = [edges[j], *[b for b in breaks if edges[j] < b < edges[j + 1]], edges[j + 1]]
@@ -80,7 +80,7 @@ def test_plant_matches_solve_ivp_of_the_com_dynamics(short_plan: FootstepPlan) -
 
 def test_cop_is_clipped_to_the_sole(short_plan: FootstepPlan) -> None:
     # a narrow sole and a sideways push: the ankle cannot make the commanded torque
-    opts = SimOptions(foot_width=0.02, pushes=(Push(0.1, 8.0, math.pi / 2),))
+    opts = SimOptions(foot_width=0.02, pushes=(Push.horizontal(0.1, 8.0, math.pi / 2),))
     res = simulate(short_plan, opts)
     ss = res.single
     assert np.all(np.abs(res.cop_offset[ss, 0]) <= 0.1 + 1e-12)
@@ -121,7 +121,7 @@ def test_walk_on_flat_reaches_the_goal_without_falling(flat_plan: FootstepPlan) 
 
 
 def test_huge_push_is_a_fall_not_an_exception(short_plan: FootstepPlan) -> None:
-    res = simulate(short_plan, SimOptions(pushes=(Push(0.1, 150.0, 0.0),)))
+    res = simulate(short_plan, SimOptions(pushes=(Push.horizontal(0.1, 150.0, 0.0),)))
     m = res.metrics
     assert m.fell and not m.success and math.isnan(m.goal_error)
     assert 0.1 < m.fall_time <= 0.2 + 1e-9
@@ -130,7 +130,7 @@ def test_huge_push_is_a_fall_not_an_exception(short_plan: FootstepPlan) -> None:
 
 
 def test_moderate_push_is_recovered(flat_plan: FootstepPlan) -> None:
-    res = simulate(flat_plan, SimOptions(pushes=(Push(1.0, 10.0, math.pi / 2),)))
+    res = simulate(flat_plan, SimOptions(pushes=(Push.horizontal(1.0, 10.0, math.pi / 2),)))
     assert not res.metrics.fell
     assert res.metrics.footstep_dev_max > NOMINAL_STEP_TOL  # recovered by stepping
 
@@ -164,7 +164,7 @@ def test_bad_inputs_raise_input_errors(short_plan: FootstepPlan) -> None:
     with pytest.raises(InputError, match="control_rate"):
         SimOptions(control_rate="fast")  # type: ignore[arg-type]
     with pytest.raises(InputError, match=r"push\.impulse"):
-        Push(1.0, -3.0)
+        Push.horizontal(1.0, -3.0)
     with pytest.raises(InputError, match="substeps"):
         SimOptions(substeps=0)
     with pytest.raises(InputError, match="seed"):

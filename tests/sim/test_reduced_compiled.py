@@ -10,7 +10,7 @@ from dataclasses import fields, replace
 import numpy as np
 import pytest
 
-import footfall.sim.reduced as reduced
+import footfall.sim.reduced.closed_loop as reduced
 from footfall.control import MPC, MPCWeights, build_mpc, solve_ball_qp
 from footfall.control.mpc import DUAL_TOL, MAX_NEWTON_ITER, CondensedMPC
 from footfall.errors import InputError, SolverUnavailableError
@@ -21,7 +21,7 @@ from footfall.sim import Push, SimOptions, SimResult, simulate
 from footfall.terrain import builtin_scene
 from tests.conftest import first_steps
 
-kernel = pytest.importorskip("footfall.sim._reduced_kernel")
+kernel = pytest.importorskip("footfall.sim.reduced._kernel")
 
 #: compiled vs reference trajectories, footsteps and metrics (same arithmetic, other rounding) [SI]
 ENGINE_TOL = 1e-9
@@ -91,8 +91,8 @@ def test_engines_agree_with_pushes_noise_and_mismatch(short_plan: FootstepPlan, 
         com_height_scale=float(rng.uniform(0.95, 1.05)),
         # one push switching inside control ticks (sub-steps), one on the tick grid
         pushes=(
-            Push(0.1234, 9.0, float(rng.uniform(0, 2 * math.pi)), 0.0503),
-            Push(0.9, 6.0, float(rng.uniform(0, 2 * math.pi)), 0.1),
+            Push.horizontal(0.1234, 9.0, float(rng.uniform(0, 2 * math.pi)), 0.0503),
+            Push.horizontal(0.9, 6.0, float(rng.uniform(0, 2 * math.pi)), 0.1),
         ),
         mpc_nodes=10,
         seed=seed,
@@ -106,14 +106,14 @@ def test_engines_agree_with_pushes_noise_and_mismatch(short_plan: FootstepPlan, 
 
 
 def test_engines_agree_on_a_whole_walk(flat_plan: FootstepPlan) -> None:
-    opts = SimOptions(pushes=(Push(1.0, 10.0, math.pi / 2),), noise_pos=0.001, seed=3)
+    opts = SimOptions(pushes=(Push.horizontal(1.0, 10.0, math.pi / 2),), noise_pos=0.001, seed=3)
     ref, fast = run_both(flat_plan, opts)
     assert ref.metrics.success and ref.metrics.steps_taken == flat_plan.n_steps
     assert_same_run(ref, fast)
 
 
 def test_engines_agree_on_a_fall(short_plan: FootstepPlan) -> None:
-    ref, fast = run_both(short_plan, SimOptions(pushes=(Push(0.1, 150.0, 0.0),)))
+    ref, fast = run_both(short_plan, SimOptions(pushes=(Push.horizontal(0.1, 150.0, 0.0),)))
     assert ref.metrics.fell and math.isfinite(ref.metrics.fall_time)
     assert_same_run(ref, fast)
 

@@ -64,11 +64,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.linalg.lapack import dposv, dpotrf, dtrtri
 
+from footfall._typing import FloatArray
 from footfall._validate import finite, positive
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
-
-FloatArray = NDArray[np.float64]
 
 #: index slices into the parameter vector theta = [x_measured, d_ref, x_next_ref]
 THETA_X = slice(0, 4)
@@ -220,7 +219,7 @@ class CondensedMPC:
     def padded(self) -> PaddedMPC:
         """The per-tick matrices of the solver stacked into zero-padded arrays (built once).
 
-        The compiled engine (:mod:`footfall.sim._reduced_kernel`) reads these instead of the
+        The compiled engine (:mod:`footfall.sim.reduced._kernel`) reads these instead of the
         tuples; they hold exactly the same numbers.
         """
         return pad_condensed(self)

@@ -3,12 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.linalg import expm
 
+from footfall._typing import FloatArray
 from footfall._validate import positive
-
-FloatArray = NDArray[np.float64]
 
 
 def zoh(a: FloatArray, b: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:

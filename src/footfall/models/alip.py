@@ -34,8 +34,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import expm
 
+from footfall._typing import FloatArray
 from footfall._validate import finite_vector, positive
-from footfall.models._linear import FloatArray, LinearModel
+from footfall.models._linear import LinearModel
 from footfall.models.lip import GRAVITY
 
 #: index slices into the ALIP state

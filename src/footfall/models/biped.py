@@ -14,15 +14,14 @@ from dataclasses import dataclass, field
 from enum import Enum
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from footfall._geometry import convexity_defect, outward_halfspaces, signed_area
+from footfall._typing import FloatArray
 from footfall._validate import positive
 from footfall.errors import InputError
 from footfall.models.alip import ALIP
 from footfall.models.lip import GRAVITY
-
-FloatArray = NDArray[np.float64]
 
 #: default reach trapezoid for a RIGHT stance foot, (4, 2) [m], CCW: a 0.55 m fore-aft range next to
 #: the stance foot narrowing to 0.37 m at the widest lateral reach, as in document 000 fig. 5.3(b)

@@ -17,8 +17,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from footfall._typing import FloatArray
 from footfall._validate import positive
-from footfall.models._linear import FloatArray, LinearModel
+from footfall.models._linear import LinearModel
 
 #: standard gravity [m/s^2]
 GRAVITY = 9.81

@@ -14,7 +14,6 @@ from footfall.planning.lip_examples import example as lip_example
 from footfall.planning.lip_walk import LipWalk, LipWalkParams, lip_walk, optimal_foothold
 from footfall.planning.miqcqp import FootstepProblem, build_footstep_problem, plan_footsteps
 from footfall.planning.plan import PLANNERS, FootstepPlan, PlannerOptions, PlannerWeights
-from footfall.planning.plan_io import plan_to_dict
 from footfall.planning.reactive import plan_reactive
 from footfall.planning.run import make_plan, plan_min_steps
 
@@ -38,5 +37,4 @@ __all__ = [
     "plan_kinematic",
     "plan_min_steps",
     "plan_reactive",
-    "plan_to_dict",
 ]

@@ -14,14 +14,12 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
+from footfall._typing import FloatArray
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import FootstepPlan
 from footfall.terrain.scene import Scene
-
-FloatArray = NDArray[np.float64]
 
 #: geometric tolerance [m]
 GEOM_TOL = 1e-5
@@ -149,29 +147,48 @@ def check_plan(plan: FootstepPlan, scene: Scene, robot: BipedParams | None = Non
     resets (re-simulated), and the goal (last two footsteps at the goal pose).
     """
     robot = robot or plan.robot
-    out: list[Violation] = []
-    checked: list[str] = []
     if not plan.has_solution:
         return CheckReport((Violation("no_solution", 0, math.inf, plan.message),), math.inf)
-    feet = plan.footsteps
-    n = plan.n_steps
-    start = scene.start
+    out: list[Violation] = []
+    checked = ["start", "region", "reach"]
+    out += _check_start(plan, scene)
+    out += _check_regions(plan, scene)
+    out += _check_reach_and_step_height(plan, robot)
+    if plan.swing_max is not None:
+        checked.append("swing")
+        out += _check_swing(plan, scene)
+    checked += ["heading_rate", "torque", "dynamics", "goal"]
+    out += _check_heading_rate(plan, robot)
+    out += _check_torque(plan, robot)
+    dynamics, worst = _check_dynamics(plan, scene, robot)
+    out += dynamics
+    out += _check_goal(plan, scene, robot)
+    return CheckReport(tuple(out), worst, tuple(checked))
 
-    checked.append("start")
-    d0 = float(np.max(np.abs(feet[0] - start.foot(start.stance))))
+
+def _check_start(plan: FootstepPlan, scene: Scene) -> list[Violation]:
+    """Footstep 0 is the scene's stance foot at its heading; the feet alternate."""
+    out = []
+    start = scene.start
+    d0 = float(np.max(np.abs(plan.footsteps[0] - start.foot(start.stance))))
     if d0 > GEOM_TOL or plan.sides[0] is not start.stance:
         out.append(Violation("start", 0, d0, "footstep 0 is not the given stance foot"))
     if abs(plan.headings[0] - start.heading) > ANGLE_TOL:
         out.append(
             Violation("start", 0, abs(plan.headings[0] - start.heading), "heading 0 differs")
         )
-    for i in range(1, n + 1):
+    for i in range(1, plan.n_steps + 1):
         if plan.sides[i] is plan.sides[i - 1]:
             out.append(Violation("alternation", i, 1.0, "two consecutive steps with the same foot"))
+    return out
 
-    checked.append("region")
+
+def _check_regions(plan: FootstepPlan, scene: Scene) -> list[Violation]:
+    """Every footstep inside its region's polygon (by the plan's margin) and on its plane."""
+    out = []
+    feet = plan.footsteps
     by_name = {r.name: r for r in scene.terrain}
-    for i in range(1, n + 1):
+    for i in range(1, plan.n_steps + 1):
         region = by_name.get(plan.regions[i])
         if region is None:
             out.append(Violation("region", i, math.inf, f"unknown region {plan.regions[i]!r}"))
@@ -180,25 +197,24 @@ def check_plan(plan: FootstepPlan, scene: Scene, robot: BipedParams | None = Non
         # distance outside the polygon, plus the margin the plan promised to keep
         outside = _inside_polygon(feet[i, :2], corners[:, :2], GEOM_TOL) + plan.region_margin
         if outside > GEOM_TOL:
-            out.append(
-                Violation(
-                    "region",
-                    i,
-                    outside,
-                    f"{outside:.2e} m outside {region.name} (margin {plan.region_margin:g} m)",
-                )
-            )
+            msg = f"{outside:.2e} m outside {region.name} (margin {plan.region_margin:g} m)"
+            out.append(Violation("region", i, outside, msg))
         dz = abs(feet[i, 2] - _plane_height(corners, feet[i, :2]))
         if dz > GEOM_TOL:
             out.append(Violation("region", i, dz, f"{dz:.2e} m off the plane of {region.name}"))
+    return out
 
-    checked.append("reach")
-    for i in range(n):
+
+def _check_reach_and_step_height(plan: FootstepPlan, robot: BipedParams) -> list[Violation]:
+    """Each step in the stance foot's reach trapezoid (eq. 5.12f; also in the landing foot's frame
+    when the plan was made so), with the true sin/cos of the heading; the step-height bound."""
+    out = []
+    feet = plan.footsteps
+    for i in range(plan.n_steps):
         d = feet[i + 1, :2] - feet[i, :2]
         corners = np.array(robot.reach.vertices, dtype=float)  # for a right stance foot
         if plan.sides[i] is Side.LEFT:
             corners = corners * np.array([1.0, -1.0])
-        # the step in the stance foot's heading frame; also in the landing foot's if asked
         for k in (i, i + 1) if plan.reach_both_frames else (i,):
             th = plan.headings[k]
             q = np.array(
@@ -215,57 +231,82 @@ def check_plan(plan: FootstepPlan, scene: Scene, robot: BipedParams | None = Non
         dz = abs(feet[i + 1, 2] - feet[i, 2])
         if dz > robot.step_height_max + GEOM_TOL:
             out.append(Violation("step_height", i + 1, dz, f"step height {dz:.3f} m"))
+    return out
 
-    if plan.swing_max is not None:
-        # beyond the document: each foot's horizontal swing from its previous foothold (the
-        # scene's start position for the first swing of each foot), against the true disc
-        checked.append("swing")
-        for i in range(1, n + 1):
-            prev = feet[i - 2, :2] if i >= 2 else start.foot(plan.sides[i])[:2]
-            length = float(np.hypot(*(feet[i, :2] - prev)))
-            if length > plan.swing_max + GEOM_TOL:
-                msg = f"swing of {length:.3f} m, longer than {plan.swing_max:g} m"
-                out.append(Violation("swing", i, length - plan.swing_max, msg))
 
-    checked.append("heading_rate")
+def _check_swing(plan: FootstepPlan, scene: Scene) -> list[Violation]:
+    """Beyond the document: each foot's horizontal swing from its previous foothold (the scene's
+    start position for the first swing of each foot), against the true disc of ``swing_max``."""
+    assert plan.swing_max is not None
+    out = []
+    feet = plan.footsteps
+    for i in range(1, plan.n_steps + 1):
+        prev = feet[i - 2, :2] if i >= 2 else scene.start.foot(plan.sides[i])[:2]
+        length = float(np.hypot(*(feet[i, :2] - prev)))
+        if length > plan.swing_max + GEOM_TOL:
+            msg = f"swing of {length:.3f} m, longer than {plan.swing_max:g} m"
+            out.append(Violation("swing", i, length - plan.swing_max, msg))
+    return out
+
+
+def _check_heading_rate(plan: FootstepPlan, robot: BipedParams) -> list[Violation]:
+    """``|theta_{i+1} - theta_i| <= theta_max`` (eq. 5.12e)."""
     rates = np.abs(np.diff(plan.headings))
-    for i, r in enumerate(rates):
-        if r > robot.theta_max + ANGLE_TOL:
-            out.append(Violation("heading_rate", i + 1, float(r), f"heading change {r:.4f} rad"))
+    return [
+        Violation("heading_rate", i + 1, float(r), f"heading change {r:.4f} rad")
+        for i, r in enumerate(rates)
+        if r > robot.theta_max + ANGLE_TOL
+    ]
 
-    checked.append("torque")
+
+def _check_torque(plan: FootstepPlan, robot: BipedParams) -> list[Violation]:
+    """``||u|| <= U_max`` (eq. 5.12d)."""
     norms = np.linalg.norm(plan.torques, axis=-1)
     if norms.size and norms.max() > robot.u_max * (1 + TORQUE_RTOL):
         i = int(np.argmax(norms.max(axis=1)))
-        out.append(Violation("torque", i, float(norms.max()), f"|u| = {norms.max():.3f} N m"))
+        return [Violation("torque", i, float(norms.max()), f"|u| = {norms.max():.3f} N m")]
+    return []
 
-    checked.append("dynamics")
+
+def _check_dynamics(
+    plan: FootstepPlan, scene: Scene, robot: BipedParams
+) -> tuple[list[Violation], float]:
+    """The initial ALIP state is the scene's, and every node and reset matches a re-simulation
+    (eq. 5.12a-c integrated with ``solve_ivp``); returns the violations and the largest error."""
+    out = []
     worst = 0.0
-    x_init_err = float(np.max(np.abs(plan.states[0, 0] - start.alip_state)))
+    x_init_err = float(np.max(np.abs(plan.states[0, 0] - scene.start.alip_state)))
     if x_init_err > STATE_TOL:
         out.append(Violation("dynamics", 0, x_init_err, "initial state differs from the scene's"))
     dt = robot.node_dt
+    n = plan.n_steps
     for i in range(n):
         for k in range(robot.n_nodes - 1):
             sim = _simulate_single_support(robot, plan.states[i, k], plan.torques[i, k], dt)
             worst = max(worst, float(np.max(np.abs(sim - plan.states[i, k + 1]))))
         nxt = plan.states[i + 1, 0] if i + 1 < n else plan.final_state
-        sim = _simulate_double_support(robot, plan.states[i, -1], feet[i + 1] - feet[i])
+        step = plan.footsteps[i + 1] - plan.footsteps[i]
+        sim = _simulate_double_support(robot, plan.states[i, -1], step)
         worst = max(worst, float(np.max(np.abs(sim - nxt))))
     if worst > STATE_TOL:
-        out.append(
-            Violation("dynamics", -1, worst, f"ALIP states differ from simulation by {worst:.2e}")
-        )
+        msg = f"ALIP states differ from simulation by {worst:.2e}"
+        out.append(Violation("dynamics", -1, worst, msg))
+    return out, worst
 
-    checked.append("goal")
+
+def _check_goal(plan: FootstepPlan, scene: Scene, robot: BipedParams) -> list[Violation]:
+    """The last two footsteps at their goal spots (the goal midpoint -/+ half the stance width)
+    and at the goal heading."""
+    out = []
     th_goal = scene.goal.heading
     left_normal = np.array([-math.sin(th_goal), math.cos(th_goal)])
+    n = plan.n_steps
     for i in (n - 1, n):
         want = scene.goal.position[:2] + plan.sides[i].sign * 0.5 * robot.stance_width * left_normal
-        err = float(np.linalg.norm(feet[i, :2] - want))
+        err = float(np.linalg.norm(plan.footsteps[i, :2] - want))
         if err > GEOM_TOL:
             out.append(Violation("goal", i, err, f"footstep {i} is {err:.3f} m from its goal spot"))
         dth = abs((plan.headings[i] - th_goal + math.pi) % (2 * math.pi) - math.pi)
         if dth > ANGLE_TOL * 10:
             out.append(Violation("goal", i, dth, f"footstep {i} heading off by {dth:.4f} rad"))
-    return CheckReport(tuple(out), worst, tuple(checked))
+    return out

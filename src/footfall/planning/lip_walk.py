@@ -26,13 +26,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
+from footfall._geometry import rot2
+from footfall._typing import FloatArray
 from footfall._validate import finite_vector, non_negative, positive
 from footfall.errors import InputError
 from footfall.models.lip import GRAVITY, LIP
-
-FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -179,11 +178,6 @@ class LipWalk:
         }
 
 
-def _rot(theta: float) -> FloatArray:
-    c, s = np.cos(theta), np.sin(theta)
-    return np.array([[c, -s], [s, c]])
-
-
 def optimal_foothold(
     lip: LIP,
     t_sup: float,
@@ -254,9 +248,9 @@ def lip_walk(params: LipWalkParams) -> LipWalk:
             com, vel = lip.state_at(com, vel, feet[n - 1], t_sup)
             # Ideal foothold of step n from the walk parameters of step n-1 (document indexing).
             step = np.array([sx[n - 1], -((-1.0) ** n) * sy[n - 1]])
-            ideal = ideal + _rot(theta[n - 1]) @ step
+            ideal = ideal + rot2(theta[n - 1]) @ step
         # Ideal end-of-step CoM state relative to the ideal foothold; velocity not rotated (erratum).
-        bar = _rot(theta[n]) @ np.array([sx[n] / 2.0, (-1.0) ** n * sy[n] / 2.0])
+        bar = rot2(theta[n]) @ np.array([sx[n] / 2.0, (-1.0) ** n * sy[n] / 2.0])
         vbar = np.array([(c + 1.0) / (tc * s) * bar[0], (c - 1.0) / (tc * s) * bar[1]])
         last = n == n_phases - 1
         a = params.a_stop if last else params.a

@@ -48,12 +48,13 @@ its node relaxations).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from footfall._geometry import rot2
+from footfall._typing import FloatArray, IntArray
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import (
@@ -61,15 +62,11 @@ from footfall.planning.plan import (
     PlannerOptions,
     goal_feet,
     result_meta,
-    rot2,
     wrap_near,
 )
 from footfall.solvers import ProblemBuilder, SolveStatus, solve
 from footfall.solvers.problem import MIQCQP
 from footfall.terrain.scene import Scene
-
-FloatArray = NDArray[np.float64]
-IntArray = NDArray[np.int64]
 
 #: sides M of the regular polygon inscribed in the swing disc ``||d|| <= L_swing`` (option
 #: ``swing_max``): 16 facets lose at most 1 - cos(pi / 16) = 1.9 % of L_swing (about 1 cm)
@@ -112,6 +109,42 @@ def _side_sequence(stance: Side, n_steps: int) -> tuple[Side, ...]:
     return tuple(sides)
 
 
+@dataclass
+class _Model:
+    """The model of :func:`build_footstep_problem` while it is built: the builder, the problem data
+    every group of rows needs, and the variable blocks made so far (see :class:`FootstepProblem`).
+
+    The groups are added in a fixed order (variables, then rows equation by equation), so a
+    model's variable and row order, and hence every solver's path through it, is reproducible.
+    """
+
+    b: ProblemBuilder
+    scene: Scene
+    robot: BipedParams
+    options: PlannerOptions
+    n: int
+    dynamics: bool
+    sides: tuple[Side, ...]
+    theta0: float
+    theta_goal: float
+    #: horizontal goal positions of the two final feet (2,) [m]
+    feet: dict[Side, FloatArray]
+    #: footstep 0, the given stance foot (3,) [m]
+    p0: FloatArray
+    #: start position (2,) [m] of the first swing foot
+    swing_from: FloatArray
+    p: IntArray = field(default_factory=lambda: np.zeros((0, 3), dtype=np.int64))
+    theta: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    s: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    c: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    x: IntArray = field(default_factory=lambda: np.zeros((0, 0, 4), dtype=np.int64))
+    u: IntArray = field(default_factory=lambda: np.zeros((0, 0, 2), dtype=np.int64))
+    x_final: IntArray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    breaks: FloatArray = field(default_factory=lambda: np.zeros(0))
+    segments: IntArray = field(default_factory=lambda: np.zeros((0, 0), dtype=np.int64))
+    regions: IntArray = field(default_factory=lambda: np.zeros((0, 0), dtype=np.int64))
+
+
 def build_footstep_problem(
     scene: Scene,
     robot: BipedParams | None = None,
@@ -136,41 +169,78 @@ def build_footstep_problem(
     options = options or PlannerOptions()
     if isinstance(n_steps, bool) or not isinstance(n_steps, int) or n_steps < 1:
         raise InputError("n_steps", n_steps, "an integer >= 1")
-    w = options.weights
-    n = n_steps
-    k_nodes = robot.n_nodes
-    alip = robot.alip()
-    ad, bd = alip.discretize(robot.node_dt)
-    a_r, b_r = alip.reset_map(robot.t_ds)
     start = scene.start
     theta0 = float(start.heading)
     theta_goal = wrap_near(float(scene.goal.heading), theta0)
-    sides = _side_sequence(start.stance, n)
-    terrain = scene.terrain
-    lo_box, hi_box = terrain.bounds()
-    mzh = robot.mass * robot.com_height
+    sides = _side_sequence(start.stance, n_steps)
+    m = _Model(
+        b=ProblemBuilder(),
+        scene=scene,
+        robot=robot,
+        options=options,
+        n=n_steps,
+        dynamics=dynamics,
+        sides=sides,
+        theta0=theta0,
+        theta_goal=theta_goal,
+        feet=goal_feet(robot, scene.goal.position[:2], theta_goal),
+        p0=start.foot(start.stance),
+        swing_from=start.foot(sides[1])[:2],
+    )
+    _add_footsteps(m)
+    _add_headings(m)
+    _add_alip(m)
+    _add_heading_rate_and_step_height(m)
+    _add_heading_segments(m)
+    _add_reach(m)
+    _add_swing_bound(m)
+    _add_regions(m)
+    x_goal = _add_goal(m)
+    _add_objective(m, x_goal)
+    return FootstepProblem(
+        problem=m.b.build(),
+        scene=scene,
+        robot=robot,
+        n_steps=m.n,
+        options=options,
+        sides=sides,
+        p=m.p,
+        theta=m.theta,
+        s=m.s,
+        c=m.c,
+        x=m.x,
+        u=m.u,
+        x_final=m.x_final,
+        regions=m.regions,
+        segments=m.segments,
+        breakpoints=m.breaks,
+        x_goal=x_goal,
+    )
 
-    feet = goal_feet(robot, scene.goal.position[:2], theta_goal)
+
+def _add_footsteps(m: _Model) -> None:
+    """Footstep variables ``p_i`` (N + 1, 3) [m], footstep 0 fixed to the stance foot.
+
+    Tight bounds, all implied by the constraints (so the optimum is unchanged): inside the terrain
+    box, within i steps of reach of footstep 0 and within N - i (N - 1 - i) of the final footstep
+    N (N - 1), whose positions the goal fixes; heights likewise. With ``swing_max`` a foot is also
+    within L_swing per swing of its previous and next position of the same foot (its start
+    position and its goal spot).
+    """
+    b, n, robot, p0, feet, sides = m.b, m.n, m.robot, m.p0, m.feet, m.sides
     reach = robot.reach.radius
-    p0 = start.foot(start.stance)
-
-    b = ProblemBuilder()
-    # Footsteps (3-D). Tight bounds, all implied by the constraints (so the optimum is unchanged):
-    # inside the terrain box, within i steps of reach of footstep 0 and within N - i (N - 1 - i) of
-    # the final footstep N (N - 1), whose positions the goal fixes; heights likewise.
-    # With ``swing_max`` a foot is also within L_swing per swing of its previous and next
-    # position of the same foot (its start position and its goal spot).
-    swing_from = start.foot(sides[1])[:2] if n >= 1 else p0[:2]
-    p = b.add_vars("p", (n + 1, 3), lb=lo_box, ub=hi_box)
+    swing_max = m.options.swing_max
+    lo_box, hi_box = m.scene.terrain.bounds()
+    m.p = p = b.add_vars("p", (n + 1, 3), lb=lo_box, ub=hi_box)
     for i in range(n + 1):
         anchors = [(p0[:2], float(i) * reach), (feet[sides[n]], float(n - i) * reach)]
         if i <= n - 1:
             anchors.append((feet[sides[n - 1]], float(n - 1 - i) * reach))
-        if options.swing_max is not None and i >= 1:
-            home = p0[:2] if i % 2 == 0 else swing_from
+        if swing_max is not None and i >= 1:
+            home = p0[:2] if i % 2 == 0 else m.swing_from
             goal_i = n if (n - i) % 2 == 0 else n - 1
-            anchors.append((home, math.ceil(i / 2) * options.swing_max))
-            anchors.append((feet[sides[goal_i]], (goal_i - i) // 2 * options.swing_max))
+            anchors.append((home, math.ceil(i / 2) * swing_max))
+            anchors.append((feet[sides[goal_i]], (goal_i - i) // 2 * swing_max))
         for j in range(2):
             lo = max(float(centre[j]) - r for centre, r in anchors)
             hi = min(float(centre[j]) + r for centre, r in anchors)
@@ -181,9 +251,15 @@ def build_footstep_problem(
     for j in range(3):
         b.set_bounds(int(p[0, j]), float(p0[j]), float(p0[j]))
 
-    # Headings: |theta_i - theta_0| <= i theta_max and |theta_i - theta_goal| <= (N - i) theta_max
-    # follow from (5.12e) and the goal heading; the window is one turn around theta_0.
-    theta = b.add_vars("theta", (n + 1,))
+
+def _add_headings(m: _Model) -> None:
+    """Headings ``theta_i`` [rad] and their piecewise-linear ``s_i``, ``c_i`` (eq. 5.12g-h).
+
+    ``|theta_i - theta_0| <= i theta_max`` and ``|theta_i - theta_goal| <= (N - i) theta_max``
+    follow from (5.12e) and the goal heading; the window is one turn around theta_0.
+    """
+    b, n, robot, theta0, theta_goal = m.b, m.n, m.robot, m.theta0, m.theta_goal
+    m.theta = theta = b.add_vars("theta", (n + 1,))
     for i in range(n + 1):
         span = min(i * robot.theta_max, math.pi)
         to_goal = (n - i) * robot.theta_max
@@ -192,34 +268,32 @@ def build_footstep_problem(
             max(theta0 - span, theta_goal - to_goal),
             min(theta0 + span, theta_goal + to_goal),
         )
-    s = b.add_vars("s", (n + 1,), lb=-1.0, ub=1.0)
-    c = b.add_vars("c", (n + 1,), lb=-1.0, ub=1.0)
-    for arr, val in ((s, math.sin(theta0)), (c, math.cos(theta0))):
+    m.s = b.add_vars("s", (n + 1,), lb=-1.0, ub=1.0)
+    m.c = b.add_vars("c", (n + 1,), lb=-1.0, ub=1.0)
+    for arr, val in ((m.s, math.sin(theta0)), (m.c, math.cos(theta0))):
         b.set_bounds(int(arr[0]), val, val)
 
-    # ALIP states and torques (sparse form).
-    pos_b = 1.0  # |CoM - stance| <= 1 m: a leg longer than that is not a biped this models
-    mom_b = mzh * options.momentum_bound
-    x_lb = np.array([-pos_b, -pos_b, -mom_b, -mom_b])
-    shape_x, shape_u = (
-        ((n, k_nodes, 4), (n, k_nodes - 1, 2))
-        if dynamics
-        else ((0, k_nodes, 4), (0, k_nodes - 1, 2))
-    )
-    x = b.add_vars("x", shape_x, lb=x_lb, ub=-x_lb)
-    u = b.add_vars("u", shape_u, lb=-robot.u_max, ub=robot.u_max)
-    x_final = b.add_vars(
-        "x_final",
-        (4 if dynamics else 0,),
-        lb=x_lb[: 4 if dynamics else 0],
-        ub=-x_lb[: 4 if dynamics else 0],
-    )
 
-    # (5.12c) initial state
-    for j in range(4 if dynamics else 0):
-        b.add_eq({int(x[0, 0, j]): 1.0}, float(start.alip_state[j]), f"5.12c x_init[{j}]")
-    # (5.12a) single-support dynamics
-    for i in range(n if dynamics else 0):
+def _add_alip(m: _Model) -> None:
+    """ALIP states ``x_{i,k}`` and torques ``u_{i,k}`` (sparse form) with the initial state
+    (5.12c), the single-support dynamics (5.12a), the reset map onto the next footstep (5.12b,
+    with the corrected eq. 5.10) and the torque bound (5.12d). Without dynamics the blocks are
+    empty."""
+    b, n, robot, p = m.b, m.n, m.robot, m.p
+    k_nodes = robot.n_nodes
+    pos_b = 1.0  # |CoM - stance| <= 1 m: a leg longer than that is not a biped this models
+    mom_b = robot.mass * robot.com_height * m.options.momentum_bound
+    x_lb = np.array([-pos_b, -pos_b, -mom_b, -mom_b])
+    n_dyn, n_final = (n, 4) if m.dynamics else (0, 0)
+    m.x = x = b.add_vars("x", (n_dyn, k_nodes, 4), lb=x_lb, ub=-x_lb)
+    m.u = u = b.add_vars("u", (n_dyn, k_nodes - 1, 2), lb=-robot.u_max, ub=robot.u_max)
+    m.x_final = b.add_vars("x_final", (n_final,), lb=x_lb[:n_final], ub=-x_lb[:n_final])
+    alip = robot.alip()
+    ad, bd = alip.discretize(robot.node_dt)
+    a_r, b_r = alip.reset_map(robot.t_ds)
+    for j in range(n_final):  # (5.12c) initial state
+        b.add_eq({int(x[0, 0, j]): 1.0}, float(m.scene.start.alip_state[j]), f"5.12c x_init[{j}]")
+    for i in range(n_dyn):  # (5.12a) single-support dynamics
         for k in range(k_nodes - 1):
             for j in range(4):
                 row: dict[int, float] = {int(x[i, k + 1, j]): 1.0}
@@ -228,9 +302,8 @@ def build_footstep_problem(
                 for jj in range(2):
                     row[int(u[i, k, jj])] = row.get(int(u[i, k, jj]), 0.0) - bd[j, jj]
                 b.add_eq(row, 0.0, f"5.12a dynamics step {i} node {k} row {j}")
-    # (5.12b) reset map onto the next footstep
-    for i in range(n if dynamics else 0):
-        nxt = x[i + 1, 0] if i + 1 < n else x_final
+    for i in range(n_dyn):  # (5.12b) reset map onto the next footstep
+        nxt = x[i + 1, 0] if i + 1 < n else m.x_final
         for j in range(4):
             row = {int(nxt[j]): 1.0}
             for jj in range(4):
@@ -241,27 +314,33 @@ def build_footstep_problem(
                     row[int(p[i + 1, jj])] = row.get(int(p[i + 1, jj]), 0.0) - coef
                     row[int(p[i, jj])] = row.get(int(p[i, jj]), 0.0) + coef
             b.add_eq(row, 0.0, f"5.12b reset {i}->{i + 1} row {j}")
-    # (5.12d) torque bound
-    for i in range(n if dynamics else 0):
+    for i in range(n_dyn):  # (5.12d) torque bound
         for k in range(k_nodes - 1):
             b.add_cone(u[i, k], robot.u_max)
-    # (5.12e) heading rate
-    for i in range(n):
+
+
+def _add_heading_rate_and_step_height(m: _Model) -> None:
+    """Heading rate ``|theta_{i+1} - theta_i| <= theta_max`` (5.12e) and the step-height bound
+    ``|z_{i+1} - z_i| <= step_height_max``."""
+    b, robot, theta, p = m.b, m.robot, m.theta, m.p
+    for i in range(m.n):
         b.add_le({int(theta[i + 1]): 1.0, int(theta[i]): -1.0}, robot.theta_max, f"5.12e rate {i}")
         b.add_le({int(theta[i + 1]): -1.0, int(theta[i]): 1.0}, robot.theta_max, f"5.12e rate {i}")
-    # Step height between consecutive footsteps.
-    for i in range(n):
+    for i in range(m.n):
         zi, zn = int(p[i, 2]), int(p[i + 1, 2])
         b.add_le({zn: 1.0, zi: -1.0}, robot.step_height_max, f"step height {i}")
         b.add_le({zn: -1.0, zi: 1.0}, robot.step_height_max, f"step height {i}")
 
-    # (5.12g-h, 5.14) heading segments over [theta0 - pi, theta0 + pi]
-    n_seg = options.heading_segments
-    breaks = theta0 - math.pi + 2.0 * math.pi * np.arange(n_seg + 1) / n_seg
-    half = math.pi / n_seg  # half the segment width
-    segments = np.full((n + 1, n_seg), -1, dtype=np.int64)
-    for i in range(1, n + 1):
-        t_lo, t_hi = b.bounds(int(theta[i]))
+
+def _add_heading_segments(m: _Model) -> None:
+    """Segment binaries ``S_{l,i}`` over ``[theta0 - pi, theta0 + pi]``: one segment per footstep
+    (5.12k), theta in it (5.14) and ``s_i``, ``c_i`` on its chord of sin and cos (5.12g-h).
+    Segments outside a footstep's heading bounds get no binary."""
+    b, n_seg = m.b, m.options.heading_segments
+    m.breaks = breaks = m.theta0 - math.pi + 2.0 * math.pi * np.arange(n_seg + 1) / n_seg
+    m.segments = segments = np.full((m.n + 1, n_seg), -1, dtype=np.int64)
+    for i in range(1, m.n + 1):
+        t_lo, t_hi = b.bounds(int(m.theta[i]))
         live = [
             ell
             for ell in range(n_seg)
@@ -270,36 +349,40 @@ def build_footstep_problem(
         for ell in live:
             segments[i, ell] = int(b.add_binaries(f"S[{i},{ell}]", ())[()])
         b.add_eq({int(segments[i, ell]): 1.0 for ell in live}, 1.0, f"5.12j one segment {i}")
-        ti = int(theta[i])
+        ti = int(m.theta[i])
         for ell in live:
             z = int(segments[i, ell])
             phi_a, phi_b = float(breaks[ell]), float(breaks[ell + 1])
             b.add_le_big_m({ti: -1.0}, -phi_a, z, f"5.14a theta_{i} >= phi_{ell}")
             b.add_le_big_m({ti: 1.0}, phi_b, z, f"5.14a theta_{i} <= phi_{ell + 1}")
-            for var, fn in ((s, math.sin), (c, math.cos)):
+            for var, fn in ((m.s, math.sin), (m.c, math.cos)):
                 g_l = (fn(phi_b) - fn(phi_a)) / (phi_b - phi_a)
                 h_l = fn(phi_a) - g_l * phi_a
                 label = f"5.12{'g' if fn is math.sin else 'h'} step {i} segment {ell}"
                 b.add_le_big_m({int(var[i]): 1.0, ti: -g_l}, h_l, z, label)
                 b.add_le_big_m({int(var[i]): -1.0, ti: g_l}, -h_l, z, label)
 
-    # (5.12f) reachability of footstep i+1 from footstep i in Rot(theta_i) R_reach(side_i); with
-    # ``reach_both_frames`` the same step also in the landing foot's frame Rot(theta_{i+1}).
-    frames = (0, 1) if options.reach_both_frames else (0,)
-    for i in range(n):
-        g_rows, h_rows = robot.reach.halfspaces(sides[i])
+
+def _add_reach(m: _Model) -> None:
+    """Reachability (5.12f) of footstep i+1 from footstep i in ``Rot(theta_i) R_reach(side_i)``,
+    linear and conservative per heading segment (module docstring); with ``reach_both_frames``
+    the same step also in the landing foot's frame ``Rot(theta_{i+1})``."""
+    b, p, n_seg, breaks = m.b, m.p, m.options.heading_segments, m.breaks
+    half = math.pi / n_seg  # half the segment width
+    frames = (0, 1) if m.options.reach_both_frames else (0,)
+    for i in range(m.n):
+        g_rows, h_rows = m.robot.reach.halfspaces(m.sides[i])
         d = {int(p[i + 1, 0]): 1.0, int(p[i, 0]): -1.0}, {int(p[i + 1, 1]): 1.0, int(p[i, 1]): -1.0}
         for f in frames:
             k = i + f  # the footstep whose heading frame holds the step
             if k == 0:
-                rot = rot2(theta0)
+                rot = rot2(m.theta0)
                 for j, (g, h) in enumerate(zip(g_rows, h_rows, strict=True)):
                     a = rot @ g  # (Rot g)^T d = g^T Rot^T d
-                    row = _combine(d, a)
-                    b.add_le(row, float(h), f"5.12f reach 0 row {j}")
+                    b.add_le(_combine(d, a), float(h), f"5.12f reach 0 row {j}")
                 continue
             for ell in range(n_seg):
-                z = int(segments[k, ell])
+                z = int(m.segments[k, ell])
                 if z < 0:
                     continue
                 for j, (g, h) in enumerate(zip(g_rows, h_rows, strict=True)):
@@ -309,27 +392,36 @@ def build_footstep_problem(
                         label = f"5.12f reach {i} frame {k} segment {ell} row {j}"
                         b.add_le_big_m(row, h_eff, z, label)
 
-    # Swing bound (beyond the document, option ``swing_max``): footstep i within L_swing of the
-    # same foot's previous position, through the rows of the inscribed SWING_SIDES-gon.
-    if options.swing_max is not None:
-        m_sides = SWING_SIDES
-        rhs = options.swing_max * math.cos(math.pi / m_sides)
-        for i in range(1, n + 1):
-            for j in range(m_sides):
-                phi = 2.0 * math.pi * j / m_sides
-                nx, ny = math.cos(phi), math.sin(phi)
-                row = {int(p[i, 0]): nx, int(p[i, 1]): ny}
-                if i >= 2:
-                    row[int(p[i - 2, 0])] = -nx
-                    row[int(p[i - 2, 1])] = -ny
-                    b.add_le(row, rhs, f"swing {i} row {j}")
-                else:  # the first swing starts at the scene's start position of that foot
-                    b.add_le(row, rhs + nx * swing_from[0] + ny * swing_from[1], f"swing 1 row {j}")
 
-    # (5.12i-k) region assignment for footsteps 1..N. A region whose bounding box misses the
-    # footstep's bounds can never hold it, so it gets no binary (H fixed to 0).
-    regions = np.full((n + 1, len(terrain)), -1, dtype=np.int64)
-    for i in range(1, n + 1):
+def _add_swing_bound(m: _Model) -> None:
+    """Beyond the document (option ``swing_max``): footstep i within L_swing of the same foot's
+    previous position, through the rows of the inscribed ``SWING_SIDES``-gon."""
+    if m.options.swing_max is None:
+        return
+    b, p = m.b, m.p
+    rhs = m.options.swing_max * math.cos(math.pi / SWING_SIDES)
+    for i in range(1, m.n + 1):
+        for j in range(SWING_SIDES):
+            phi = 2.0 * math.pi * j / SWING_SIDES
+            nx, ny = math.cos(phi), math.sin(phi)
+            row = {int(p[i, 0]): nx, int(p[i, 1]): ny}
+            if i >= 2:
+                row[int(p[i - 2, 0])] = -nx
+                row[int(p[i - 2, 1])] = -ny
+                b.add_le(row, rhs, f"swing {i} row {j}")
+            else:  # the first swing starts at the scene's start position of that foot
+                start = m.swing_from
+                b.add_le(row, rhs + nx * start[0] + ny * start[1], f"swing 1 row {j}")
+
+
+def _add_regions(m: _Model) -> None:
+    """Region binaries ``H_{r,i}`` of footsteps 1..N: one region per footstep (5.12j) and, under
+    big-M (5.12i), the region's plane rows (5.15-5.17) and polygon rows (5.18, moved in by
+    ``region_margin``). A region whose bounding box misses the footstep's bounds can never hold
+    it, so it gets no binary (H fixed to 0)."""
+    b, p, terrain = m.b, m.p, m.scene.terrain
+    m.regions = regions = np.full((m.n + 1, len(terrain)), -1, dtype=np.int64)
+    for i in range(1, m.n + 1):
         box = [b.bounds(int(p[i, j])) for j in range(3)]
         for r_idx, region in enumerate(terrain):
             corners = region.vertices3d
@@ -349,65 +441,43 @@ def build_footstep_problem(
                 continue
             a_pl, b_pl = region.plane_rows()  # eq. 5.17
             for row_a, row_b in zip(a_pl, b_pl, strict=True):
-                b.add_le_big_m(
-                    dict(zip(pv, map(float, row_a), strict=True)), float(row_b), z,
-                    f"5.17 plane {region.name} step {i}",
-                )  # fmt: skip
+                row = dict(zip(pv, map(float, row_a), strict=True))
+                b.add_le_big_m(row, float(row_b), z, f"5.17 plane {region.name} step {i}")
             a_poly, b_poly = region.halfspaces()  # eq. 5.18, unit outward normals
-            b_poly = b_poly - options.region_margin
+            b_poly = b_poly - m.options.region_margin
             for row_a, row_b in zip(a_poly, b_poly, strict=True):
-                b.add_le_big_m(
-                    dict(zip(pv[:2], map(float, row_a), strict=True)), float(row_b), z,
-                    f"5.18 polygon {region.name} step {i}",
-                )  # fmt: skip
+                row = dict(zip(pv[:2], map(float, row_a), strict=True))
+                b.add_le_big_m(row, float(row_b), z, f"5.18 polygon {region.name} step {i}")
 
-    # Goal: the last two footsteps stand at the goal pose.
-    for i in (n - 1, n):
+
+def _add_goal(m: _Model) -> FloatArray:
+    """The last two footsteps stand at the goal pose; returns ``x_goal`` (4,): at rest with the
+    CoM at the goal midpoint, relative to footstep N."""
+    for i in (m.n - 1, m.n):
         for j in range(2):
-            b.add_eq({int(p[i, j]): 1.0}, float(feet[sides[i]][j]), f"goal footstep {i}")
-        b.add_eq({int(theta[i]): 1.0}, theta_goal, f"goal heading {i}")
-    # x_goal: at rest with the CoM at the goal midpoint, relative to footstep N.
-    mid_rel = scene.goal.position[:2] - feet[sides[n]]
-    x_goal = np.array([mid_rel[0], mid_rel[1], 0.0, 0.0])
+            m.b.add_eq({int(m.p[i, j]): 1.0}, float(m.feet[m.sides[i]][j]), f"goal footstep {i}")
+        m.b.add_eq({int(m.theta[i]): 1.0}, m.theta_goal, f"goal heading {i}")
+    mid_rel = m.scene.goal.position[:2] - m.feet[m.sides[m.n]]
+    return np.array([mid_rel[0], mid_rel[1], 0.0, 0.0])
 
-    # Objective (5.11)
-    for i in range(n if dynamics else 0):
-        for k in range(k_nodes - 1):
+
+def _add_objective(m: _Model, x_goal: FloatArray) -> None:
+    """The objective (5.11): torque effort, terminal state, heading smoothness, step size."""
+    b, n, w, p, theta = m.b, m.n, m.options.weights, m.p, m.theta
+    for i in range(m.x.shape[0]):
+        for k in range(m.robot.n_nodes - 1):
             for j in range(2):
-                b.add_square({int(u[i, k, j]): 1.0}, 0.0, w.torque, "torque")
-    q_x = w.terminal_diag(robot)
-    for j in range(4 if dynamics else 0):
-        b.add_square({int(x_final[j]): 1.0}, float(x_goal[j]), w.terminal * q_x[j], "terminal")
+                b.add_square({int(m.u[i, k, j]): 1.0}, 0.0, w.torque, "torque")
+    q_x = w.terminal_diag(m.robot)
+    for j in range(m.x_final.shape[0]):
+        b.add_square({int(m.x_final[j]): 1.0}, float(x_goal[j]), w.terminal * q_x[j], "terminal")
     for i in range(n - 1):
-        b.add_square(
-            {int(theta[i + 2]): 1.0, int(theta[i + 1]): -2.0, int(theta[i]): 1.0}, 0.0, w.heading,
-            "heading",
-        )  # fmt: skip
+        row = {int(theta[i + 2]): 1.0, int(theta[i + 1]): -2.0, int(theta[i]): 1.0}
+        b.add_square(row, 0.0, w.heading, "heading")
     for i in range(n):
         for j in range(3):
-            b.add_square(
-                {int(p[i + 1, j]): 1.0, int(p[i, j]): -1.0}, 0.0, w.step * w.step_matrix[j], "step"
-            )
-
-    return FootstepProblem(
-        problem=b.build(),
-        scene=scene,
-        robot=robot,
-        n_steps=n,
-        options=options,
-        sides=sides,
-        p=p,
-        theta=theta,
-        s=s,
-        c=c,
-        x=x,
-        u=u,
-        x_final=x_final,
-        regions=regions,
-        segments=segments,
-        breakpoints=breaks,
-        x_goal=x_goal,
-    )
+            row = {int(p[i + 1, j]): 1.0, int(p[i, j]): -1.0}
+            b.add_square(row, 0.0, w.step * w.step_matrix[j], "step")
 
 
 def _combine(d: tuple[dict[int, float], dict[int, float]], a: FloatArray) -> dict[int, float]:

@@ -7,15 +7,13 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from footfall._typing import FloatArray
 from footfall._validate import non_negative, positive
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.solvers import KNOWN_BACKENDS
 from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
-
-FloatArray = NDArray[np.float64]
 
 PLANNERS = ("miqcqp", "kinematic", "reactive")
 
@@ -239,16 +237,74 @@ class FootstepPlan:
         u = self.torques
         return np.stack([-u[..., 1], u[..., 0]], axis=-1) / mg
 
+    def to_dict(self, scene_name: str = "") -> dict[str, Any]:
+        """Plain-JSON dict of the plan (the ``plan.json`` of ``footfall plan``), SI units (m, rad,
+        s, N m, kg m^2/s); :meth:`from_dict` reads it back.
+
+        Keys: ``status``, ``planner``, ``scene``, ``message``, ``objective``, ``bound``, ``gap``,
+        ``solve_time_s``, ``solver``, ``region_margin`` [m], ``reach_both_frames``, ``swing_max``
+        [m] (null: no swing bound), ``heading_segments``, ``stats``, ``robot``, ``footsteps``
+        (``index``, ``side``, ``position``, ``heading``, ``region``; index 0 is the initial stance
+        foot) and ``alip`` (``states`` per step: K states of 4; ``torques`` per step: K - 1
+        torques of 2; ``final_state``; the state layout). Unknown numbers (NaN, inf) are null.
+        """
+        stats = {k: (_num(v) if isinstance(v, float) else v) for k, v in self.stats.items()}
+        r = self.robot
+        return {
+            "status": self.status.value,
+            "planner": self.planner,
+            "scene": scene_name,
+            "message": self.message,
+            "objective": _num(self.objective),
+            "bound": _num(self.bound),
+            "gap": _num(self.gap),
+            "solve_time_s": self.solve_time,
+            "solver": self.solver,
+            "region_margin": self.region_margin,
+            "reach_both_frames": self.reach_both_frames,
+            "swing_max": self.swing_max,
+            "heading_segments": self.heading_segments,
+            "stats": stats,
+            "robot": {
+                "mass": r.mass,
+                "com_height": r.com_height,
+                "t_ss": r.t_ss,
+                "t_ds": r.t_ds,
+                "n_nodes": r.n_nodes,
+                "u_max": r.u_max,
+            },
+            "footsteps": [
+                {
+                    "index": i,
+                    "side": self.sides[i].value,
+                    "position": self.footsteps[i].tolist(),
+                    "heading": float(self.headings[i]),
+                    "region": self.regions[i],
+                }
+                for i in range(self.footsteps.shape[0])
+            ],
+            "alip": {
+                "state_layout": ["x_c [m]", "y_c [m]", "L_x [kg m^2/s]", "L_y [kg m^2/s]"],
+                "states": self.states.tolist(),
+                "torques": self.torques.tolist(),
+                "final_state": [_num(v) for v in self.final_state],
+            },
+        }
+
+    @classmethod
+    def from_dict(cls, data: object, robot: BipedParams, source: str = "plan") -> FootstepPlan:
+        """The plan written by :meth:`to_dict`, for ``robot`` (the file holds only part of it).
+
+        Every field is checked (types, shapes for ``robot.n_nodes``, finite numbers, known
+        statuses and sides); a bad one raises :class:`InputError` naming ``source`` and the field.
+        Nothing in the file is executed: it is JSON data.
+        """
+        return _plan_from_dict(data, robot, source)
+
 
 def wrap_near(angle: float, reference: float) -> float:
     """``angle`` shifted by a multiple of 2 pi into [reference - pi, reference + pi)."""
     return reference + (angle - reference + math.pi) % (2.0 * math.pi) - math.pi
-
-
-def rot2(theta: float) -> FloatArray:
-    """2-D rotation matrix Rot(theta) of eq. (5.13)."""
-    c, s = math.cos(theta), math.sin(theta)
-    return np.array([[c, -s], [s, c]])
 
 
 def goal_feet(robot: BipedParams, goal_xy: FloatArray, heading: float) -> dict[Side, FloatArray]:
@@ -263,3 +319,105 @@ def check_planner_name(name: str) -> str:
     if name not in PLANNERS:
         raise InputError("planner", name, f"one of {', '.join(PLANNERS)}")
     return name
+
+
+def _num(v: float) -> float | None:
+    """JSON has no NaN/inf: unknown numbers become null."""
+    return float(v) if math.isfinite(v) else None
+
+
+def _plan_from_dict(data: object, robot: BipedParams, source: str) -> FootstepPlan:
+    """See :meth:`FootstepPlan.from_dict`."""
+
+    def bad(fld: str, value: object, expected: str) -> InputError:
+        return InputError(f"{source}.{fld}", value, expected)
+
+    def get(d: object, key: str, where: str) -> Any:
+        if not isinstance(d, dict) or key not in d:
+            raise bad(where, d if not isinstance(d, dict) else sorted(d), f"an object with {key!r}")
+        return d[key]
+
+    def array(value: object, fld: str, shape: tuple[int, ...], nan_ok: bool = False) -> FloatArray:
+        try:
+            arr = np.array(value, dtype=float)
+        except (TypeError, ValueError):
+            raise bad(fld, value, f"numbers of shape {shape}") from None
+        if arr.shape != shape:
+            raise bad(fld, value, f"numbers of shape {shape}, got {arr.shape}")
+        if not nan_ok and not np.all(np.isfinite(arr)):
+            raise bad(fld, value, "finite numbers")
+        return arr
+
+    def number(value: object, fld: str, default: float) -> float:
+        if value is None:
+            return default
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise bad(fld, value, "a number or null")
+        return float(value)
+
+    try:
+        status = SolveStatus(get(data, "status", "status"))
+    except ValueError:
+        raise bad("status", get(data, "status", "status"), "a SolveStatus value") from None
+    steps = get(data, "footsteps", "footsteps")
+    if not isinstance(steps, list):
+        raise bad("footsteps", steps, "a list of footsteps")
+    n = len(steps) - 1
+    if n < 0:
+        return _empty_from_dict(data, status, robot)
+    k = robot.n_nodes
+    sides = []
+    for i, st in enumerate(steps):
+        try:
+            sides.append(Side(get(st, "side", f"footsteps[{i}]")))
+        except ValueError:
+            raise bad(f"footsteps[{i}].side", st["side"], "'left' or 'right'") from None
+        region = get(st, "region", f"footsteps[{i}]")
+        if not isinstance(region, str):
+            raise bad(f"footsteps[{i}].region", region, "a region name")
+    alip = get(data, "alip", "alip")
+    planner = get(data, "planner", "planner")
+    if planner not in PLANNERS:
+        raise bad("planner", planner, f"one of {', '.join(PLANNERS)}")
+    segments = data.get("heading_segments") if isinstance(data, dict) else None
+    if segments is not None and (isinstance(segments, bool) or not isinstance(segments, int)):
+        raise bad("heading_segments", segments, "an integer or null")
+    swing = data.get("swing_max") if isinstance(data, dict) else None
+    assert isinstance(data, dict)
+    positions = [get(st, "position", f"footsteps[{i}]") for i, st in enumerate(steps)]
+    headings = [get(st, "heading", f"footsteps[{i}]") for i, st in enumerate(steps)]
+    return FootstepPlan(
+        planner=planner,
+        status=status,
+        robot=robot,
+        footsteps=array(positions, "footsteps[].position", (n + 1, 3)),
+        headings=array(headings, "footsteps[].heading", (n + 1,)),
+        sides=tuple(sides),
+        regions=tuple(st["region"] for st in steps),
+        states=array(get(alip, "states", "alip"), "alip.states", (n, k, 4)),
+        torques=array(get(alip, "torques", "alip"), "alip.torques", (n, k - 1, 2)),
+        final_state=array(
+            [math.nan if v is None else v for v in get(alip, "final_state", "alip")],
+            "alip.final_state",
+            (4,),
+            nan_ok=True,
+        ),
+        objective=number(data.get("objective"), "objective", math.nan),
+        bound=number(data.get("bound"), "bound", math.nan),
+        gap=number(data.get("gap"), "gap", math.inf),
+        solve_time=number(data.get("solve_time_s"), "solve_time_s", 0.0),
+        solver=str(data.get("solver", "none")),
+        message=str(data.get("message", "")),
+        region_margin=number(data.get("region_margin"), "region_margin", 0.0),
+        reach_both_frames=bool(data.get("reach_both_frames", False)),
+        swing_max=None if swing is None else number(swing, "swing_max", math.nan),
+        heading_segments=segments,
+    )
+
+
+def _empty_from_dict(data: object, status: SolveStatus, robot: BipedParams) -> FootstepPlan:
+    """A plan without footsteps read from ``data`` (planner, status and message only)."""
+    d = data if isinstance(data, dict) else {}
+    return FootstepPlan.empty(
+        str(d.get("planner", "none")), status, robot, str(d.get("message", ""))
+    )

@@ -18,6 +18,7 @@ from enum import Enum
 import numpy as np
 from numpy.typing import NDArray
 
+from footfall._typing import FloatArray
 from footfall._validate import non_negative, positive
 from footfall.errors import InputError
 from footfall.quadruped.kinematics import (
@@ -32,8 +33,6 @@ from footfall.quadruped.robot import LEGS, Leg, QuadrupedRobot
 from footfall.quadruped.stability import stability_margins, support_polygon, zmp_from_momentum
 from footfall.quadruped.swing import SwingProfile, swing_in_leg_frame
 from footfall.quadruped.zmp_planning import ZmpStrategy, swing_groups, swing_order, zmp_target
-
-FloatArray = NDArray[np.float64]
 
 #: fixed-point iterations placing the body so that the whole-body CoM is on the ZMP target;
 #: the legs hold 20 % of the mass, so each iteration shrinks the CoM error about fivefold

@@ -18,12 +18,11 @@ Body orientation: footfall's gaits only pitch the body. ``pitch_up`` is the docu
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from footfall._typing import FloatArray
 from footfall.errors import InputError
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, Leg, QuadrupedRobot
-
-FloatArray = NDArray[np.float64]
 
 #: tolerance on the law-of-cosines argument before a target counts as out of reach
 _REACH_TOL = 1e-9

@@ -20,14 +20,12 @@ from dataclasses import dataclass
 from enum import Enum
 
 import numpy as np
-from numpy.typing import NDArray
 
+from footfall._typing import FloatArray
 from footfall._validate import finite, non_negative, positive
 from footfall.errors import InputError
 from footfall.quadruped.kinematics import body_rotation
 from footfall.quadruped.robot import LEGS, Leg, QuadrupedRobot
-
-FloatArray = NDArray[np.float64]
 
 #: steepest slope footfall accepts at all; beyond it tan(beta_S) blows up the geometry
 MAX_SLOPE = math.radians(60.0)

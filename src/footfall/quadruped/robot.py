@@ -20,12 +20,10 @@ from dataclasses import dataclass, field
 from enum import Enum
 
 import numpy as np
-from numpy.typing import NDArray
 
+from footfall._typing import FloatArray
 from footfall._validate import finite_vector, positive
 from footfall.errors import InputError
-
-FloatArray = NDArray[np.float64]
 
 
 class Leg(str, Enum):

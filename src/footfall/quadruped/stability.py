@@ -7,12 +7,11 @@ support polygons are returned counter-clockwise.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from footfall._typing import FloatArray
 from footfall.errors import InputError
 from footfall.models.lip import GRAVITY
-
-FloatArray = NDArray[np.float64]
 
 #: points closer than this [m] count as the same point when building a hull
 _GEOM_EPS = 1e-12

@@ -12,12 +12,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from footfall._typing import FloatArray
 from footfall._validate import non_negative, positive
 from footfall.quadruped.kinematics import rot_y
-
-FloatArray = NDArray[np.float64]
 
 TWO_PI = 2.0 * np.pi
 FOUR_PI = 4.0 * np.pi

@@ -18,14 +18,12 @@ from __future__ import annotations
 
 from enum import Enum
 
-import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from footfall._typing import FloatArray
 from footfall.errors import InfeasibleError
 from footfall.quadruped.robot import Leg
 from footfall.quadruped.stability import clip_convex, incentre, line_intersection
-
-FloatArray = NDArray[np.float64]
 
 
 class ZmpStrategy(str, Enum):

@@ -86,13 +86,12 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
+from footfall._typing import FloatArray, IntArray
 from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
 from footfall.solvers.problem import MIQCQP
 
 NAME = "bnb"
 
-FloatArray = NDArray[np.float64]
-IntArray = NDArray[np.int64]
 
 #: a relaxation weight within this of 0 or 1 counts as integral
 INT_TOL = 1e-6

@@ -16,15 +16,14 @@ planner itself does not change.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from footfall._geometry import clip_halfplane, outward_halfspaces, signed_area
+from footfall._typing import FloatArray
 from footfall._validate import non_negative, positive
 from footfall.errors import InputError
 from footfall.terrain.region import MIN_AREA, Region
 from footfall.terrain.terrain import Terrain
-
-FloatArray = NDArray[np.float64]
 
 #: a step up of at most this [m] where a neighbour begins is no riser (surfaces meet within it)
 RISER_MIN_RISE = 0.005

@@ -12,12 +12,11 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from footfall._geometry import as_points, convexity_defect, outward_halfspaces, signed_area
+from footfall._typing import FloatArray
 from footfall.errors import SceneError
-
-FloatArray = NDArray[np.float64]
 
 #: largest distance [m] of a 3-D vertex from its fitted plane for the polygon to count as planar
 PLANAR_TOL = 1e-6

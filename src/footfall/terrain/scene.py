@@ -16,17 +16,16 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 import yaml
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from footfall._geometry import outward_halfspaces, polygon_distance
+from footfall._geometry import outward_halfspaces, polygon_distance, rot2
+from footfall._typing import FloatArray
 from footfall._validate import finite, finite_vector
 from footfall.errors import InputError, SceneError
 from footfall.models.biped import BipedParams, ReachTrapezoid, Side
 from footfall.terrain.region import Region
 from footfall.terrain.terrain import Terrain
-
-FloatArray = NDArray[np.float64]
 
 #: tolerance [m] for the start feet and the goal to count as on a region (plane and polygon); looser
 #: than Region.contains' default because hand-written YAML heights are rounded
@@ -445,10 +444,9 @@ def _floats(a: ArrayLike) -> Any:
     return (np.asarray(a, dtype=float) + 0.0).tolist()  # + 0.0 turns -0.0 into 0.0
 
 
-def scene_to_dict(scene: Scene) -> dict[str, Any]:
-    """The scene as plain data following the YAML schema (every robot field written out)."""
-    r = scene.robot
-    robot: dict[str, Any] = {
+def robot_to_dict(r: BipedParams) -> dict[str, Any]:
+    """The robot as plain data following the scene YAML schema's ``robot:`` (every field)."""
+    return {
         "mass": r.mass,
         "com_height": r.com_height,
         "t_ss": r.t_ss,
@@ -463,6 +461,10 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
         "foot_width": r.foot_width,
         "g": r.g,
     }
+
+
+def scene_to_dict(scene: Scene) -> dict[str, Any]:
+    """The scene as plain data following the YAML schema (every robot field written out)."""
     regions: list[dict[str, Any]] = []
     for reg in scene.terrain:
         entry: dict[str, Any] = {"name": reg.name}
@@ -476,7 +478,7 @@ def scene_to_dict(scene: Scene) -> dict[str, Any]:
     return {
         "name": scene.name,
         "description": scene.description,
-        "robot": robot,
+        "robot": robot_to_dict(scene.robot),
         "start": {
             "left": _floats(scene.start.left),
             "right": _floats(scene.start.right),
@@ -519,11 +521,6 @@ def _rect(centre: FloatArray, length: float, width: float, yaw: float) -> FloatA
     c, s = math.cos(yaw), math.sin(yaw)
     local = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=float) * [length / 2, width / 2]
     return centre + local @ np.array([[c, s], [-s, c]])
-
-
-def _rot(yaw: float) -> FloatArray:
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([[c, -s], [s, c]])
 
 
 def _sample_reach(
@@ -597,10 +594,10 @@ def random_stepping_stones(
         for _ in range(2_000):
             q = _sample_reach(rng, robot.reach, side, forward_min, margin)
             new_psi = psi + float(rng.uniform(-max_turn, max_turn))
-            centre = point + _rot(psi) @ q  # reach is in the stance foot's frame (eq. 5.12f)
+            centre = point + rot2(psi) @ q  # reach is in the stance foot's frame (eq. 5.12f)
             if last:
                 # Goal pad: big enough for both feet, the reached point 0.2 m behind its centre.
-                pad_centre = centre + _rot(new_psi) @ np.array([0.2, 0.0])
+                pad_centre = centre + rot2(new_psi) @ np.array([0.2, 0.0])
                 poly = _rect(pad_centre, 0.6, 0.7, new_psi)
             else:
                 length = float(rng.uniform(*stone_length))

@@ -6,13 +6,12 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from footfall._geometry import inset_polygon, polygon_distance
+from footfall._typing import FloatArray
 from footfall.errors import SceneError
 from footfall.terrain.region import Region
-
-FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

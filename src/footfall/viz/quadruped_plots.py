@@ -10,8 +10,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from footfall._typing import FloatArray
 from footfall.quadruped.kinematics import body_rotation, foot_in_leg_frame
 from footfall.quadruped.robot import LEGS, Leg
 from footfall.quadruped.swing import SwingProfile, slope_to_leg_rotation, swing_in_leg_frame
@@ -20,9 +20,8 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
     from footfall.quadruped.gait import GaitPlan
-    from footfall.sim.quadruped_sim import SimResult
+    from footfall.sim.quadruped.sim import SimResult
 
-FloatArray = NDArray[np.float64]
 
 #: length of the drawn frame axes [m]
 _AXIS_LEN = 0.12

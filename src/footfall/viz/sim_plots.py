@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from matplotlib.patches import Polygon
 
-from footfall.sim.reduced import SimResult
+from footfall._geometry import rot2
+from footfall.sim.reduced.closed_loop import SimResult
 from footfall.terrain.terrain import Terrain
 from footfall.viz._mpl import plt, save
 
@@ -17,8 +17,7 @@ from footfall.viz._mpl import plt, save
 def _sole(
     ax: Any, foot: np.ndarray, heading: float, length: float, width: float, **kw: Any
 ) -> None:
-    c, s = math.cos(heading), math.sin(heading)
-    rot = np.array([[c, -s], [s, c]])
+    rot = rot2(heading)
     half = np.array([[1, 1], [-1, 1], [-1, -1], [1, -1]]) * np.array([length, width]) / 2
     ax.add_patch(Polygon(foot[:2] + half @ rot.T, closed=True, **kw))
 
@@ -109,32 +108,3 @@ def save_sim_figures(res: SimResult, out: Path, terrain: Terrain | None = None) 
         plot_zmp_offset(res, out / "sim_zmp.png"),
         plot_torques(res, out / "sim_torque.png"),
     ]
-
-
-def plot_compare(rows: list[dict[str, Any]], out: Path) -> list[Path]:
-    """Box plots of the per-trial mean and max single-support ZMP offset per scene and planner."""
-    scenes = list(dict.fromkeys(r["scene"] for r in rows))
-    planners = list(dict.fromkeys(r["planner"] for r in rows))
-    paths = []
-    for key, label in (("zmp_offset_mean", "mean"), ("zmp_offset_max", "max")):
-        fig, axes = plt.subplots(
-            1,
-            max(1, len(scenes)),
-            figsize=(4.5 * max(1, len(scenes)), 4),
-            squeeze=False,
-            constrained_layout=True,
-        )
-        for ax, scene in zip(axes[0], scenes, strict=False):
-            data = [
-                [
-                    1000 * r[key]
-                    for r in rows
-                    if r["scene"] == scene and r["planner"] == p and r[key] is not None
-                ]
-                for p in planners
-            ]
-            ax.boxplot(data, tick_labels=planners)
-            ax.set_title(scene)
-            ax.set_ylabel(f"{label} single-support ZMP offset [mm]")
-        paths.append(save(fig, out / f"compare_zmp_{label}.png"))
-    return paths

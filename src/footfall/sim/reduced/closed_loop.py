@@ -34,7 +34,7 @@ stops at the fall. The state also counts as fallen when it becomes non-finite. S
 the convex hull of the two final soles; ``success = not fell and stopped``.
 
 Engines. The loop runs either in Python (the reference: numpy and the :class:`MPC` class) or
-compiled with numba (:mod:`footfall.sim._reduced_kernel`, the default when numba is installed), which
+compiled with numba (:mod:`footfall.sim.reduced._kernel`, the default when numba is installed), which
 mirrors it operation by operation. Both read the same inputs, built once per run (plant matrices,
 noise, push table, the MPC's condensed matrices), and the metrics are computed from their
 trajectories by the same code, so they agree to rounding (tests check 1e-9).
@@ -54,47 +54,19 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from footfall._validate import finite, non_negative, positive
+from footfall._geometry import rot2
+from footfall._typing import FloatArray
+from footfall._validate import non_negative, positive
 from footfall.control.mpc import MPC, SOLVERS, CondensedMPC, MPCWeights, build_mpc
 from footfall.errors import InputError, SolverUnavailableError
 from footfall.models._linear import zoh
 from footfall.models.alip import ALIP
 from footfall.models.biped import BipedParams
 from footfall.planning.plan import FootstepPlan
-
-FloatArray = NDArray[np.float64]
+from footfall.sim.pushes import Push
 
 #: ways to run the loop (:attr:`SimOptions.engine`)
 ENGINES = ("auto", "compiled", "python")
-
-
-@dataclass(frozen=True)
-class Push:
-    """A horizontal push on the CoM: a constant force pulse.
-
-    Attributes:
-        time: start time from the beginning of the walk [s], >= 0.
-        impulse: impulse magnitude [N s], >= 0 (force = impulse / duration).
-        direction: direction of the force in the world frame [rad] (0 = +x, forward at start).
-        duration: pulse length [s], > 0.
-    """
-
-    time: float
-    impulse: float
-    direction: float = 0.0
-    duration: float = 0.1
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "time", non_negative("push.time", self.time))
-        object.__setattr__(self, "impulse", non_negative("push.impulse", self.impulse))
-        object.__setattr__(self, "direction", finite("push.direction", self.direction))
-        object.__setattr__(self, "duration", positive("push.duration", self.duration))
-
-    @property
-    def force(self) -> FloatArray:
-        """Force vector (2,) [N] during the pulse."""
-        f = self.impulse / self.duration
-        return np.array([f * math.cos(self.direction), f * math.sin(self.direction)])
 
 
 @dataclass(frozen=True)
@@ -155,9 +127,15 @@ class SimOptions:
         if isinstance(self.pushes, Push):
             object.__setattr__(self, "pushes", (self.pushes,))
         pushes = tuple(self.pushes)
-        for p in pushes:
+        for i, p in enumerate(pushes):
             if not isinstance(p, Push):
-                raise InputError("pushes", p, "Push objects")
+                raise InputError(f"pushes[{i}]", p, "a footfall.sim.Push")
+            if p.force[2] != 0.0:
+                raise InputError(
+                    f"pushes[{i}].force",
+                    p.force.tolist(),
+                    "a horizontal force (z = 0): the reduced-order plant has no vertical motion",
+                )
         object.__setattr__(self, "pushes", pushes)
         if not isinstance(self.weights, MPCWeights):
             raise InputError("weights", self.weights, "an MPCWeights")
@@ -286,11 +264,6 @@ class SimResult:
     planner: str
 
 
-def _rot(theta: float) -> FloatArray:
-    c, s = math.cos(theta), math.sin(theta)
-    return np.array([[c, -s], [s, c]])
-
-
 def viability_bounds(
     robot: BipedParams, omega: float, foot_length: float, foot_width: float
 ) -> tuple[FloatArray, FloatArray]:
@@ -318,7 +291,7 @@ def _in_hull(point: FloatArray, corners: FloatArray) -> bool:
 
 def _sole_corners(foot: FloatArray, heading: float, length: float, width: float) -> FloatArray:
     half = np.array([[1, 1], [-1, 1], [-1, -1], [1, -1]]) * np.array([length, width]) / 2.0
-    return np.asarray(foot[:2] + half @ _rot(heading).T)
+    return np.asarray(foot[:2] + half @ rot2(heading).T)
 
 
 #: condensed MPCs by (robot, weights, rate, nodes) description: trials of one plan build it once
@@ -448,8 +421,8 @@ def _prepare(plan: FootstepPlan, opts: SimOptions, goal: FloatArray | None) -> _
     mids = t_start[:, None] + (np.arange(n_sub)[None] + 0.5) * h_sub[:, None]
     push_tab = np.zeros((t_start.shape[0], n_sub, 2))
     for p in opts.pushes:
-        on = (mids >= p.time) & (mids < p.time + p.duration)
-        f = p.force
+        on = (mids >= p.start) & (mids < p.start + p.duration)
+        f = p.force[:2]
         push_tab[on] += zh * np.array([-f[1], f[0]])
 
     rng = np.random.default_rng(opts.seed)
@@ -620,9 +593,9 @@ def _walk_python(w: _Walk) -> _Trace:
 
 
 def _walk_compiled(w: _Walk) -> _Trace:
-    """The same loop in the numba kernel :func:`footfall.sim._reduced_kernel.walk`."""
+    """The same loop in the numba kernel :func:`footfall.sim.reduced._kernel.walk`."""
     from footfall.control.mpc import DUAL_TOL, MAX_NEWTON_ITER
-    from footfall.sim import _reduced_kernel as kernel
+    from footfall.sim.reduced import _kernel as kernel
 
     tr = _new_trace(w)
     pad = w.mdl.padded

@@ -27,7 +27,7 @@ from footfall.solvers.base import SolveStatus
 from footfall.terrain.scene import Scene, builtin_scene, random_stepping_stones
 
 if TYPE_CHECKING:
-    from footfall.sim.reduced import SimOptions
+    from footfall.sim.reduced.closed_loop import SimOptions
 
 #: relative objective difference above which two optimal runs disagree (beyond both gaps)
 AGREE_SLACK = 1e-6
@@ -375,7 +375,7 @@ def bench_sim_options(control_rate: float = 500.0) -> SimOptions:
         control_rate=control_rate,
         noise_pos=0.002,
         noise_vel=0.02,
-        pushes=(Push(1.0, 10.0, math.pi / 2), Push(3.0, 12.0, 0.3)),
+        pushes=(Push.horizontal(1.0, 10.0, math.pi / 2), Push.horizontal(3.0, 12.0, 0.3)),
     )
 
 

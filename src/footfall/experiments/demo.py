@@ -45,7 +45,7 @@ def _lip(out: Path, lines: list[str]) -> dict[str, Any]:
 
 
 def _plans(out: Path, lines: list[str]) -> dict[str, Any]:
-    from footfall.planning import PlannerOptions, check_plan, make_plan, plan_to_dict
+    from footfall.planning import PlannerOptions, check_plan, make_plan
     from footfall.terrain import builtin_scene
     from footfall.viz.plan_plot import plot_plan
 
@@ -59,7 +59,7 @@ def _plans(out: Path, lines: list[str]) -> dict[str, Any]:
             steps = plan.n_steps or None  # the kinematic baseline plans the same N
             summary["_miqcqp_plan"] = plan
         folder = out / "plan" / planner
-        payload = plan_to_dict(plan, scene.name)
+        payload = plan.to_dict(scene.name)
         report = check_plan(plan, scene) if plan.has_solution else None
         payload["check"] = {"ok": bool(report and report.ok)}
         write_json(folder / "plan.json", payload)
@@ -89,7 +89,7 @@ def _closed_loop(out: Path, lines: list[str], plan: Any) -> dict[str, Any]:
     from footfall.viz.sim_plots import save_sim_figures
 
     scene = builtin_scene(DEMO_SCENE)
-    push = Push(time=2.0, impulse=10.0, direction=math.pi / 2)
+    push = Push.horizontal(2.0, 10.0, math.pi / 2)
     res = simulate(plan, SimOptions(pushes=(push,)), goal=scene.goal.position)
     save_sim_figures(res, out / "closed_loop", scene.terrain)
     m = res.metrics.to_dict()
@@ -106,7 +106,7 @@ def _quadruped(out: Path, lines: list[str]) -> dict[str, Any]:
         lines.append('quadruped: skipped (MuJoCo missing: pip install "footfall[sim]")')
         return {"skipped": "mujoco not installed"}
     from footfall.quadruped import GaitParams, QuadrupedRobot, plan_gait
-    from footfall.sim.quadruped_sim import simulate
+    from footfall.sim.quadruped.sim import simulate
     from footfall.viz import quadruped_plots as qp
 
     params = GaitParams(slope=math.radians(15.0), body_pitch=math.radians(10.0), cycles=2)

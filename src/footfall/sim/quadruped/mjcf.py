@@ -25,8 +25,8 @@ import numpy as np
 from footfall._validate import positive
 from footfall.errors import InputError
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
-from footfall.sim import quadruped_names as nm
 from footfall.sim._mjcf import SimSettings, box_inertia, fmt, rod_inertia
+from footfall.sim.quadruped import names as nm
 
 #: joint axes in the parent body frame, in ``JOINT_NAMES`` order (ab/ad about x, pitch/knee about y)
 _JOINT_AXES = ("1 0 0", "0 1 0", "0 1 0")

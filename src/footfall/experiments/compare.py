@@ -1,7 +1,7 @@
 """The planner comparison of document 000, section 5.5: every planner through the same MPC and plant.
 
-Plans are deterministic, so each (scene, planner) is planned once and cached on disk (pickle in
-``<out>/plans``); the trials vary only the disturbances. Trial ``k`` uses the same seed, hence the
+Plans are deterministic, so each (scene, planner) is planned once and kept in the plan cache of
+``<out>/plans`` (:mod:`footfall.planning.cache`); the trials vary only the disturbances. Trial ``k`` uses the same seed, hence the
 same push (magnitude, direction, time as a fraction of the walk), noise and placement errors, for
 every planner (common random numbers), so differences come from the plans.
 """
@@ -10,8 +10,7 @@ from __future__ import annotations
 
 import csv
 import math
-import pickle
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -20,8 +19,10 @@ import numpy as np
 
 from footfall._validate import non_negative, positive
 from footfall.errors import InputError
-from footfall.planning.plan import PLANNERS, FootstepPlan, PlannerOptions
-from footfall.sim.reduced import Push, SimOptions, simulate
+from footfall.planning.cache import PlanCache, cached_plan
+from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
+from footfall.sim.pushes import Push
+from footfall.sim.reduced.closed_loop import SimOptions, simulate
 from footfall.terrain.scene import Scene
 
 #: metrics written per trial (keys of SimMetrics.to_dict)
@@ -83,7 +84,7 @@ class TrialSpec:
             rng.uniform(0, 2 * math.pi),
         )
         scales = rng.uniform(1 - self.mismatch, 1 + self.mismatch, 2)
-        push = Push(time=frac * walk, impulse=imp, direction=ang, duration=self.push_duration)
+        push = Push.horizontal(frac * walk, imp, ang, self.push_duration)
         return SimOptions(
             control_rate=self.control_rate,
             noise_pos=self.noise_pos,
@@ -96,55 +97,24 @@ class TrialSpec:
         )
 
 
-def check_names(field: str, names: Sequence[str], valid: Sequence[str]) -> list[str]:
-    """Validate a list of names against ``valid`` (error lists the valid choices)."""
-    out = [n.strip() for n in names if n.strip()]
-    if not out:
-        raise InputError(field, ",".join(names), f"one or more of {', '.join(valid)}")
-    for n in out:
-        if n not in valid:
-            raise InputError(field, n, f"one of {', '.join(valid)}")
-    return out
-
-
-def make_plan(
-    scene: Scene, planner: str, n_steps: int | None = None, time_limit: float = 60.0
+def comparison_plan(
+    scene: Scene,
+    planner: str,
+    n_steps: int | None,
+    options: PlannerOptions,
+    cache: PlanCache | None = None,
 ) -> FootstepPlan:
-    """Plan ``scene`` with ``planner`` (``miqcqp``, ``kinematic`` or ``reactive``).
-
-    ``n_steps`` (horizon planners only) defaults to the smallest N with a plan
-    (:func:`footfall.planning.plan_min_steps`).
-    """
-    from footfall.planning.run import make_plan as plan_with
-
-    if planner not in PLANNERS:
-        raise InputError("planner", planner, f"one of {', '.join(PLANNERS)}")
+    """The plan a comparison walks: :func:`footfall.planning.cache.cached_plan`, except that the
+    reactive planner walks until the goal (``n_steps`` is for the horizon planners) and that the
+    kinematic planner without ``n_steps`` gets the footstep count of the full-horizon plan (its own
+    smallest N ignores the torque the dynamics need): like is compared with like."""
+    check_planner_name(planner)
     if planner == "reactive":
-        n_steps = None  # it walks until the goal; N applies to the horizon planners
-    return plan_with(scene, planner, n_steps, PlannerOptions(time_limit=time_limit, threads=2))
-
-
-def cached_plan(
-    cache: Path, scene: Scene, planner: str, n_steps: int | None, time_limit: float
-) -> FootstepPlan:
-    """:func:`make_plan`, cached as a pickle keyed by scene, planner, steps and time limit."""
-    steps = "auto" if n_steps is None else str(n_steps)
-    path = cache / f"{scene.name}_{planner}_n{steps}_t{time_limit:g}.pkl"
-    if path.is_file():
-        with path.open("rb") as fh:
-            plan = pickle.load(fh)
-        if isinstance(plan, FootstepPlan):
-            return plan
-    if planner == "kinematic" and n_steps is None:
-        # Compare like with like: the kinematic planner gets the footstep count of the
-        # full-horizon plan (its own smallest N ignores the torque the dynamics need).
-        full = cached_plan(cache, scene, "miqcqp", None, time_limit)
+        n_steps = None
+    elif planner == "kinematic" and n_steps is None:
+        full = comparison_plan(scene, "miqcqp", None, options, cache)
         n_steps = full.n_steps if full.has_solution else None
-    plan = make_plan(scene, planner, n_steps, time_limit)
-    cache.mkdir(parents=True, exist_ok=True)
-    with path.open("wb") as fh:
-        pickle.dump(plan, fh)
-    return plan
+    return cached_plan(scene, planner, n_steps, options, cache=cache)
 
 
 def run_trial(
@@ -253,7 +223,7 @@ def write_outputs(
         md.append("")
     md_path = out / "compare.md"
     md_path.write_text("\n".join(md))
-    from footfall.viz.sim_plots import plot_compare
+    from footfall.viz.compare_plots import plot_compare
 
     figs = plot_compare(rows, out)
     return [csv_path, md_path, *figs]
@@ -267,13 +237,15 @@ def run_compare(
     spec: TrialSpec,
     workers: int = 1,
     n_steps: int | dict[str, int] | None = None,
-    time_limit: float = 60.0,
+    options: PlannerOptions | None = None,
     progress: Callable[[str, int, int], None] | None = None,
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]], dict[tuple[str, str], FootstepPlan]]:
-    """Plan (cached), then run ``trials`` seeded trials per (scene, planner) over ``workers``.
+    """Plan (cached in ``out/plans``), then run ``trials`` seeded trials per (scene, planner) over
+    ``workers`` processes.
 
     ``n_steps``: footsteps of the horizon planners, for all scenes or per scene name (missing
-    scenes use the default of :func:`make_plan`).
+    scenes: the smallest N with a plan, see :func:`comparison_plan`). ``options``: the planner
+    options of every plan.
 
     Returns:
         ``(rows, table, plans)``.
@@ -281,13 +253,15 @@ def run_compare(
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
+    options = options or PlannerOptions()
+    cache = PlanCache(out / "plans")
     plans: dict[tuple[str, str], FootstepPlan] = {}
     for s_name, scene in scenes.items():
         for planner in planners:
             if progress:
                 progress(f"planning {s_name} / {planner}", 0, 0)
             n: int | None = n_steps.get(s_name) if isinstance(n_steps, dict) else n_steps
-            plans[(s_name, planner)] = cached_plan(out / "plans", scene, planner, n, time_limit)
+            plans[(s_name, planner)] = comparison_plan(scene, planner, n, options, cache)
     jobs = [
         (s, p, plan, seed)
         for (s, p), plan in plans.items()

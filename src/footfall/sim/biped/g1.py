@@ -6,7 +6,7 @@ G1's URDF, ``g1_29dof_rev_1_0.urdf``). :func:`g1_spec` builds a MuJoCo model fro
 
 - the URDF's inertials are kept as they are (total 33.3 kg); its visual and collision geometry
   (STL meshes, small spheres) is dropped, so no mesh file is read;
-- the 12 leg joints stay, renamed to :mod:`footfall.sim.biped_names` (``left_hip_yaw`` ...
+- the 12 leg joints stay, renamed to :mod:`footfall.sim.biped.names` (``left_hip_yaw`` ...
   ``right_ankle_roll``); every other revolute joint (waist yaw / roll / pitch, arms, wrists) is
   made fixed at its zero angle, so the walker drives the same 12 joints as on our biped and the
   whole-body IK cannot swing the arms to move the CoM;
@@ -37,15 +37,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from footfall._typing import FloatArray
 from footfall._validate import non_negative, positive
 from footfall.errors import FootfallError, InputError
 from footfall.models.biped import Side
-from footfall.sim import biped_names as nm
-from footfall.sim.biped_model import require_mujoco
-
-FloatArray = NDArray[np.float64]
+from footfall.sim.biped import names as nm
+from footfall.sim.biped.model import require_mujoco
 
 #: the distribution and the G1's URDF inside its cmeel prefix
 ERD_DISTRIBUTION = "example-robot-data"

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from footfall.sim.biped_model import BipedModel
-from footfall.sim.biped_walk import WalkResult
+from footfall.sim.biped.model import BipedModel
+from footfall.sim.biped.walk import WalkResult
 from footfall.terrain.scene import Scene
 
 

@@ -20,15 +20,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from footfall._typing import FloatArray
 from footfall._validate import positive
 from footfall.errors import FootfallError
 from footfall.quadruped.gait import GaitParams, GaitPlan, GaitTrajectory, PhaseKind, plan_gait
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
 from footfall.quadruped.stability import centre_of_pressure, stability_margin, support_polygon
-from footfall.sim import quadruped_names as nm
-from footfall.sim.quadruped_mjcf import SimSettings, slope_scene
-
-FloatArray = NDArray[np.float64]
+from footfall.sim.quadruped import names as nm
+from footfall.sim.quadruped.mjcf import SimSettings, slope_scene
 
 #: a foot counts as in contact when it carries more than this fraction of the robot's weight
 CONTACT_FORCE_FRACTION = 0.01

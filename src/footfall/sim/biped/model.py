@@ -22,21 +22,19 @@ from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
 import numpy as np
-from numpy.typing import NDArray
 
+from footfall._typing import FloatArray
 from footfall._validate import non_negative, positive
 from footfall.errors import FootfallError, InputError
 from footfall.models.biped import BipedParams, Side
-from footfall.sim import biped_names as nm
 from footfall.sim._mjcf import SimSettings, box_inertia, fmt, rod_inertia
-
-FloatArray = NDArray[np.float64]
+from footfall.sim.biped import names as nm
 
 #: share of the half foot width the planner's ankle-torque bound may use: U_max = share * m g * w/2
 #: keeps the planned ZMP (eq. 5.12d) inside the sole in every direction, with a margin
 U_MAX_FOOT_SHARE = 0.8
 #: the planner's swing bound L_swing for this biped [m] (``PlannerOptions.swing_max``, beyond the
-#: document; :func:`footfall.sim.biped_compare.plan_for_walk` uses it): the longest swing this
+#: document; :func:`footfall.experiments.compare_mujoco.plan_for_walk` uses it): the longest swing this
 #: biped has walked. Measured (walker of 6f8c4b6, plans with ``reach_both_frames``): the swings
 #: of walks that reached the goal were at most 0.684 m (flat, N = 8) and 0.611 m (discrete_steps
 #: N = 16); the N = 13 plan of the one-frame reach swings 0.60-0.71 m and falls. 0.70 m keeps
@@ -49,7 +47,7 @@ SWING_MAX = 0.70
 
 #: Heading segments L (eq. 5.12g-h) of the robot-aware miqcqp / kinematic plans this biped walks
 #: (the document's problem and the :class:`PlannerOptions` default: 16). See
-#: :func:`footfall.sim.biped_compare.plan_for_walk`: with 16, straight plans with both reach
+#: :func:`footfall.experiments.compare_mujoco.plan_for_walk`: with 16, straight plans with both reach
 #: frames alternate 0.12 and 0.24 m wide steps and drift sideways, and the stairs walks fell at
 #: the step-downs (stairs_slope_gap N = 16-20 all fell); with 64 the smallest N (16) reaches the
 #: goal.
@@ -76,11 +74,11 @@ class BipedSimSettings(SimSettings):
 
 
 class WalkerModel(Protocol):
-    """What the walker (:mod:`footfall.sim.biped_walk`) and :func:`planner_params` need of a robot.
+    """What the walker (:mod:`footfall.sim.biped.walk`) and :func:`planner_params` need of a robot.
 
-    :class:`BipedModel` (our biped) and :class:`footfall.sim.g1_model.G1Model` (the Unitree G1 of
+    :class:`BipedModel` (our biped) and :class:`footfall.sim.biped.g1.G1Model` (the Unitree G1 of
     ``example-robot-data``) implement it. The MJCF must name its elements as
-    :mod:`footfall.sim.biped_names` does (pelvis, torso, 12 leg joints and their position
+    :mod:`footfall.sim.biped.names` does (pelvis, torso, 12 leg joints and their position
     actuators, sole sites, four corner contact geoms per foot, pelvis and torso geoms).
     """
 
@@ -367,7 +365,7 @@ def biped_mjcf(
     Args:
         params: link parameters (default :class:`BipedModel`).
         terrain: ``(asset_xml, worldbody_xml)`` of the terrain (see
-            :func:`footfall.sim.terrain_mjcf.terrain_xml`); empty = no ground at all.
+            :func:`footfall.sim.biped.terrain_mjcf.terrain_xml`); empty = no ground at all.
         settings: physics and actuator settings.
 
     Returns:

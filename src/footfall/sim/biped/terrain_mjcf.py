@@ -14,14 +14,12 @@ Nothing is placed where there is no region: gaps are holes.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
-from footfall.sim import biped_names as nm
+from footfall._typing import FloatArray
 from footfall.sim._mjcf import fmt as _fmt
+from footfall.sim.biped import names as nm
 from footfall.terrain.region import Region
 from footfall.terrain.terrain import Terrain
-
-FloatArray = NDArray[np.float64]
 
 
 def _f(*values: float | np.floating) -> str:

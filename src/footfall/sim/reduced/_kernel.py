@@ -1,4 +1,4 @@
-"""Compiled engine of :func:`footfall.sim.reduced.simulate`: the same closed loop, in numba.
+"""Compiled engine of :func:`footfall.sim.reduced.closed_loop.simulate`: the same closed loop, in numba.
 
 Two kernels mirror the Python reference operation by operation, so both engines give the same
 trajectories up to rounding:

@@ -38,14 +38,15 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import expm
 
 from footfall._geometry import inset_polygon
-from footfall._validate import finite_vector, non_negative, positive
+from footfall._typing import FloatArray
+from footfall._validate import non_negative, positive
 from footfall.control.mpc import MPC, MPCWeights, build_mpc
 from footfall.errors import FootfallError, InputError
 from footfall.models.alip import ALIP
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import FootstepPlan
-from footfall.sim import biped_names as nm
-from footfall.sim.biped_model import (
+from footfall.sim.biped import names as nm
+from footfall.sim.biped.model import (
     U_MAX_FOOT_SHARE,
     BipedModel,
     BipedSimSettings,
@@ -53,12 +54,11 @@ from footfall.sim.biped_model import (
     measure_model,
     require_mujoco,
 )
-from footfall.sim.terrain_mjcf import terrain_xml
+from footfall.sim.biped.terrain_mjcf import terrain_xml
+from footfall.sim.pushes import Push
 from footfall.terrain.edges import inset_riser_edges
 from footfall.terrain.region import Region
 from footfall.terrain.scene import Scene
-
-FloatArray = NDArray[np.float64]
 
 #: a foot is loaded when its contact force exceeds this share of the weight
 CONTACT_FORCE_SHARE = 0.02
@@ -80,7 +80,7 @@ VIDEO_FPS = 30
 #: 0.004 / 0.024 m, both at the goal)
 STOP_STEPS = 2
 #: a plan's robot mass and CoM height may differ this much (relative) from the walker model's
-#: (:func:`~footfall.sim.biped_model.planner_params` measures them: 0.0 exactly)
+#: (:func:`~footfall.sim.biped.model.planner_params` measures them: 0.0 exactly)
 PLAN_ROBOT_RTOL = 0.01
 #: sole-pose and CoM costs of the inverse kinematics: the feet must be where they are (the stance
 #: foot cannot move), the CoM is the ALIP's; torso and posture are secondary
@@ -109,32 +109,6 @@ RISER_LANDING_TOLERANCE = 0.04
 
 
 # ============================================================================= options
-@dataclass(frozen=True)
-class Push:
-    """An external force on the torso.
-
-    Attributes:
-        start: time since the start of the walk [s].
-        duration: [s].
-        force: world-frame force (3,) [N].
-    """
-
-    start: float
-    duration: float
-    force: FloatArray
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "start", non_negative("push.start", self.start))
-        object.__setattr__(self, "duration", positive("push.duration", self.duration))
-        f = finite_vector("push.force", self.force, 3)
-        f.setflags(write=False)
-        object.__setattr__(self, "force", f)
-
-    def active(self, t: float) -> bool:
-        """Whether the push acts at time ``t`` [s]."""
-        return self.start <= t < self.start + self.duration
-
-
 @dataclass(frozen=True)
 class WalkOptions:
     """Options of the walking controller.
@@ -187,12 +161,12 @@ class WalkOptions:
         stop_on_fall: end the simulation when a fall is detected.
         landing_margin: the walker's MPC keeps each footstep this much further inside its region
             than the plan did (its ``region_margin``, half the sole length for
-            :func:`footfall.sim.biped_compare.plan_for_walk`) [m]: landings fall ~2 cm short of
+            :func:`footfall.experiments.compare_mujoco.plan_for_walk`) [m]: landings fall ~2 cm short of
             their targets, and a heel over a block's edge on a step down tipped the landing foot.
         riser_tolerance: the MPC keeps each footstep in its region with the riser edges moved
             in by :func:`footfall.terrain.edges.inset_riser_edges` with this landing tolerance
             [m] (on top of ``region_margin`` + ``landing_margin``), as
-            :func:`footfall.sim.biped_compare.plan_for_walk` plans; 0 = the regions as they are.
+            :func:`footfall.experiments.compare_mujoco.plan_for_walk` plans; 0 = the regions as they are.
             Without it the MPC moved the footstep below ``top``'s riser of stairs_slope_gap
             (N = 15) from the plan's 0.147 m to 0.12 m from the riser, the heel landed on the
             riser edge and the robot fell at 6.4 s (8 steps); with it, at 7.5 s (10 steps).
@@ -884,9 +858,9 @@ class CoMHeight:
 class BipedSim:
     """MuJoCo model + data of a biped on a scene's terrain, with handles resolved by name.
 
-    ``model_params`` is any :class:`~footfall.sim.biped_model.WalkerModel`: our biped
-    (:class:`BipedModel`, the default) or e.g. :class:`footfall.sim.g1_model.G1Model`; its MJCF
-    names its elements as :mod:`footfall.sim.biped_names` does. ``settings`` go to its ``mjcf``
+    ``model_params`` is any :class:`~footfall.sim.biped.model.WalkerModel`: our biped
+    (:class:`BipedModel`, the default) or e.g. :class:`footfall.sim.biped.g1.G1Model`; its MJCF
+    names its elements as :mod:`footfall.sim.biped.names` does. ``settings`` go to its ``mjcf``
     (None: the model's defaults).
     """
 
@@ -1241,7 +1215,7 @@ def _check_plan_robot(robot: BipedParams, model: WalkerModel | None) -> None:
                 f"plan.robot.{field_name}",
                 planned,
                 f"the {name} model's {actual:.4g} {unit} within {PLAN_ROBOT_RTOL:.0%}: plan with "
-                "footfall.sim.biped_model.planner_params(model) as the robot, or walk a "
+                "footfall.sim.biped.model.planner_params(model) as the robot, or walk a "
                 "mismatched plan on purpose with WalkOptions(check_robot=False)",
             )
 
@@ -1265,9 +1239,9 @@ def walk(
         options: controller options.
         adjuster: footstep / torque source; default :class:`PlanFollower`.
         model_params: the robot (default: our biped, :class:`BipedModel`); any
-            :class:`~footfall.sim.biped_model.WalkerModel`, e.g. the G1 of
-            :mod:`footfall.sim.g1_model`. The plan should be made for it
-            (:func:`~footfall.sim.biped_model.planner_params`).
+            :class:`~footfall.sim.biped.model.WalkerModel`, e.g. the G1 of
+            :mod:`footfall.sim.biped.g1`. The plan should be made for it
+            (:func:`~footfall.sim.biped.model.planner_params`).
         settings: physics settings (None: the model's defaults).
         video_path: write an MP4 here (offscreen GL); None = no video.
         video_size: (width, height) [px].

@@ -1,0 +1,157 @@
+"""Footstep plans cached on disk as JSON, keyed by the content of everything that determines them.
+
+A MIQCQP plan can take minutes; walks, comparisons and studies ask for the same plan again. The
+cache key is a SHA-256 digest of one canonical JSON document holding the scene (regions, start,
+goal, its robot: :func:`footfall.terrain.scene_to_dict`), the planner, the step count, the robot
+the plan is made for and every planner option (weights, solver, its settings, time limit, gap,
+threads, margins): change any of them, or edit a scene file under the same name, and the plan is
+made again. The file name is the digest alone (``plan-<digest>.json``), so no name a user gave
+reaches a path. A file is the ``plan.json`` of ``footfall plan`` (:meth:`FootstepPlan.to_dict`)
+plus its key; it is read back by the validating :meth:`FootstepPlan.from_dict`, so a cache file
+is data, never code.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import hashlib
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from footfall._io import write_json
+from footfall.errors import InputError
+from footfall.models.biped import BipedParams
+from footfall.planning.plan import FootstepPlan, PlannerOptions
+from footfall.planning.run import make_plan
+from footfall.terrain.scene import Scene, robot_to_dict, scene_to_dict
+
+#: version of the key's layout and of the file format; bumping it makes every old entry a miss
+CACHE_VERSION = 2
+#: a cache file larger than this [bytes] is refused (a plan of 100 steps is ~200 kB)
+MAX_CACHE_FILE = 20_000_000
+
+
+def _plain(value: Any) -> Any:
+    """``value`` as plain JSON data with a canonical form (dataclasses, enums, arrays, floats)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
+    if isinstance(value, enum.Enum):
+        return _plain(value.value)
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in sorted(value.items(), key=lambda kv: str(kv[0]))}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, np.generic):
+        return _plain(value.item())
+    if isinstance(value, float):
+        # repr round-trips exactly; -0.0 and 0.0 are the same plan input
+        return "nan" if math.isnan(value) else repr(value + 0.0)
+    return value
+
+
+def plan_key(
+    scene: Scene,
+    planner: str,
+    n_steps: int | None,
+    options: PlannerOptions,
+    robot: BipedParams | None = None,
+) -> str:
+    """The cache key (64 hex digits) of the plan these arguments make (see the module docstring).
+
+    ``options.verbose`` is left out (it changes the log, not the plan).
+    """
+    opts = _plain(options)
+    opts.pop("verbose", None)
+    doc = {
+        "version": CACHE_VERSION,
+        "scene": _plain(scene_to_dict(scene)),
+        "planner": planner,
+        "n_steps": n_steps,
+        "robot": _plain(robot_to_dict(robot if robot is not None else scene.robot)),
+        "options": opts,
+    }
+    text = json.dumps(doc, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+@dataclasses.dataclass(frozen=True)
+class PlanCache:
+    """A folder of cached plans.
+
+    Attributes:
+        folder: where the ``plan-<digest>.json`` files live (created on the first save).
+    """
+
+    folder: Path
+
+    def path(self, key: str) -> Path:
+        """The file of ``key``."""
+        if len(key) != 64 or any(c not in "0123456789abcdef" for c in key):
+            raise InputError("cache key", key, "64 lowercase hex digits (plan_key)")
+        return Path(self.folder) / f"plan-{key[:32]}.json"
+
+    def load(self, key: str, robot: BipedParams) -> FootstepPlan | None:
+        """The cached plan of ``key`` for ``robot``, or None when there is none.
+
+        Raises:
+            InputError: the file exists but is not a regular file, is too large, is not JSON, or
+                does not hold a valid plan (it names the file and the field).
+        """
+        path = self.path(key)
+        if not path.exists():
+            return None
+        if not path.is_file():
+            raise InputError("plan cache file", str(path), "a regular file")
+        if path.stat().st_size > MAX_CACHE_FILE:
+            raise InputError(
+                "plan cache file", str(path), f"at most {MAX_CACHE_FILE} bytes; delete it"
+            )
+        try:
+            data = json.loads(path.read_text())
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise InputError(
+                "plan cache file", str(path), f"a JSON plan ({exc}); delete it to plan again"
+            ) from None
+        if not isinstance(data, dict) or data.get("cache_key") != key:
+            return None  # another plan whose digest shares the first 32 digits: a miss
+        plan = FootstepPlan.from_dict(data, robot, source=str(path))
+        return dataclasses.replace(plan, message=plan.message + " (loaded from cache)")
+
+    def save(self, key: str, plan: FootstepPlan, scene_name: str = "") -> Path:
+        """Write ``plan`` under ``key``; returns the path."""
+        payload = plan.to_dict(scene_name)
+        payload["cache_key"] = key
+        return write_json(self.path(key), payload)
+
+
+def cached_plan(
+    scene: Scene,
+    planner: str = "miqcqp",
+    n_steps: int | None = None,
+    options: PlannerOptions | None = None,
+    robot: BipedParams | None = None,
+    cache: PlanCache | None = None,
+) -> FootstepPlan:
+    """:func:`footfall.planning.make_plan`, served from ``cache`` when it holds the plan.
+
+    Only plans with footsteps are stored: a failed search is made again next time (it may have
+    hit a time limit).
+    """
+    options = options or PlannerOptions()
+    robot = robot if robot is not None else scene.robot
+    key = plan_key(scene, planner, n_steps, options, robot)
+    if cache is not None:
+        hit = cache.load(key, robot)
+        if hit is not None:
+            return hit
+    plan = make_plan(scene, planner, n_steps, options, robot)
+    if cache is not None and plan.has_solution:
+        cache.save(key, plan, scene.name)
+    return plan

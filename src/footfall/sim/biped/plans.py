@@ -1,0 +1,156 @@
+"""Plans made for a MuJoCo walker, and the seeded pushes of its walks.
+
+:func:`plan_for_walk` makes (or loads from the plan cache, :mod:`footfall.planning.cache`) the plan
+of a scene for a walker model's measured robot (:func:`~footfall.sim.biped.model.planner_params`),
+with the options beyond the document that the walks need; :func:`robot_model` names the walkers;
+:func:`random_push` draws a seeded push inside the walk.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from footfall._validate import non_negative
+from footfall.errors import InputError
+from footfall.planning.cache import PlanCache, cached_plan
+from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
+from footfall.sim.biped.model import (
+    SWING_MAX,
+    WALK_HEADING_SEGMENTS,
+    BipedModel,
+    WalkerModel,
+    planner_params,
+)
+from footfall.sim.biped.walk import RISER_LANDING_TOLERANCE, WalkOptions
+from footfall.sim.pushes import Push
+from footfall.terrain.edges import inset_riser_edges
+from footfall.terrain.scene import Scene
+
+#: robots the walker can walk (``footfall walk --robot``): our biped and the Unitree G1 of
+#: example-robot-data (``footfall[robots]``)
+ROBOTS = ("biped", "g1")
+#: pushes last this long [s]
+PUSH_DURATION = 0.1
+#: a push starts at a random single support between these shares of the walk
+PUSH_WINDOW = (0.3, 0.7)
+
+
+def robot_model(name: str) -> WalkerModel:
+    """The walker model called ``name`` (one of :data:`ROBOTS`), with its default settings.
+
+    Raises:
+        InputError: for an unknown name.
+        FootfallError: for ``g1`` without ``example-robot-data`` installed.
+    """
+    if name == "biped":
+        return BipedModel()
+    if name == "g1":
+        from footfall.sim.biped.g1 import G1Model, g1_urdf_path
+
+        g1_urdf_path()  # fail here, with the extra to install, rather than at the first use
+        return G1Model()
+    raise InputError("robot", name, f"one of {', '.join(ROBOTS)}")
+
+
+def plan_for_walk(
+    scene: Scene,
+    planner: str,
+    n_steps: int | None = None,
+    time_limit: float = 300.0,
+    cache_dir: Path | None = None,
+    model: WalkerModel | None = None,
+    robot_aware: bool = True,
+    heading_segments: int | None = None,
+) -> FootstepPlan:
+    """The plan of ``scene`` for the MuJoCo biped or another walker model (robot parameters from
+    :func:`planner_params`).
+
+    With ``robot_aware`` (the default) the optimising planners (miqcqp, kinematic) also get the
+    options beyond the document that this robot needs (:func:`walk_planner_options`): the reach
+    set in both feet's frames and the swing bound ``SWING_MAX`` (measured on our biped, used for
+    every walker model). The reactive planner cannot honour them and plans without.
+    ``robot_aware=False`` plans the document's problem (with the region margin only).
+
+    ``heading_segments``: L of the miqcqp and kinematic plans (eq. 5.12g-h); None:
+    ``WALK_HEADING_SEGMENTS`` (64) for robot-aware plans, the document's 16 otherwise. Each
+    segment's linear reach (eq. 5.12f) holds for every heading in it, so a heading held on a
+    breakpoint (a straight walk at theta = 0 sits on the one between two 22.5 deg segments) gets
+    the trapezoid intersected with its copy rotated a whole segment away: from a right stance
+    foot, a left step at the inner width 0.12 m may reach 0.342 m forward in the segment below 0
+    but not forward at all (-0.024 m) in the one above. With both reach frames each foot's segment
+    must serve its incoming and its outgoing step, which need opposite segments, so straight
+    robot-aware plans alternate 0.12 and about 0.24 m wide steps and drift sideways
+    (stairs_slope_gap N = 16: to y = 0.39 m). 64 segments (5.6 deg) lose at most 4 cm of width
+    there (0.329 m forward at 0.16 m); the plans take longer (stairs_slope_gap N = 16: 38 s
+    instead of 4 s).
+
+    With ``cache_dir`` the plan is kept in that folder's plan cache (:mod:`footfall.planning.cache`)
+    and reused while the scene's contents (its regions after the riser insets, start, goal), the
+    planner, N, the robot and every planner option are unchanged (MIQCQP plans take minutes).
+
+    Beyond the document: the plan is made on the scene's regions with their riser edges moved in
+    by ``RISER_LANDING_TOLERANCE`` (:func:`footfall.terrain.edges.inset_riser_edges`) and with a
+    ``region_margin`` of half the sole length: footsteps stay half a sole plus the tolerance from
+    the edge of a tread below a riser (a step down lands there) and half a sole from other edges.
+    """
+    check_planner_name(planner)
+    robot = planner_params(model, base=scene.robot)
+    # the sole is not a point: keep its centre half a foot length inside every region, so the
+    # whole sole stands on the block (at the plan's headings, which stay near the scene's)
+    margin = robot.foot_length / 2.0
+    scene = replace(scene, terrain=inset_riser_edges(scene.terrain, RISER_LANDING_TOLERANCE))
+    aware = walk_planner_options(planner) if robot_aware else {}
+    if heading_segments is None:
+        heading_segments = WALK_HEADING_SEGMENTS if robot_aware else PlannerOptions.heading_segments
+    opts = PlannerOptions(
+        time_limit=time_limit, region_margin=margin, heading_segments=heading_segments, **aware
+    )
+    return cached_plan(
+        scene,
+        planner,
+        n_steps,
+        opts,
+        robot,
+        PlanCache(cache_dir) if cache_dir is not None else None,
+    )
+
+
+def walk_planner_options(planner: str) -> dict[str, Any]:
+    """The :class:`PlannerOptions` beyond the document that the MuJoCo biped's walks use.
+
+    ``reach_both_frames``: with eq. (5.12f) alone the minimum-N plans stretch their reach by
+    zig-zagging the headings (turn: 0, 22.5, 0, 30, 60, 90 deg; discrete_steps N = 13: up to
+    22.5 deg on block2) and the legs cross or the swing gets long. ``swing_max``: the swing bound
+    ``SWING_MAX`` measured for this robot (see there). The reactive planner gets neither (it
+    refuses both).
+    """
+    check_planner_name(planner)
+    if planner == "reactive":
+        return {}
+    return {"reach_both_frames": True, "swing_max": SWING_MAX}
+
+
+def random_push(seed: int, magnitude: float, plan: FootstepPlan, options: WalkOptions) -> Push:
+    """A horizontal push of ``magnitude`` [N] in a seeded random direction, lasting
+    ``PUSH_DURATION``, starting mid single support of a seeded step in ``PUSH_WINDOW`` of the walk.
+    """
+    magnitude = non_negative("push", magnitude)
+    rng = np.random.default_rng(seed)
+    n = plan.n_steps
+    lo, hi = (max(0, int(f * n)) for f in PUSH_WINDOW)
+    step = int(rng.integers(lo, max(lo + 1, hi)))
+    robot = plan.robot
+    t0 = (
+        options.settle_time
+        + options.shift_time
+        + step * (robot.t_ss + robot.t_ds)
+        + 0.25 * robot.t_ss
+    )
+    angle = float(rng.uniform(0.0, 2.0 * math.pi))
+    force = magnitude * np.array([math.cos(angle), math.sin(angle), 0.0])
+    return Push(start=t0, duration=PUSH_DURATION, force=force)

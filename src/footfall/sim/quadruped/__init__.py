@@ -1,0 +1,1 @@
+"""The document-001 quadruped in MuJoCo: its MJCF model and the simulated slope walk."""
