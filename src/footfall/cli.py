@@ -7,6 +7,8 @@ Every command that computes something writes JSON and a figure into ``--out``. I
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +18,7 @@ from rich.console import Console
 from footfall._io import write_json
 from footfall._validate import names_in, non_negative
 from footfall.errors import FootfallError, InputError
+from footfall.terrain.resolve import resolve_scene, resolve_scene_arguments
 
 app = typer.Typer(
     name="footfall",
@@ -41,12 +44,23 @@ def parse_floats(field: str, text: str) -> list[float]:
 
 
 def main() -> None:
-    """Entry point of the ``footfall`` console script."""
+    """Entry point of the ``footfall`` console script.
+
+    Exit codes: 0 success, 1 a run that failed (no plan, a solver error, a fall reported as a
+    failure), 2 bad input (:class:`footfall.errors.InputError`), 130 interrupted. Errors footfall
+    raises are printed as one line, never as a traceback.
+    """
     try:
         app()
-    except FootfallError as exc:
+    except InputError as exc:
         console.print(f"[bold red]error:[/] {exc}")
         sys.exit(2)
+    except FootfallError as exc:
+        console.print(f"[bold red]failed:[/] {exc}")
+        sys.exit(1)
+    except KeyboardInterrupt:
+        console.print("[bold red]interrupted[/]")
+        sys.exit(130)
 
 
 # --- LIP walk (document 004) ---
@@ -86,49 +100,28 @@ def lip(
 ) -> None:
     """Kajita LIP walking pattern with foot placement modification (document 004)."""
     import math
-    from dataclasses import replace
 
-    from footfall.planning.lip_examples import example as get_example
+    from footfall.planning.lip_examples import lip_params
     from footfall.planning.lip_io import lip_walk_to_dict
-    from footfall.planning.lip_walk import LipWalkParams, lip_walk
+    from footfall.planning.lip_walk import lip_walk
     from footfall.viz.lip_plot import plot_lip_walk
 
-    given: dict[str, object] = {
-        k: v
-        for k, v in {
-            "z_c": zc,
-            "t_sup": t_sup,
-            "sx": None if sx is None else tuple(parse_floats("sx", sx)),
-            "sy": None if sy is None else tuple(parse_floats("sy", sy)),
-            "theta": None
-            if theta_deg is None
-            else tuple(math.radians(v) for v in parse_floats("theta_deg", theta_deg)),
-            "a": a,
-            "b": b,
-            "a_stop": a_stop,
-            "b_stop": b_stop,
-            "g": g,
-        }.items()
-        if v is not None
+    given = {
+        "z_c": zc,
+        "t_sup": t_sup,
+        "sx": None if sx is None else tuple(parse_floats("sx", sx)),
+        "sy": None if sy is None else tuple(parse_floats("sy", sy)),
+        "theta": None
+        if theta_deg is None
+        else tuple(math.radians(v) for v in parse_floats("theta_deg", theta_deg)),
+        "a": a,
+        "b": b,
+        "a_stop": a_stop,
+        "b_stop": b_stop,
+        "g": g,
     }
-    if example is not None:
-        # the example's walk, changed only where the user asked (LipWalkParams checks the result)
-        params = replace(get_example(example), **given)  # type: ignore[arg-type]
-        title = f"LIP walk: {example} (document 004)"
-    else:
-        base: dict[str, object] = {
-            "z_c": 0.8,
-            "t_sup": 0.8,
-            "sx": (0.0, 0.3, 0.3, 0.3, 0.0),
-            "sy": (0.2, 0.2, 0.2, 0.2, 0.2),
-            "a": 10.0,
-            "b": 1.0,
-            "a_stop": 1.0,
-            "b_stop": 1.0,
-            "g": 9.81,
-        }
-        params = LipWalkParams(**(base | given))  # type: ignore[arg-type]
-        title = "LIP walk"
+    params = lip_params(example, **{k: v for k, v in given.items() if v is not None})
+    title = "LIP walk" if example is None else f"LIP walk: {example} (document 004)"
     walk = lip_walk(params)
     write_json(out / "lip_walk.json", lip_walk_to_dict(walk, dt))
     plot_lip_walk(walk, out / "lip_walk.png", title=title)
@@ -171,7 +164,7 @@ def scenes_command(
 
     from rich.table import Table
 
-    from footfall.terrain import builtin_scene, builtin_scene_names, load_scene, scene_to_yaml
+    from footfall.terrain import builtin_scene, builtin_scene_names, scene_to_yaml
 
     if show is None:
         table = Table(title="Built-in scenes")
@@ -186,60 +179,16 @@ def scenes_command(
         Console().print(table)
         return
 
-    import matplotlib
+    from footfall.viz.terrain_plot import plot_scene
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from footfall.viz.terrain_plot import plot_terrain, plot_terrain_side
-
-    is_file = show.endswith((".yaml", ".yml")) or Path(show).is_file()
-    scene = load_scene(Path(show)) if is_file else builtin_scene(show)
+    scene = resolve_scene(show)
     out.mkdir(parents=True, exist_ok=True)
     (out / "scene.yaml").write_text(scene_to_yaml(scene))
-    fig, (ax_top, ax_side) = plt.subplots(
-        2, 1, figsize=(9, 8), gridspec_kw={"height_ratios": [3, 1]}, constrained_layout=True
-    )
-    sm = plot_terrain(ax_top, scene.terrain)
-    plot_terrain_side(ax_side, scene.terrain)
-    for foot, mark in ((scene.start.left, "^"), (scene.start.right, "v")):
-        ax_top.plot(foot[0], foot[1], mark, color="tab:red", ms=8)
-        ax_side.plot(foot[0], foot[2], mark, color="tab:red", ms=8)
-    g = scene.goal
-    ax_top.plot(g.position[0], g.position[1], "*", color="gold", mec="k", ms=14)
-    ax_top.arrow(
-        g.position[0],
-        g.position[1],
-        0.2 * math.cos(g.heading),
-        0.2 * math.sin(g.heading),
-        width=0.01,
-        color="k",
-    )
-    ax_side.plot(g.position[0], g.position[2], "*", color="gold", mec="k", ms=14)
-    ax_top.set_title(f"{scene.name}: {scene.description}", fontsize=9)
-    fig.colorbar(sm, ax=ax_top, label="z [m]", shrink=0.8)
-    fig.savefig(out / "scene.png", dpi=120)
-    plt.close(fig)
+    plot_scene(scene, out / "scene.png")
     console.print(f"wrote {out / 'scene.png'} and {out / 'scene.yaml'}")
 
 
 # --- footstep planning (document 000, section 5.3) ---
-def resolve_scene(scene_file: Path | None, scene: str | None) -> Any:
-    """Load a scene from a YAML file or by built-in name (exactly one of the two)."""
-    from footfall.terrain import builtin_scene, load_scene
-
-    if (scene_file is None) == (scene is None):
-        raise InputError(
-            "scene", scene_file or scene, "either a SCENE.yaml argument or --scene NAME"
-        )
-    if scene_file is not None:
-        return load_scene(scene_file)
-    assert scene is not None
-    if scene.endswith((".yaml", ".yml")):
-        return load_scene(Path(scene))
-    return builtin_scene(scene)
-
-
 @app.command()
 def plan(
     scene_file: Path | None = typer.Argument(None, help="Scene YAML file (or use --scene)."),
@@ -281,7 +230,7 @@ def plan(
     from footfall.viz.plan_plot import plot_plan
 
     check_planner_name(planner)
-    sc = resolve_scene(scene_file, scene)
+    sc = resolve_scene_arguments(scene_file, scene)
     if steps is not None and (steps < 1):
         raise InputError("steps", steps, "an integer >= 1")
     options = PlannerOptions(
@@ -441,12 +390,24 @@ def quadruped_cmd(
 
 
 # --- simulate (issue 4) ---
-def _scene_arg(text: str) -> object:
-    """A built-in scene name or a YAML file path."""
-    from footfall.terrain import builtin_scene, load_scene
+@contextmanager
+def _progress_bar() -> Iterator[Callable[[str, int, int], None]]:
+    """A console progress bar; yields ``progress(what, done, total)`` (total 0: unknown)."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-    is_file = text.endswith((".yaml", ".yml")) or Path(text).is_file()
-    return load_scene(Path(text)) if is_file else builtin_scene(text)
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn())
+    with Progress(*columns, TimeElapsedColumn(), console=console) as bar:
+        task = bar.add_task("planning", total=None)
+
+        def progress(what: str, done: int, total: int) -> None:
+            bar.update(task, description=what, completed=done, total=total or None)
+
+        yield progress
+
+
+def _list_arg(text: str) -> list[str]:
+    """The non-empty items of a comma-separated option."""
+    return [item.strip() for item in text.split(",") if item.strip()]
 
 
 def _positive_int(field: str, value: int) -> int:
@@ -486,7 +447,7 @@ def simulate_command(
     from footfall.planning import PlannerOptions, make_plan
     from footfall.planning.plan import check_planner_name
     from footfall.sim import Push, SimOptions, simulate
-    from footfall.terrain.scene import Scene
+    from footfall.sim.reduced.closed_loop import run_report
     from footfall.viz.sim_plots import save_sim_figures
 
     check_planner_name(planner)
@@ -503,8 +464,7 @@ def simulate_command(
         seed=seed,
         engine=engine,
     )
-    sc = _scene_arg(scene)
-    assert isinstance(sc, Scene)
+    sc = resolve_scene(scene)
     # the reactive planner walks until the goal: --steps is for the horizon planners
     n = None if planner == "reactive" else steps
     plan = make_plan(sc, planner, n, PlannerOptions(time_limit=time_limit, threads=threads))
@@ -514,38 +474,7 @@ def simulate_command(
         raise InfeasibleError(f"{planner} found no plan for {sc.name}: {plan.message}")
     res = simulate(plan, opts, goal=sc.goal.position)
     m = res.metrics
-    write_json(
-        out / "sim.json",
-        {
-            "scene": sc.name,
-            "planner": planner,
-            "plan": {
-                "status": plan.status.value,
-                "steps": plan.n_steps,
-                "planning_time": plan.solve_time,
-                "message": plan.message,
-                "footsteps": plan.footsteps.tolist(),
-            },
-            "options": {
-                "control_rate": rate,
-                "push": {
-                    "impulse": push,
-                    "time": push_time,
-                    "direction_deg": push_direction,
-                    "duration": push_duration,
-                },
-                "noise_pos": noise_pos,
-                "noise_vel": noise_vel,
-                "placement_error": placement_error,
-                "mass_scale": mass_scale,
-                "com_height_scale": com_height_scale,
-                "seed": seed,
-                "engine": m.engine,
-            },
-            "metrics": m.to_dict(),
-            "footsteps": res.footsteps.tolist(),
-        },
-    )
+    write_json(out / "sim.json", run_report(sc.name, plan, opts, res))
     figs = save_sim_figures(res, out, sc.terrain)
     outcome = f"FELL at {m.fall_time:.2f} s" if m.fell else ("stopped" if m.stopped else "walked")
     typer.echo(
@@ -619,11 +548,14 @@ def compare_command(
         )
         return
 
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
-    from footfall.experiments.compare import TrialSpec, run_compare, write_outputs
+    from footfall.experiments.compare import (
+        TrialSpec,
+        describe,
+        run_compare,
+        summary_lines,
+        write_outputs,
+    )
     from footfall.planning.plan import PLANNERS, PlannerOptions
-    from footfall.terrain.scene import Scene
 
     _positive_int("trials", trials)
     _positive_int("workers", workers)
@@ -636,49 +568,19 @@ def compare_command(
         mismatch=mismatch,
         control_rate=rate,
     )
-    scene_objs: dict[str, Scene] = {}
-    for text in [s.strip() for s in scenes.split(",") if s.strip()]:
-        sc = _scene_arg(text)
-        assert isinstance(sc, Scene)
-        scene_objs[sc.name] = sc
+    scene_objs = {sc.name: sc for sc in map(resolve_scene, _list_arg(scenes))}
     if not scene_objs:
         raise InputError("scenes", scenes, "one or more scene names or YAML files")
     # The MPC's small matrices run fastest single-threaded; spawned workers read this.
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-    with Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        console=console,
-    ) as bar:
-        task = bar.add_task("planning", total=None)
-
-        def progress(what: str, done: int, total: int) -> None:
-            bar.update(task, description=what, completed=done, total=total or None)
-
+    with _progress_bar() as progress:
         options = PlannerOptions(time_limit=time_limit, threads=threads)
         rows, table, plans = run_compare(
             scene_objs, names, trials, out, spec, workers, n_steps, options, progress
         )
-    header = (
-        f"{trials} trials per scene and planner; pushes uniform in [0, {push_max:g}] N s "
-        f"({spec.push_duration:g} s pulse, random direction, at 10-80 % of the walk), estimate noise "
-        f"{noise_pos:g} m / {noise_vel:g} m/s, placement error {placement_error:g} m, mismatch "
-        f"{mismatch:g}, control rate {rate:g} Hz; planner time limit {time_limit:g} s. Plans: "
-        + "; ".join(
-            f"{s}/{p}: {pl.status.value}, N={pl.n_steps}, {pl.solve_time:.1f} s"
-            for (s, p), pl in plans.items()
-        )
-        + "."
-    )
-    paths = write_outputs(out, rows, table, header)
-    for r in table:
-        console.print(
-            f"{r['scene']:>18} {r['planner']:>9}: mean ZMP {1000 * r['zmp_mean']:.2f} mm, "
-            f"max {1000 * r['zmp_max']:.2f} mm, success {100 * r['success_rate']:.0f}% "
-            f"({r['trials']} trials)"
-        )
+    paths = write_outputs(out, rows, table, describe(spec, trials, time_limit, plans))
+    for line in summary_lines(table):
+        console.print(line)
     console.print(f"wrote {', '.join(str(p) for p in paths)}")
 
 
@@ -715,6 +617,9 @@ def _compare_mujoco(
     from footfall.experiments.compare_mujoco import (
         compare_mujoco,
         compare_table,
+        describe,
+        steps_per_pair,
+        summary_lines,
         write_mujoco_outputs,
     )
     from footfall.planning.plan import PLANNERS
@@ -724,24 +629,16 @@ def _compare_mujoco(
     _positive_int("trials", trials)
     push_max = non_negative("push_max", push_max)
     names = names_in("planners", planners.split(","), PLANNERS)
-    scene_names = names_in(
-        "scenes", [s.strip() for s in scenes.split(",") if s.strip()], builtin_scene_names()
-    )
+    scene_names = names_in("scenes", _list_arg(scenes), builtin_scene_names())
     force = push_max / PUSH_DURATION
-    # N per scene for the optimising planners (the reactive planner walks until the goal)
-    per_pair = {
-        (sc, p): n_steps if isinstance(n_steps, int) else n_steps[sc]
-        for sc in scene_names
-        for p in names
-        if p != "reactive" and n_steps is not None and (isinstance(n_steps, int) or sc in n_steps)
-    }
+    per_pair = steps_per_pair(scene_names, names, n_steps)
     with console.status("walking in MuJoCo ...") as status:
         rows = compare_mujoco(
             scene_names,
             names,
             seeds=tuple(range(trials)),
             push=force,
-            n_steps=per_pair or None,
+            n_steps=per_pair,
             time_limit=time_limit,
             cache_dir=out / "plans",
             progress=lambda line: status.update(line),
@@ -749,21 +646,9 @@ def _compare_mujoco(
             heading_segments=heading_segments,
         )
     table = compare_table(rows)
-    header = (
-        f"{trials} walks per scene and planner, each with one push of {force:g} N for "
-        f"{PUSH_DURATION:g} s ({push_max:g} N s) in a seeded random direction mid single support "
-        "in 30-70 % of the walk; plans cached in plans/."
-    )
-    paths = write_mujoco_outputs(out, rows, table, header)
-    for r in table:
-        if r["walks"]:
-            console.print(
-                f"{r['scene']:>18} {r['planner']:>9}: mean ZMP {1000 * r['zmp_mean_m']:.1f} mm, "
-                f"max {1000 * r['zmp_max_m']:.1f} mm, success {100 * r['success_rate']:.0f}% "
-                f"({r['walks']} walks)"
-            )
-        else:
-            console.print(f"{r['scene']:>18} {r['planner']:>9}: no plan")
+    paths = write_mujoco_outputs(out, rows, table, describe(trials, force, PUSH_DURATION))
+    for line in summary_lines(table):
+        console.print(line)
     console.print(f"wrote {', '.join(str(p) for p in paths)}")
 
 
@@ -837,7 +722,7 @@ def walk_cmd(
         raise InputError("steps", steps, "an integer >= 1")
     push = non_negative("push", push)
     model = robot_model(robot)
-    sc = resolve_scene(scene_file, scene)
+    sc = resolve_scene_arguments(scene_file, scene)
     with console.status(f"planning {sc.name} with {planner} for the {robot} ..."):
         plan = plan_for_walk(
             sc,
@@ -983,7 +868,6 @@ def bench_sim_cmd(
     )
     from footfall.planning import PlannerOptions, make_plan
     from footfall.planning.plan import check_planner_name
-    from footfall.terrain.scene import Scene
 
     check_planner_name(planner)
     k_list: list[int | None] = []
@@ -996,8 +880,7 @@ def bench_sim_cmd(
             raise InputError(
                 "nodes", nodes, "comma-separated integers >= 2 or 'plan', e.g. plan,10"
             )
-    sc = _scene_arg(scene)
-    assert isinstance(sc, Scene)
+    sc = resolve_scene(scene)
     plan = make_plan(sc, planner, None, PlannerOptions(threads=2))
     if not plan.has_solution:
         from footfall.errors import InfeasibleError

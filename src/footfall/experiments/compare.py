@@ -293,3 +293,31 @@ def run_compare(
                     progress("trials", i + 2, len(jobs))
     table = summarise(rows, plans)
     return rows, table, plans
+
+
+def describe(
+    spec: TrialSpec, trials: int, time_limit: float, plans: dict[tuple[str, str], FootstepPlan]
+) -> str:
+    """One paragraph saying how the trials were disturbed and what each plan was (the header of
+    compare.md)."""
+    planned = "; ".join(
+        f"{s}/{p}: {pl.status.value}, N={pl.n_steps}, {pl.solve_time:.1f} s"
+        for (s, p), pl in plans.items()
+    )
+    return (
+        f"{trials} trials per scene and planner; pushes uniform in [0, {spec.push_max:g}] N s "
+        f"({spec.push_duration:g} s pulse, random direction, at 10-80 % of the walk), estimate "
+        f"noise {spec.noise_pos:g} m / {spec.noise_vel:g} m/s, placement error "
+        f"{spec.placement_error:g} m, mismatch {spec.mismatch:g}, control rate "
+        f"{spec.control_rate:g} Hz; planner time limit {time_limit:g} s. Plans: {planned}."
+    )
+
+
+def summary_lines(table: list[dict[str, Any]]) -> list[str]:
+    """One console line per (scene, planner) of the summary table."""
+    return [
+        f"{r['scene']:>18} {r['planner']:>9}: mean ZMP {1000 * r['zmp_mean']:.2f} mm, "
+        f"max {1000 * r['zmp_max']:.2f} mm, success {100 * r['success_rate']:.0f}% "
+        f"({r['trials']} trials)"
+        for r in table
+    ]

@@ -192,3 +192,40 @@ def write_mujoco_outputs(
     md_path.write_text("\n".join(md))
     fig_path = plot_mujoco_table(table, out / "compare_mujoco.png")
     return [csv_path, md_path, fig_path]
+
+
+def steps_per_pair(
+    scenes: Sequence[str], planners: Sequence[str], n_steps: int | dict[str, int] | None
+) -> dict[tuple[str, str], int] | None:
+    """Footsteps N per (scene, planner) for the horizon planners, from one N for every scene or
+    one per scene name; None where nothing was asked (the reactive planner walks to the goal)."""
+    if n_steps is None:
+        return None
+    pairs = {
+        (sc, p): n_steps if isinstance(n_steps, int) else n_steps[sc]
+        for sc in scenes
+        for p in planners
+        if p != "reactive" and (isinstance(n_steps, int) or sc in n_steps)
+    }
+    return pairs or None
+
+
+def describe(trials: int, force: float, push_duration: float) -> str:
+    """The header of compare_mujoco.md: how many walks and which push."""
+    return (
+        f"{trials} walks per scene and planner, each with one push of {force:g} N for "
+        f"{push_duration:g} s ({force * push_duration:g} N s) in a seeded random direction mid "
+        "single support in 30-70 % of the walk; plans cached in plans/."
+    )
+
+
+def summary_lines(table: Sequence[dict[str, Any]]) -> list[str]:
+    """One console line per (scene, planner) of the MuJoCo table."""
+    return [
+        f"{r['scene']:>18} {r['planner']:>9}: mean ZMP {1000 * r['zmp_mean_m']:.1f} mm, "
+        f"max {1000 * r['zmp_max_m']:.1f} mm, success {100 * r['success_rate']:.0f}% "
+        f"({r['walks']} walks)"
+        if r["walks"]
+        else f"{r['scene']:>18} {r['planner']:>9}: no plan"
+        for r in table
+    ]

@@ -59,3 +59,33 @@ def example(name: str) -> LipWalkParams:
         return EXAMPLES[name]()
     except KeyError:
         raise InputError("example", name, f"one of {', '.join(EXAMPLES)}") from None
+
+
+#: the walk of ``footfall lip`` without ``--example``: four 0.3 m steps on 0.2 m wide feet, with
+#: standard gravity (the document's examples use its 9.8 m/s^2)
+DEFAULT_WALK: dict[str, Any] = {
+    "z_c": 0.8,
+    "t_sup": 0.8,
+    "sx": (0.0, 0.3, 0.3, 0.3, 0.0),
+    "sy": (0.2, 0.2, 0.2, 0.2, 0.2),
+    "a": 10.0,
+    "b": 1.0,
+    "a_stop": 1.0,
+    "b_stop": 1.0,
+    "g": 9.81,
+}
+
+
+def lip_params(name: str | None = None, **given: Any) -> LipWalkParams:
+    """The named document example (or :data:`DEFAULT_WALK` when ``name`` is None), with the
+    fields in ``given`` replaced; :class:`LipWalkParams` validates the result."""
+    from dataclasses import replace
+
+    if name is None:
+        return LipWalkParams(**(DEFAULT_WALK | given))
+    try:
+        return replace(example(name), **given)
+    except TypeError as exc:  # an unknown field name
+        raise InputError(
+            "lip parameters", sorted(given), f"fields of LipWalkParams ({exc})"
+        ) from None

@@ -61,6 +61,15 @@ class Push:
         """End time [s]."""
         return self.start + self.duration
 
+    def to_dict(self) -> dict[str, object]:
+        """Plain JSON data: start and duration [s], force [N], impulse [N s]."""
+        return {
+            "start": self.start,
+            "duration": self.duration,
+            "force": self.force.tolist(),
+            "impulse": self.impulse,
+        }
+
     def active(self, t: float) -> bool:
         """Whether the push acts at time ``t`` [s]."""
         return self.start <= t < self.start + self.duration

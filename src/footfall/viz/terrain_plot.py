@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -11,6 +12,7 @@ from matplotlib.colors import Colormap, Normalize
 from matplotlib.patches import Polygon
 from matplotlib.tri import Triangulation
 
+from footfall.terrain.scene import Scene
 from footfall.terrain.terrain import Terrain
 
 
@@ -130,3 +132,31 @@ def _hull(points: np.ndarray) -> np.ndarray:
             upper.pop()
         upper.append(p)
     return np.array(lower[:-1] + upper[:-1])
+
+
+def plot_scene(scene: Scene, path: Path, dpi: int = 120) -> Path:
+    """Draw ``scene`` to ``path``: top view (regions coloured by height, start feet, goal with its
+    heading) above a side view (x against z); return the path."""
+    import matplotlib.pyplot as plt
+
+    fig, (ax_top, ax_side) = plt.subplots(
+        2, 1, figsize=(9, 8), gridspec_kw={"height_ratios": [3, 1]}, constrained_layout=True
+    )
+    mappable = plot_terrain(ax_top, scene.terrain)
+    plot_terrain_side(ax_side, scene.terrain)
+    for foot, mark in ((scene.start.left, "^"), (scene.start.right, "v")):
+        ax_top.plot(foot[0], foot[1], mark, color="tab:red", ms=8)
+        ax_side.plot(foot[0], foot[2], mark, color="tab:red", ms=8)
+    goal = scene.goal.position
+    heading = scene.goal.heading
+    ax_top.plot(goal[0], goal[1], "*", color="gold", mec="k", ms=14)
+    ax_top.arrow(
+        goal[0], goal[1], 0.2 * np.cos(heading), 0.2 * np.sin(heading), width=0.01, color="k"
+    )
+    ax_side.plot(goal[0], goal[2], "*", color="gold", mec="k", ms=14)
+    ax_top.set_title(f"{scene.name}: {scene.description}", fontsize=9)
+    fig.colorbar(mappable, ax=ax_top, label="z [m]", shrink=0.8)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path

@@ -150,6 +150,23 @@ class SimOptions:
                 "'python' or 'auto' with solver 'clarabel' (compiled: newton)",
             )
 
+    def to_dict(self) -> dict[str, Any]:
+        """The disturbance and loop options as plain JSON data (MPC weights and sole size
+        omitted: they come from the plan's robot unless set)."""
+        return {
+            "control_rate": self.control_rate,
+            "substeps": self.substeps,
+            "pushes": [p.to_dict() for p in self.pushes],
+            "noise_pos": self.noise_pos,
+            "noise_vel": self.noise_vel,
+            "placement_error": self.placement_error,
+            "mass_scale": self.mass_scale,
+            "com_height_scale": self.com_height_scale,
+            "seed": self.seed,
+            "solver": self.solver,
+            "engine": self.engine,
+        }
+
 
 @dataclass(frozen=True)
 class SimMetrics:
@@ -792,3 +809,24 @@ def simulate(
     w = _prepare(plan, opts, goal)
     tr = _walk_compiled(w) if engine == "compiled" else _walk_python(w)
     return _result(w, tr, engine, wall0)
+
+
+def run_report(
+    scene_name: str, plan: FootstepPlan, options: SimOptions, result: SimResult
+) -> dict[str, Any]:
+    """What ``footfall simulate`` writes to ``sim.json``: the plan in brief, the options (with
+    the engine that actually ran), the metrics and the landed footsteps."""
+    return {
+        "scene": scene_name,
+        "planner": result.planner,
+        "plan": {
+            "status": plan.status.value,
+            "steps": plan.n_steps,
+            "planning_time": plan.solve_time,
+            "message": plan.message,
+            "footsteps": plan.footsteps.tolist(),
+        },
+        "options": options.to_dict() | {"engine": result.metrics.engine},
+        "metrics": result.metrics.to_dict(),
+        "footsteps": result.footsteps.tolist(),
+    }
