@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from footfall._typing import FloatArray
+from footfall.errors import InputError
 
 #: turning angles smaller than this [rad] count as straight (collinear vertices are allowed)
 ANGLE_TOL = 1e-9
@@ -167,7 +168,7 @@ def as_points(xy: ArrayLike) -> tuple[FloatArray, bool]:
     single = arr.ndim == 1
     pts = np.atleast_2d(arr)
     if pts.shape[-1] < 2:
-        raise ValueError(f"expected points with at least 2 coordinates, got shape {arr.shape}")
+        raise InputError("points", arr.shape, "an array of shape (2,) or (N, 2) or wider")
     return pts[:, :2], single
 
 

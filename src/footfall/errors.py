@@ -41,6 +41,14 @@ class InputError(FootfallError, ValueError):
         super().__init__(f"{field}: got {value_repr(value)}, expected {expected}")
 
 
+class UnknownNameError(InputError, KeyError):
+    """A name (region, joint, body) that the container does not hold; also a :class:`KeyError`,
+    so mapping-style lookups keep their protocol."""
+
+    def __str__(self) -> str:  # KeyError would print the repr of the message
+        return str(self.args[0]) if self.args else ""
+
+
 class SceneError(InputError):
     """A terrain scene (file or object) is invalid."""
 

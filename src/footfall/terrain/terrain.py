@@ -10,7 +10,7 @@ from numpy.typing import ArrayLike
 
 from footfall._geometry import inset_polygon, polygon_distance
 from footfall._typing import FloatArray
-from footfall.errors import SceneError
+from footfall.errors import SceneError, UnknownNameError
 from footfall.terrain.region import Region
 
 
@@ -42,7 +42,7 @@ class Terrain:
         for r in self.regions:
             if r.name == name:
                 return r
-        raise KeyError(name)
+        raise UnknownNameError("region", name, f"one of {', '.join(self.names)}")
 
     def __len__(self) -> int:
         return len(self.regions)
@@ -56,11 +56,11 @@ class Terrain:
         return [r.name for r in self.regions]
 
     def index(self, name: str) -> int:
-        """Position of the region called ``name`` (raises KeyError if absent)."""
+        """Position of the region called ``name`` (raises :class:`UnknownNameError`, a KeyError, if absent)."""
         for i, r in enumerate(self.regions):
             if r.name == name:
                 return i
-        raise KeyError(name)
+        raise UnknownNameError("region", name, f"one of {', '.join(self.names)}")
 
     def locate(self, p: ArrayLike, tol: float = 1e-6) -> list[str]:
         """Names of the regions containing the 3-D point ``p`` (3,) [m] (on plane and inside)."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from footfall.errors import UnknownNameError
 from footfall.models.biped import Side
 
 MODEL_NAME = "footfall_biped"
@@ -38,7 +39,7 @@ def _side(side: Side) -> str:
 def joint(side: Side, name: str) -> str:
     """Joint name, e.g. ``left_knee``; ``name`` is one of ``LEG_JOINTS``."""
     if name not in LEG_JOINTS:
-        raise KeyError(name)
+        raise UnknownNameError("joint", name, f"one of {', '.join(LEG_JOINTS)}")
     return f"{_side(side)}_{name}"
 
 

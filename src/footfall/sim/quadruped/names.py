@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from footfall.errors import UnknownNameError
 from footfall.quadruped.robot import JOINT_NAMES, Leg
 
 MODEL_NAME = "footfall_quadruped"
@@ -35,7 +36,7 @@ def shank_body(leg: Leg) -> str:
 def joint(leg: Leg, joint_name: str) -> str:
     """Joint name, e.g. ``LF_knee``; ``joint_name`` is one of ``JOINT_NAMES``."""
     if joint_name not in JOINT_NAMES:
-        raise KeyError(joint_name)
+        raise UnknownNameError("joint", joint_name, f"one of {', '.join(JOINT_NAMES)}")
     return f"{leg.value}_{joint_name}"
 
 
