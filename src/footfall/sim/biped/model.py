@@ -2,7 +2,7 @@
 
 A ~30 kg humanoid lower body for document 000's validation (section 5.5): a pelvis carrying a torso
 box, two 6-DoF legs (hip yaw / roll / pitch, knee, ankle pitch / roll, axes as in
-:data:`biped_names.LEG_JOINT_AXES`) and flat rectangular feet. The ankle axes sit straight above the
+:data:`footfall.sim.biped.names.LEG_JOINT_AXES`) and flat rectangular feet. The ankle axes sit straight above the
 sole centre, which is the footstep point of the planner and the ALIP contact point. Each foot
 touches the ground through four small spheres at the sole corners; the foot box is visual only.
 Joints are driven by position actuators (PD servos).
@@ -11,7 +11,7 @@ The planner's :class:`~footfall.models.biped.BipedParams` are *derived* from thi
 (:func:`planner_params`): mass and CoM height come from MuJoCo at the nominal walking posture.
 
 MuJoCo notes (as for the quadruped): angles in radians need ``<compiler angle="radian"/>``; robot
-geoms collide only with terrain through the contype/conaffinity bits of :mod:`biped_names`;
+geoms collide only with terrain through the contype/conaffinity bits of :mod:`footfall.sim.biped.names`;
 ``cone="elliptic"`` with a high ``impratio`` keeps the feet from creeping on the slope.
 """
 

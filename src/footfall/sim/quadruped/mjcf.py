@@ -11,7 +11,7 @@ ground plane is placed one foot radius below it along its normal.
 
 MuJoCo notes (measured for this issue): angles are in radians only with
 ``<compiler angle="radian"/>``; robot geoms would collide with each other without the
-contype/conaffinity bits of :mod:`quadruped_names`; feet creep down a 15 degree slope with the
+contype/conaffinity bits of :mod:`footfall.sim.quadruped.names`; feet creep down a 15 degree slope with the
 default pyramidal cone, which ``cone="elliptic" impratio="10"`` stops.
 """
 
