@@ -14,6 +14,7 @@ from typing import Any
 
 import typer
 from rich.console import Console
+from rich.text import Text
 
 from footfall._io import write_json
 from footfall._validate import names_in, non_negative
@@ -26,8 +27,16 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    # help texts are plain text: units like [s] and extras like footfall[robots] must show as typed
+    rich_markup_mode=None,
 )
-console = Console(stderr=True)
+#: user-facing messages (scene names, paths, install hints) are printed as typed, never as markup
+console = Console(stderr=True, markup=False, highlight=False)
+
+
+def _say_error(prefix: str, message: str) -> None:
+    """Print ``prefix: message`` on stderr, the prefix in bold red, the message as plain text."""
+    console.print(Text(f"{prefix}: ", style="bold red") + Text(message))
 
 
 @app.callback()
@@ -53,13 +62,13 @@ def main() -> None:
     try:
         app()
     except InputError as exc:
-        console.print(f"[bold red]error:[/] {exc}")
+        _say_error("error", str(exc))
         sys.exit(2)
     except FootfallError as exc:
-        console.print(f"[bold red]failed:[/] {exc}")
+        _say_error("failed", str(exc))
         sys.exit(1)
     except KeyboardInterrupt:
-        console.print("[bold red]interrupted[/]")
+        _say_error("interrupted", "stopped by the user")
         sys.exit(130)
 
 
