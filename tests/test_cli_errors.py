@@ -23,3 +23,10 @@ def test_help_shows_units_in_brackets() -> None:
     r = _run("plan", "--help")
     assert r.returncode == 0
     assert "[s]" in r.stdout
+
+
+def test_a_long_error_stays_on_one_line() -> None:
+    r = _run("plan", "--scene", "no_such_scene_" + "x" * 100)
+    assert r.returncode == 2
+    lines = [line for line in r.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1, r.stderr

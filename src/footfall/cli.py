@@ -31,7 +31,7 @@ app = typer.Typer(
     rich_markup_mode=None,
 )
 #: user-facing messages (scene names, paths, install hints) are printed as typed, never as markup
-console = Console(stderr=True, markup=False, highlight=False)
+console = Console(stderr=True, markup=False, highlight=False, soft_wrap=True)
 
 
 def _say_error(prefix: str, message: str) -> None:
