@@ -163,3 +163,26 @@ def test_bad_input_names_the_parameter(kwargs: dict, field: str) -> None:
     with pytest.raises(InputError) as err:
         LipWalkParams(**args)
     assert err.value.field == field
+
+
+def test_a_support_phase_too_long_for_double_precision_is_refused() -> None:
+    # T_c = sqrt(0.8 / 9.81) = 0.2856 s; 1000 s would overflow cosh and write NaN footholds
+    from footfall.errors import InputError
+    from footfall.planning.lip_walk import LipWalkParams
+
+    with pytest.raises(InputError, match="t_sup"):
+        LipWalkParams(z_c=0.8, t_sup=1000.0, sx=(0.0, 0.3), sy=(0.2, 0.2))
+    ok = LipWalkParams(z_c=0.8, t_sup=5.0, sx=(0.0, 0.3), sy=(0.2, 0.2))
+    assert ok.t_sup == 5.0
+
+
+def test_written_json_is_strict(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    import json
+
+    from footfall._io import write_json
+
+    path = write_json(tmp_path / "x.json", {"a": float("nan"), "b": np.array([1.0, np.inf])})
+    assert json.loads(path.read_text(), parse_constant=lambda c: pytest.fail(c)) == {
+        "a": None,
+        "b": [1.0, None],
+    }

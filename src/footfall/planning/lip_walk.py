@@ -23,6 +23,7 @@ the CoM comes to rest over the last foot.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -32,6 +33,10 @@ from footfall._typing import FloatArray
 from footfall._validate import finite_vector, non_negative, positive
 from footfall.errors import InputError
 from footfall.models.lip import GRAVITY, LIP
+
+#: longest support phase, in time constants T_c: cosh(20) = 2.4e8 still leaves the foot placement
+#: (differences of such terms) about 8 significant digits in double precision
+MAX_SUPPORT_TIME_CONSTANTS = 20
 
 
 @dataclass(frozen=True)
@@ -74,6 +79,15 @@ class LipWalkParams:
         set_(self, "z_c", positive("z_c", self.z_c))
         set_(self, "t_sup", positive("t_sup", self.t_sup))
         set_(self, "g", positive("g", self.g))
+        t_c = math.sqrt(self.z_c / self.g)
+        if self.t_sup > MAX_SUPPORT_TIME_CONSTANTS * t_c:
+            raise InputError(
+                "t_sup",
+                self.t_sup,
+                f"at most {MAX_SUPPORT_TIME_CONSTANTS} T_c = {MAX_SUPPORT_TIME_CONSTANTS * t_c:.3g} s "
+                f"(T_c = sqrt(z_c / g) = {t_c:.3g} s): the pendulum grows like exp(T_sup / T_c), so a "
+                "longer support loses the foot placement to rounding",
+            )
         sx = finite_vector("sx", self.sx)
         sy = finite_vector("sy", self.sy)
         if sy.shape != sx.shape:
