@@ -9,6 +9,7 @@ pydantic, then builds the frozen dataclasses (which validate the geometry); ever
 from __future__ import annotations
 
 import math
+import stat
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -394,6 +395,70 @@ def _pydantic_error(err: ValidationError, loc: _Locator) -> SceneError:
     return loc.error(path, first.get("input"), f"{first['msg'].lower()}{more}")
 
 
+#: largest scene file or text accepted [bytes]; the largest built-in scene is a few kB
+MAX_SCENE_BYTES = 4_000_000
+#: most YAML nodes a scene may expand to, aliases counted at every use (a ~1 kB "billion laughs"
+#: alias bomb expands to ~10^9 nodes, which validation or an error message would materialise)
+MAX_SCENE_NODES = 1_000_000
+
+
+def _read_scene_file(path: Path) -> str:
+    """The text of a scene file: a regular file (not a device or a pipe) of bounded size."""
+    try:
+        info = path.stat()
+    except OSError as e:
+        raise SceneError("scene file", str(path), f"a readable YAML file ({e.strerror})") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise SceneError("scene file", str(path), "a regular file (not a folder, device or pipe)")
+    if info.st_size > MAX_SCENE_BYTES:
+        raise SceneError(
+            "scene file", f"{path} ({info.st_size} bytes)", f"at most {MAX_SCENE_BYTES} bytes"
+        )
+    try:
+        with path.open("rb") as fh:
+            raw = fh.read(MAX_SCENE_BYTES + 1)
+    except OSError as e:
+        raise SceneError("scene file", str(path), f"a readable YAML file ({e.strerror})") from None
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise SceneError(
+            "scene file", str(path), f"UTF-8 text ({e.reason} at byte {e.start})"
+        ) from None
+
+
+def _check_expanded_size(root: yaml.Node | None, source: str | None) -> None:
+    """Refuse a YAML document whose aliases expand it beyond :data:`MAX_SCENE_NODES` nodes.
+
+    Counts the expanded size on the composed node graph, where an alias is one shared node: each
+    node's size is computed once (memoised), so a bomb is measured without being expanded."""
+    sizes: dict[int, int] = {}
+
+    def size(node: yaml.Node, depth: int) -> int:
+        if depth > 100:
+            raise SceneError(
+                "yaml" + (f" ({source})" if source else ""), "nesting", "at most 100 levels"
+            )
+        if id(node) in sizes:
+            return sizes[id(node)]
+        total = 1
+        if isinstance(node, yaml.SequenceNode):
+            total += sum(size(child, depth + 1) for child in node.value)
+        elif isinstance(node, yaml.MappingNode):
+            total += sum(size(k, depth + 1) + size(v, depth + 1) for k, v in node.value)
+        sizes[id(node)] = total
+        return total
+
+    if root is not None:
+        n = size(root, 0)
+        if n > MAX_SCENE_NODES:
+            raise SceneError(
+                "yaml" + (f" ({source})" if source else ""),
+                f"{n} nodes once aliases are expanded",
+                f"at most {MAX_SCENE_NODES} (an alias bomb?)",
+            )
+
+
 def load_scene(path_or_text: str | Path) -> Scene:
     """Load and validate a scene from a YAML file path or YAML text.
 
@@ -409,15 +474,15 @@ def load_scene(path_or_text: str | Path) -> Scene:
         and (path_or_text.endswith((".yaml", ".yml")) or Path(path_or_text).is_file())
     ):
         p = Path(path_or_text)
-        try:
-            text = p.read_text()
-        except OSError as e:
-            raise SceneError("scene file", str(p), f"a readable YAML file ({e.strerror})") from None
+        text = _read_scene_file(p)
         source = p.name
     else:
         text = path_or_text
+    if len(text) > MAX_SCENE_BYTES:
+        raise SceneError("scene", f"{len(text)} characters", f"at most {MAX_SCENE_BYTES}")
     try:
         root = yaml.compose(text, Loader=yaml.SafeLoader)
+        _check_expanded_size(root, source)
         data = yaml.safe_load(text)
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
