@@ -30,3 +30,36 @@ def test_a_long_error_stays_on_one_line() -> None:
     assert r.returncode == 2
     lines = [line for line in r.stderr.splitlines() if line.strip()]
     assert len(lines) == 1, r.stderr
+
+
+def test_steps_with_min_steps_is_refused() -> None:
+    r = _run("plan", "--scene", "flat", "--steps", "8", "--min-steps")
+    assert r.returncode == 2
+    assert "min-steps" in r.stderr
+
+
+def test_an_output_path_that_is_a_file_is_refused_before_planning(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    f = tmp_path / "taken"
+    f.write_text("x")
+    r = _run("plan", "--scene", "flat", "--steps", "8", "--out", str(f))
+    assert r.returncode == 2
+    assert "out:" in r.stderr and "Traceback" not in r.stderr
+    assert "planning" not in r.stdout
+
+
+def test_threads_beyond_the_cores_are_refused() -> None:
+    r = _run("plan", "--scene", "flat", "--steps", "8", "--threads", "4096")
+    assert r.returncode == 2
+    assert "threads" in r.stderr
+
+
+def test_a_failed_reactive_plan_exits_1_and_leaves_no_stale_figure(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    ok = _run("plan", "--scene", "flat", "--planner", "reactive", "--out", str(tmp_path))
+    assert ok.returncode == 0, ok.stderr
+    assert (tmp_path / "plan.png").exists()
+    # two footsteps cannot reach the goal of `flat` (1 m away)
+    short = _run(
+        "plan", "--scene", "flat", "--planner", "reactive", "--steps", "2", "--out", str(tmp_path)
+    )
+    assert short.returncode == 1, short.stdout + short.stderr
+    assert '"status": "incomplete"' in (tmp_path / "plan.json").read_text()

@@ -6,6 +6,7 @@ Every command that computes something writes JSON and a figure into ``--out``. I
 
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -42,6 +43,37 @@ def _say_error(prefix: str, message: str) -> None:
 @app.callback()
 def _root() -> None:
     """Footstep planning for legged robots (LIP/ALIP, MIQCQP planner, quadruped ZMP gaits)."""
+
+
+_THREADS_HELP = (
+    "Worker processes of the bnb backend / solver threads (default: 2, or the cores if fewer; "
+    "at most the cores this process may use)."
+)
+
+
+def _threads(threads: int | None) -> int:
+    """``--threads``: as given, or the default of two workers where two cores exist."""
+    if threads is not None:
+        return threads
+    from footfall.planning.plan import available_cores
+
+    return min(2, available_cores())
+
+
+def output_folder(out: Path) -> Path:
+    """Create ``out`` (and its parents) and check that it is a writable folder, before any work
+    whose result would otherwise be lost."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise InputError("out", str(out), "a folder (a file of that name exists)") from None
+    except OSError as e:
+        raise InputError("out", str(out), f"a folder that can be created ({e.strerror})") from None
+    if not out.is_dir():
+        raise InputError("out", str(out), "a folder (a file of that name exists)")
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise InputError("out", str(out), "a folder this user may write to")
+    return out
 
 
 def parse_floats(field: str, text: str) -> list[float]:
@@ -129,6 +161,7 @@ def lip(
         "b_stop": b_stop,
         "g": g,
     }
+    output_folder(out)
     params = lip_params(example, **{k: v for k, v in given.items() if v is not None})
     title = "LIP walk" if example is None else f"LIP walk: {example} (document 004)"
     walk = lip_walk(params)
@@ -191,7 +224,7 @@ def scenes_command(
     from footfall.viz.terrain_plot import plot_scene
 
     scene = resolve_scene(show)
-    out.mkdir(parents=True, exist_ok=True)
+    output_folder(out)
     (out / "scene.yaml").write_text(scene_to_yaml(scene))
     plot_scene(scene, out / "scene.png")
     console.print(f"wrote {out / 'scene.png'} and {out / 'scene.yaml'}")
@@ -212,7 +245,7 @@ def plan(
     solver: str = typer.Option(
         "bnb", help="Backend: bnb (fast exact, default), scip (direct model) or gurobi."
     ),
-    threads: int = typer.Option(2, help="Worker processes of the bnb backend / solver threads."),
+    threads: int | None = typer.Option(None, help=_THREADS_HELP),
     region_margin: float = typer.Option(
         0.0, help="Keep footsteps this far inside their region [m] (0: point footholds)."
     ),
@@ -240,13 +273,14 @@ def plan(
 
     check_planner_name(planner)
     sc = resolve_scene_arguments(scene_file, scene)
-    if steps is not None and (steps < 1):
-        raise InputError("steps", steps, "an integer >= 1")
+    output_folder(out)
+    if steps is not None and min_steps:
+        raise InputError("steps", steps, "no --steps with --min-steps (which searches N)")
     options = PlannerOptions(
         time_limit=time_limit,
         gap=gap,
         solver=solver,
-        threads=threads,
+        threads=_threads(threads),
         region_margin=region_margin,
         reach_both_frames=reach_both_frames,
         swing_max=swing_max,
@@ -267,18 +301,24 @@ def plan(
         else:
             result = make_plan(sc, planner, steps, options, robot_params)
     payload = result.to_dict(sc.name)
+    checked = True
     if result.has_solution:
         report = check_plan(result, sc)
+        checked = report.ok
         payload["check"] = {"ok": report.ok, "violations": report.summary().splitlines()}
     write_json(out / "plan.json", payload)
     if result.has_solution:
         plot_plan(result, sc, out / "plan.png")
+    else:  # no figure of an earlier run beside this run's plan.json
+        (out / "plan.png").unlink(missing_ok=True)
     console.print(
         f"{sc.name}: {planner} -> {result.status.value}, {result.n_steps} steps, "
         f"objective {result.objective:.4g}, {result.solve_time:.2f} s. {result.message}"
     )
     console.print(f"wrote {out / 'plan.json'}" + (" and plan.png" if result.has_solution else ""))
-    if not result.has_solution:
+    if not checked:
+        console.print("the plan violates the checker's constraints (see plan.json 'check')")
+    if not (result.reaches_goal and checked):
         raise typer.Exit(1)
 
 
@@ -433,7 +473,7 @@ def simulate_command(
         None, help="Footsteps N of miqcqp/kinematic (default: the smallest N with a miqcqp plan)."
     ),
     time_limit: float = typer.Option(60.0, "--time-limit", help="Planner time limit [s]."),
-    threads: int = typer.Option(2, help="Worker processes of the bnb backend / solver threads."),
+    threads: int | None = typer.Option(None, help=_THREADS_HELP),
     push: float = typer.Option(0.0, help="Push impulse [N s]; 0 for none."),
     push_time: float = typer.Option(1.0, help="Push start time [s]."),
     push_direction: float = typer.Option(90.0, help="Push direction [deg] (0 = +x, 90 = +y)."),
@@ -474,9 +514,12 @@ def simulate_command(
         engine=engine,
     )
     sc = resolve_scene(scene)
+    output_folder(out)
     # the reactive planner walks until the goal: --steps is for the horizon planners
     n = None if planner == "reactive" else steps
-    plan = make_plan(sc, planner, n, PlannerOptions(time_limit=time_limit, threads=threads))
+    plan = make_plan(
+        sc, planner, n, PlannerOptions(time_limit=time_limit, threads=_threads(threads))
+    )
     if not plan.has_solution:
         from footfall.errors import InfeasibleError
 
@@ -516,7 +559,7 @@ def compare_command(
         "(default: the smallest N with a miqcqp plan).",
     ),
     time_limit: float = typer.Option(60.0, "--time-limit", help="Planner time limit [s]."),
-    threads: int = typer.Option(2, help="Worker processes of the bnb backend / solver threads."),
+    threads: int | None = typer.Option(None, help=_THREADS_HELP),
     push_max: float = typer.Option(15.0, help="Push impulses uniform in [0, push_max] [N s]."),
     noise_pos: float = typer.Option(0.002, help="CoM position estimate noise (std) [m]."),
     noise_vel: float = typer.Option(0.02, help="CoM velocity estimate noise (std) [m/s]."),
@@ -578,12 +621,13 @@ def compare_command(
         control_rate=rate,
     )
     scene_objs = {sc.name: sc for sc in map(resolve_scene, _list_arg(scenes))}
+    output_folder(out)
     if not scene_objs:
         raise InputError("scenes", scenes, "one or more scene names or YAML files")
     # The MPC's small matrices run fastest single-threaded; spawned workers read this.
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     with _progress_bar() as progress:
-        options = PlannerOptions(time_limit=time_limit, threads=threads)
+        options = PlannerOptions(time_limit=time_limit, threads=_threads(threads))
         rows, table, plans = run_compare(
             scene_objs, names, trials, out, spec, workers, n_steps, options, progress
         )
@@ -636,6 +680,7 @@ def _compare_mujoco(
     from footfall.terrain.scene import builtin_scene_names
 
     _positive_int("trials", trials)
+    output_folder(out)
     push_max = non_negative("push_max", push_max)
     names = names_in("planners", planners.split(","), PLANNERS)
     scene_names = names_in("scenes", _list_arg(scenes), builtin_scene_names())
@@ -890,7 +935,7 @@ def bench_sim_cmd(
                 "nodes", nodes, "comma-separated integers >= 2 or 'plan', e.g. plan,10"
             )
     sc = resolve_scene(scene)
-    plan = make_plan(sc, planner, None, PlannerOptions(threads=2))
+    plan = make_plan(sc, planner, None, PlannerOptions(threads=_threads(None)))
     if not plan.has_solution:
         from footfall.errors import InfeasibleError
 

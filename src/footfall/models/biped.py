@@ -119,6 +119,10 @@ class ReachTrapezoid:
         return bool(np.all(g @ np.asarray(q, dtype=float)[:2] - h <= tol))
 
 
+#: most ALIP nodes K per single support (the problem grows linearly in K; the document uses 5)
+MAX_NODES = 50
+
+
 @dataclass(frozen=True, eq=False)
 class BipedParams:
     """Everything the footstep planners need to know about the biped.
@@ -169,8 +173,10 @@ class BipedParams:
         ):
             object.__setattr__(self, name, positive(name, getattr(self, name)))
         n = self.n_nodes
-        if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 2:
-            raise InputError("n_nodes", n, "an integer >= 2 (nodes per single support)")
+        if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 2 <= n <= MAX_NODES:
+            raise InputError(
+                "n_nodes", n, f"an integer in 2..{MAX_NODES} (nodes per single support)"
+            )
         object.__setattr__(self, "n_nodes", int(n))
         theta = self.theta_max
         if isinstance(theta, bool) or not isinstance(theta, int | float | np.integer | np.floating):

@@ -58,6 +58,7 @@ from footfall._typing import FloatArray, IntArray
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import (
+    MAX_STEPS,
     FootstepPlan,
     PlannerOptions,
     goal_feet,
@@ -167,8 +168,8 @@ def build_footstep_problem(
     """
     robot = robot or scene.robot
     options = options or PlannerOptions()
-    if isinstance(n_steps, bool) or not isinstance(n_steps, int) or n_steps < 1:
-        raise InputError("n_steps", n_steps, "an integer >= 1")
+    if isinstance(n_steps, bool) or not isinstance(n_steps, int) or not 1 <= n_steps <= MAX_STEPS:
+        raise InputError("n_steps", n_steps, f"an integer in 1..{MAX_STEPS}")
     start = scene.start
     theta0 = float(start.heading)
     theta_goal = wrap_near(float(scene.goal.heading), theta0)

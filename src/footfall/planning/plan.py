@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -51,6 +52,21 @@ class PlannerWeights:
             return np.asarray(self.terminal_state, dtype=float)
         mzh = robot.mass * robot.com_height
         return np.array([1.0, 1.0, 1.0 / mzh**2, 1.0 / mzh**2])
+
+
+#: most footsteps N a horizon planner accepts (the problem grows linearly in N; the built-in
+#: scenes need at most 20)
+MAX_STEPS = 200
+#: most heading segments L (eq. 5.12g-h): one binary per segment and footstep
+MAX_HEADING_SEGMENTS = 1024
+
+
+def available_cores() -> int:
+    """Cores this process may run on (the affinity mask where the OS reports one)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
 
 
 @dataclass(frozen=True)
@@ -103,12 +119,23 @@ class PlannerOptions:
     swing_max: float | None = None
 
     def __post_init__(self) -> None:
-        if not isinstance(self.heading_segments, int) or self.heading_segments < 4:
-            raise InputError("heading_segments", self.heading_segments, "an integer >= 4")
+        segments = self.heading_segments
+        if isinstance(segments, bool) or not isinstance(segments, int):
+            raise InputError(
+                "heading_segments", segments, f"an integer in 4..{MAX_HEADING_SEGMENTS}"
+            )
+        if not 4 <= segments <= MAX_HEADING_SEGMENTS:
+            raise InputError(
+                "heading_segments", segments, f"an integer in 4..{MAX_HEADING_SEGMENTS}"
+            )
         object.__setattr__(self, "time_limit", positive("time_limit", self.time_limit))
         object.__setattr__(self, "gap", non_negative("gap", self.gap))
-        if isinstance(self.threads, bool) or not isinstance(self.threads, int) or self.threads < 1:
-            raise InputError("threads", self.threads, "an integer >= 1")
+        cores = available_cores()
+        threads = self.threads
+        if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= cores:
+            raise InputError(
+                "threads", threads, f"an integer in 1..{cores} (the cores this process may use)"
+            )
         if self.solver not in KNOWN_BACKENDS:
             raise InputError("solver", self.solver, f"one of {', '.join(KNOWN_BACKENDS)}")
         object.__setattr__(self, "momentum_bound", positive("momentum_bound", self.momentum_bound))
@@ -206,6 +233,13 @@ class FootstepPlan:
     def has_solution(self) -> bool:
         """True when the plan holds footsteps."""
         return self.footsteps.shape[0] > 0
+
+    @property
+    def reaches_goal(self) -> bool:
+        """True when the plan holds footsteps that end at the goal: a solved optimisation
+        (optimal, feasible, or an incumbent at the time limit) or a reactive walk that got there."""
+        ok = (SolveStatus.OPTIMAL, SolveStatus.FEASIBLE, SolveStatus.TIME_LIMIT)
+        return self.has_solution and self.status in ok
 
     @classmethod
     def empty(

@@ -262,8 +262,11 @@ def plan_reactive(
     message = ""
 
     def at_goal() -> bool:
+        # both feet on their goal positions *and* at the goal heading
         return len(feet) >= 2 and all(
-            np.linalg.norm(feet[-1 - j][:2] - feet_goal[sides[-1 - j]]) < 1e-6 for j in (0, 1)
+            np.linalg.norm(feet[-1 - j][:2] - feet_goal[sides[-1 - j]]) < 1e-6
+            and abs(headings[-1 - j] - theta_goal) < 1e-6
+            for j in (0, 1)
         )
 
     while not (reached := at_goal()) and len(feet) <= max_steps:
@@ -285,7 +288,8 @@ def plan_reactive(
     if reached:
         status, message = SolveStatus.FEASIBLE, f"reached the goal in {n} footsteps"
     else:
-        status = SolveStatus.INFEASIBLE
+        # a greedy planner's failure proves nothing: a horizon planner may still find a plan
+        status = SolveStatus.INCOMPLETE
         message = message or f"did not reach the goal within {max_steps} footsteps"
     return FootstepPlan(
         planner="reactive",

@@ -63,6 +63,21 @@ def make_plan(
     return plan_footsteps(scene, robot, n_steps, options)
 
 
+def _search_note(found: int, start: int, tried: list[dict[str, object]]) -> str:
+    """What a smallest-N search proved: the N below ``found`` that were proven infeasible and the
+    N that were not decided (time limit, error), in which case ``found`` may not be the smallest."""
+    proven = [t["n_steps"] for t in tried if t["status"] == "infeasible"]
+    open_ = [f"{t['n_steps']} ({t['status']})" for t in tried if t["status"] != "infeasible"]
+    note = f"first N with a plan: {found} (searched from the lower bound {start}"
+    if proven:
+        note += f"; proven infeasible: N = {', '.join(map(str, proven))}"
+    if open_:
+        return (
+            note + f"; not decided: N = {', '.join(open_)}, so a plan with fewer steps may exist)"
+        )
+    return note + f"; so {found} is the smallest N with a plan)"
+
+
 def plan_min_steps(
     scene: Scene,
     planner: str = "miqcqp",
@@ -94,9 +109,7 @@ def plan_min_steps(
             stats = dict(plan.stats)
             stats["tried"] = tried
             return replace(
-                plan,
-                stats=stats,
-                message=plan.message + f"; smallest N with a plan: {n} (searched from {start})",
+                plan, stats=stats, message=plan.message + "; " + _search_note(n, start, tried)
             )
         tried.append({"n_steps": n, "status": plan.status.value})
     assert plan is not None

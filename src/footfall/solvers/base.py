@@ -20,6 +20,9 @@ class SolveStatus(str, Enum):
     TIME_LIMIT = "time_limit"  # stopped by the time limit; a solution may or may not exist
     INFEASIBLE = "infeasible"  # proven infeasible
     ERROR = "error"  # the solver failed or reported unboundedness
+    INCOMPLETE = (
+        "incomplete"  # a heuristic stopped short of the goal: proves nothing about feasibility
+    )
 
 
 @dataclass(frozen=True)

@@ -30,6 +30,10 @@ DUPLICATE_TOL = 1e-9
 MIN_NORMAL_Z = 0.2
 
 
+#: most vertices of one region's polygon (each is a row of the region constraint, eq. 5.18)
+MAX_VERTICES = 256
+
+
 def _error(name: str, attr: str, value: object, expected: str) -> SceneError:
     # Field is "region '<name>' <attr>" so that the scene loader can map <attr> to a YAML line.
     return SceneError(f"region {name!r} {attr}", value, expected)
@@ -94,8 +98,13 @@ class Region:
             raise _error(
                 name, "vertices", self.vertices, "a list of [x, y] points [m], shape (V, 2)"
             )
-        if v.shape[0] < 3:
-            raise _error(name, "vertices", v.tolist(), "at least 3 vertices")
+        if not 3 <= v.shape[0] <= MAX_VERTICES:
+            raise _error(
+                name,
+                "vertices",
+                f"{v.shape[0]} vertices",
+                f"at least 3 and at most {MAX_VERTICES} vertices",
+            )
         if not np.all(np.isfinite(v)):
             raise _error(name, "vertices", v.tolist(), "finite coordinates (no NaN or inf)")
         gaps = np.linalg.norm(np.roll(v, -1, axis=0) - v, axis=1)

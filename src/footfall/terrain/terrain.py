@@ -13,6 +13,10 @@ from footfall._typing import FloatArray
 from footfall.errors import SceneError, UnknownNameError
 from footfall.terrain.region import Region
 
+#: most regions of a terrain: one binary per region and footstep, and the region graph is
+#: quadratic in the count
+MAX_REGIONS = 1000
+
 
 @dataclass(frozen=True, eq=False)
 class Terrain:
@@ -27,8 +31,8 @@ class Terrain:
 
     def __post_init__(self) -> None:
         regions = tuple(self.regions)
-        if not regions:
-            raise SceneError("regions", [], "at least one region")
+        if not 1 <= len(regions) <= MAX_REGIONS:
+            raise SceneError("regions", f"{len(regions)} regions", f"1..{MAX_REGIONS} regions")
         seen: set[str] = set()
         for i, r in enumerate(regions):
             if not isinstance(r, Region):

@@ -69,6 +69,10 @@ from footfall.sim.pushes import Push
 ENGINES = ("auto", "compiled", "python")
 
 
+#: highest MPC rate [Hz]: the loop stores a sample per tick, so memory grows with the rate
+MAX_CONTROL_RATE = 10_000.0
+
+
 @dataclass(frozen=True)
 class SimOptions:
     """Options of :func:`simulate`.
@@ -113,6 +117,8 @@ class SimOptions:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "control_rate", positive("control_rate", self.control_rate))
+        if self.control_rate > MAX_CONTROL_RATE:
+            raise InputError("control_rate", self.control_rate, f"at most {MAX_CONTROL_RATE:g} Hz")
         for name in ("noise_pos", "noise_vel", "placement_error"):
             object.__setattr__(self, name, non_negative(name, getattr(self, name)))
         for name in ("mass_scale", "com_height_scale"):
