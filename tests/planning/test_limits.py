@@ -64,3 +64,17 @@ def test_min_steps_note_says_what_was_proven() -> None:
         and "smallest" not in undecided.split(";")[-1].split(",")[0]
     )
     assert "fewer steps may exist" in undecided
+
+
+def test_a_plan_with_a_nan_footstep_is_refused_at_construction() -> None:
+    from dataclasses import replace
+
+    from footfall.planning import make_plan
+
+    plan = make_plan(builtin_scene("flat"), "kinematic", 8)
+    feet = plan.footsteps.copy()
+    feet[3, 0] = np.nan
+    with pytest.raises(InputError, match=r"plan.footsteps\[3\]"):
+        replace(plan, footsteps=feet)
+    with pytest.raises(InputError, match="plan.headings"):
+        replace(plan, headings=plan.headings[:-1])

@@ -224,6 +224,30 @@ class FootstepPlan:
     swing_max: float | None = None
     heading_segments: int | None = None
 
+    def __post_init__(self) -> None:
+        """Shapes agree and every number that positions the robot is finite: a NaN footstep
+        would otherwise reach the checker, the simulators and the walkers."""
+        feet = np.asarray(self.footsteps, dtype=float)
+        if feet.ndim != 2 or feet.shape[1] != 3:
+            raise InputError("plan.footsteps", f"shape {feet.shape}", "shape (N + 1, 3)")
+        rows = feet.shape[0]
+        headings = np.asarray(self.headings, dtype=float)
+        if headings.shape != (rows,):
+            raise InputError("plan.headings", f"shape {headings.shape}", f"shape ({rows},)")
+        for name, arr in (("footsteps", feet), ("headings", headings)):
+            if not np.all(np.isfinite(arr)):
+                bad = int(np.argwhere(~np.isfinite(arr))[0][0])
+                raise InputError(f"plan.{name}[{bad}]", arr[bad].tolist(), "finite numbers")
+        for name in ("sides", "regions"):
+            if len(getattr(self, name)) != rows:
+                raise InputError(f"plan.{name}", f"{len(getattr(self, name))} entries", f"{rows}")
+        for name in ("states", "torques"):
+            arr = np.asarray(getattr(self, name), dtype=float)
+            if arr.ndim != 3 or arr.shape[0] > max(rows - 1, 0):
+                raise InputError(f"plan.{name}", f"shape {arr.shape}", f"(n <= {rows - 1}, K, .)")
+            if not np.all(np.isfinite(arr)):
+                raise InputError(f"plan.{name}", "a NaN or inf entry", "finite numbers")
+
     @property
     def n_steps(self) -> int:
         """Number of planned footsteps N (0 when there is no solution)."""
