@@ -828,8 +828,9 @@ def walk_cmd(
         # headless offscreen rendering; MuJoCo picks its GL backend when it is first imported
         os.environ.setdefault("MUJOCO_GL", "egl")
     from footfall.planning.plan import check_planner_name
+    from footfall.sim.biped.options import WalkOptions
     from footfall.sim.biped.plans import plan_for_walk, random_push, robot_model
-    from footfall.sim.biped.walk import WalkOptions, walk
+    from footfall.sim.biped.walk import walk
     from footfall.viz.walk_plot import plot_walk
 
     check_planner_name(planner)

@@ -12,25 +12,23 @@ pytest.importorskip("mink")
 
 from typer.testing import CliRunner  # noqa: E402
 
+from footfall._geometry import inset_polygon  # noqa: E402
 from footfall.cli import app  # noqa: E402
+from footfall.control.adjusters import (  # noqa: E402
+    MPCAdjuster,
+    PlanFollower,
+    project_to_polygon,
+    sole_torque_limits,
+)
 from footfall.errors import FootfallError, InputError  # noqa: E402
 from footfall.models.biped import Side  # noqa: E402
 from footfall.planning import make_plan  # noqa: E402
 from footfall.sim.biped.model import planner_params  # noqa: E402
-from footfall.sim.biped.walk import (  # noqa: E402
-    BipedSim,
-    MPCAdjuster,
-    PlanFollower,
-    Push,
-    WalkOptions,
-    _ds_propagator,
-    ankle_joint_torque,
-    inset_polygon,
-    project_to_polygon,
-    sole_cop,
-    sole_torque_limits,
-    walk,
-)
+from footfall.sim.biped.options import WalkOptions  # noqa: E402
+from footfall.sim.biped.plant import BipedSim, ankle_joint_torque, sole_cop  # noqa: E402
+from footfall.sim.biped.references import ds_propagator  # noqa: E402
+from footfall.sim.biped.walk import walk  # noqa: E402
+from footfall.sim.pushes import Push  # noqa: E402
 from footfall.terrain import Goal, Region, builtin_scene  # noqa: E402
 
 #: exact arithmetic of the CoP formula
@@ -306,7 +304,7 @@ def test_stop_target_leaves_the_capture_point_midway(short_walk) -> None:  # typ
     a, b = alip.discretize(robot.t_ss - t)
     x = a @ state + b @ u
     step = round(robot.t_ds / 1e-3)
-    ds = _ds_propagator(alip, robot.t_ds / step)
+    ds = ds_propagator(alip, robot.t_ds / step)
     aug = np.concatenate([x, np.zeros(3), np.array([d[0], d[1], 0.0]) / robot.t_ds])
     for _ in range(step):
         aug = ds @ aug
@@ -391,8 +389,8 @@ def test_plan_for_walk_plans_on_the_riser_inset_regions(monkeypatch: pytest.Monk
     # the planner sees stairs_slope_gap's treads below a riser moved in by the landing tolerance
     # at that edge only, and keeps its uniform half-sole region margin (the planner is unchanged)
     import footfall.planning.cache as run
+    from footfall.sim.biped.options import RISER_LANDING_TOLERANCE
     from footfall.sim.biped.plans import plan_for_walk
-    from footfall.sim.biped.walk import RISER_LANDING_TOLERANCE
 
     seen = {}
 

@@ -33,7 +33,7 @@ from footfall.sim.biped import names as nm  # noqa: E402
 from footfall.sim.biped.g1 import G1Model, g1_urdf_path, urdf_joint  # noqa: E402
 from footfall.sim.biped.model import measure_model, planner_params  # noqa: E402
 from footfall.sim.biped.plans import robot_model  # noqa: E402
-from footfall.sim.biped.walk import BipedSim, ankle_joint_torque  # noqa: E402
+from footfall.sim.biped.plant import BipedSim, ankle_joint_torque  # noqa: E402
 from footfall.terrain import builtin_scene  # noqa: E402
 
 pytestmark = pytest.mark.robots

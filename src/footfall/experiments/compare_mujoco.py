@@ -17,8 +17,10 @@ from typing import Any
 import numpy as np
 
 from footfall.errors import InputError
+from footfall.sim.biped.options import WalkOptions
 from footfall.sim.biped.plans import plan_for_walk, random_push
-from footfall.sim.biped.walk import WalkOptions, WalkResult, walk
+from footfall.sim.biped.result import WalkResult
+from footfall.sim.biped.walk import walk
 from footfall.terrain.scene import Scene, builtin_scene
 from footfall.viz.compare_plots import plot_mujoco_table
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from footfall.sim.biped.model import BipedModel
-from footfall.sim.biped.walk import WalkResult
+from footfall.sim.biped.result import WalkResult
 from footfall.terrain.scene import Scene
 
 

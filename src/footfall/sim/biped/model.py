@@ -25,14 +25,12 @@ import numpy as np
 
 from footfall._typing import FloatArray
 from footfall._validate import non_negative, positive
+from footfall.control.adjusters import U_MAX_FOOT_SHARE
 from footfall.errors import FootfallError, InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.sim._mjcf import SimSettings, box_inertia, fmt, rod_inertia
 from footfall.sim.biped import names as nm
 
-#: share of the half foot width the planner's ankle-torque bound may use: U_max = share * m g * w/2
-#: keeps the planned ZMP (eq. 5.12d) inside the sole in every direction, with a margin
-U_MAX_FOOT_SHARE = 0.8
 #: the planner's swing bound L_swing for this biped [m] (``PlannerOptions.swing_max``, beyond the
 #: document; :func:`footfall.experiments.compare_mujoco.plan_for_walk` uses it): the longest swing this
 #: biped has walked. Measured (walker of 6f8c4b6, plans with ``reach_both_frames``): the swings

@@ -1,0 +1,59 @@
+"""What a simulated walk of the MuJoCo biped measured (:func:`footfall.sim.biped.walk.walk`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from footfall._typing import FloatArray
+
+
+@dataclass(frozen=True)
+class WalkResult:
+    """Measurements of one simulated walk (arrays sampled every control tick, T samples).
+
+    Attributes:
+        t: time since the start of the walk, shape (T,) [s].
+        phase: single-support phase index per tick, -1 outside single support, shape (T,).
+        com: measured CoM, shape (T, 3) [m].
+        com_ref: reference CoM sent to the IK, shape (T, 3) [m].
+        zmp_offset: stance-foot CoP relative to the sole centre in the foot frame, shape (T, 2)
+            [m] (NaN outside single support or without contact).
+        zmp_planned: the ZMP offset of the adjuster's commanded torque, shape (T, 2) [m].
+        feet: measured sole centres (left, right), shape (T, 2, 3) [m].
+        landed: measured sole centre after each planned footstep 1..N landed, shape (N, 3) [m]
+            (NaN if never reached).
+        targets: the commanded (corrected) footsteps 1..N, shape (N, 3) [m].
+        planned: the plan's footsteps 1..N, shape (N, 3) [m].
+        n_planned: the plan's N; entries beyond it are stopping steps.
+        fell: whether a fall was detected.
+        fall_time: when [s] (NaN if none).
+        metrics: summary numbers (:func:`summarise`).
+        timing: wall-clock seconds per part: ``control`` (measurement, adjuster, references),
+            ``ik``, ``physics``, ``render``.
+        sim_time: simulated time [s].
+        video: path of the MP4 or None; video_note says why there is none.
+    """
+
+    t: FloatArray
+    phase: NDArray[np.int_]
+    com: FloatArray
+    com_ref: FloatArray
+    zmp_offset: FloatArray
+    zmp_planned: FloatArray
+    feet: FloatArray
+    landed: FloatArray
+    targets: FloatArray
+    planned: FloatArray
+    n_planned: int
+    fell: bool
+    fall_time: float
+    metrics: dict[str, Any]
+    timing: dict[str, float]
+    sim_time: float
+    video: Path | None = None
+    video_note: str = ""
