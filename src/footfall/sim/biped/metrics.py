@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
+from numpy.typing import NDArray
 
 from footfall._typing import FloatArray
 from footfall.planning.plan import FootstepPlan
 from footfall.sim.biped.model import WalkerModel
-from footfall.sim.biped.result import WalkResult
 from footfall.terrain.scene import Scene
 
 #: the CoP counts as "at the edge" of the sole (the foot starts to tip) within this distance [m]
@@ -19,8 +19,38 @@ EDGE_TOL = 0.005
 GOAL_TOL = 0.10
 
 
+class WalkRecord(Protocol):
+    """The measurements :func:`summarise` reads (those of
+    :class:`~footfall.sim.biped.result.WalkResult`, whose docstring gives shapes and units)."""
+
+    @property
+    def phase(self) -> NDArray[np.int_]: ...
+    @property
+    def zmp_offset(self) -> FloatArray: ...
+    @property
+    def zmp_planned(self) -> FloatArray: ...
+    @property
+    def feet(self) -> FloatArray: ...
+    @property
+    def landed(self) -> FloatArray: ...
+    @property
+    def targets(self) -> FloatArray: ...
+    @property
+    def planned(self) -> FloatArray: ...
+    @property
+    def n_planned(self) -> int: ...
+    @property
+    def fell(self) -> bool: ...
+    @property
+    def fall_time(self) -> float: ...
+    @property
+    def sim_time(self) -> float: ...
+    @property
+    def timing(self) -> dict[str, float]: ...
+
+
 def summarise(
-    res: WalkResult, scene: Scene, plan: FootstepPlan, params: WalkerModel, t_steps_end: float
+    res: WalkRecord, scene: Scene, plan: FootstepPlan, params: WalkerModel, t_steps_end: float
 ) -> dict[str, Any]:
     """Summary metrics of a walk.
 

@@ -1,19 +1,29 @@
-"""Options of the MuJoCo biped's walking controller (:mod:`footfall.sim.biped.walk`)."""
+"""Options of the MuJoCo biped's walking controller (:mod:`footfall.sim.biped.walk`) and the checks
+of what it is asked to walk."""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from footfall._validate import non_negative, positive
 from footfall.control.adjusters import STOP_STEPS
 from footfall.errors import InputError
+from footfall.models.biped import BipedParams
+from footfall.planning.plan import FootstepPlan
+from footfall.sim.biped.model import BipedModel, WalkerModel, measure_model
 from footfall.sim.pushes import Push
+from footfall.terrain.scene import Scene
 
 #: landing error [m] the walk leaves room for at riser edges (:mod:`footfall.terrain.edges`):
 #: landings fall 2-4 cm short of their targets, and on stairs_slope_gap a heel that landed on the
 #: edge of the tread above (step down from ``top``, footstep 0.10 m from the riser) tipped the foot
 RISER_LANDING_TOLERANCE = 0.04
+#: a plan's robot mass and CoM height may differ this much (relative) from the walker model's
+#: (:func:`~footfall.sim.biped.model.planner_params` measures them: 0.0 exactly)
+PLAN_ROBOT_RTOL = 0.01
 
 
 @dataclass(frozen=True)
@@ -143,3 +153,39 @@ class WalkOptions:
             if not isinstance(p, Push):
                 raise InputError(f"pushes[{i}]", p, "a Push")
         object.__setattr__(self, "pushes", pushes)
+
+
+def _check_plan_robot(robot: BipedParams, model: WalkerModel | None) -> None:
+    """Raise :class:`InputError` when the plan's robot is not the walker model's pendulum (mass
+    and CoM height within ``PLAN_ROBOT_RTOL``, see :func:`planner_params`)."""
+    info = measure_model(model)
+    name = (model if model is not None else BipedModel()).name
+    for field_name, planned, actual, unit in (
+        ("mass", robot.mass, info.mass, "kg"),
+        ("com_height", robot.com_height, info.com_height, "m"),
+    ):
+        if abs(planned - actual) > PLAN_ROBOT_RTOL * abs(actual):
+            raise InputError(
+                f"plan.robot.{field_name}",
+                planned,
+                f"the {name} model's {actual:.4g} {unit} within {PLAN_ROBOT_RTOL:.0%}: plan with "
+                "footfall.sim.biped.model.planner_params(model) as the robot, or walk a "
+                "mismatched plan on purpose with WalkOptions(check_robot=False)",
+            )
+
+
+def check_walk_inputs(
+    scene: Scene, plan: FootstepPlan, opts: WalkOptions, model: WalkerModel | None
+) -> None:
+    """Raise :class:`InputError` for a plan this walk cannot follow (see :func:`walk`)."""
+    if not plan.has_solution or plan.n_steps < 1:
+        raise InputError("plan", plan.status.value, "a plan with at least one footstep")
+    start_stance = scene.start.stance_foot
+    if np.linalg.norm(plan.footsteps[0] - start_stance) > 1e-6:
+        raise InputError(
+            "plan.footsteps[0]",
+            plan.footsteps[0].tolist(),
+            f"the scene's start stance foot {start_stance.tolist()}",
+        )
+    if opts.check_robot:
+        _check_plan_robot(plan.robot, model)

@@ -28,9 +28,9 @@ import math
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from footfall._typing import FloatArray
 from footfall.control.adjusters import (
@@ -40,16 +40,14 @@ from footfall.control.adjusters import (
     sole_torque_limits,
 )
 from footfall.errors import InputError
-from footfall.models.biped import BipedParams, Side
+from footfall.models.biped import Side
 from footfall.planning.plan import FootstepPlan
-from footfall.sim.biped import names as nm
 from footfall.sim.biped.ik import WholeBodyIK
 from footfall.sim.biped.metrics import summarise
-from footfall.sim.biped.model import BipedModel, BipedSimSettings, WalkerModel, measure_model
-from footfall.sim.biped.options import WalkOptions
+from footfall.sim.biped.model import BipedSimSettings, WalkerModel
+from footfall.sim.biped.options import WalkOptions, check_walk_inputs
 from footfall.sim.biped.plant import BipedSim, ankle_joint_torque, sole_cop
 from footfall.sim.biped.references import (
-    SWING_SHARES,
     CoMHeight,
     blend_rot,
     ds_propagator,
@@ -61,6 +59,17 @@ from footfall.sim.biped.references import (
     terrain_height_along,
 )
 from footfall.sim.biped.result import WalkResult
+from footfall.sim.biped.state import (
+    ActuationState,
+    Command,
+    FeetState,
+    Observation,
+    ReferenceState,
+    SolePoses,
+    SwingState,
+    Video,
+    WalkLog,
+)
 from footfall.terrain.edges import inset_riser_edges
 from footfall.terrain.scene import Scene
 
@@ -71,30 +80,480 @@ CONTACT_FORCE_SHARE = 0.02
 FALL_HEIGHT_SHARE = 0.6
 #: ... or the torso tilts more than this [rad], or the pelvis or torso touches the terrain
 FALL_TILT = math.radians(40.0)
-#: video frame rate [1/s]
-VIDEO_FPS = 30
-#: a plan's robot mass and CoM height may differ this much (relative) from the walker model's
-#: (:func:`~footfall.sim.biped.model.planner_params` measures them: 0.0 exactly)
-PLAN_ROBOT_RTOL = 0.01
 
 
-def _check_plan_robot(robot: BipedParams, model: WalkerModel | None) -> None:
-    """Raise :class:`InputError` when the plan's robot is not the walker model's pendulum (mass
-    and CoM height within ``PLAN_ROBOT_RTOL``, see :func:`planner_params`)."""
-    info = measure_model(model)
-    name = (model if model is not None else BipedModel()).name
-    for field_name, planned, actual, unit in (
-        ("mass", robot.mass, info.mass, "kg"),
-        ("com_height", robot.com_height, info.com_height, "m"),
-    ):
-        if abs(planned - actual) > PLAN_ROBOT_RTOL * abs(actual):
+class BipedWalk:
+    """One simulated walk of a plan: setup, then one :meth:`step` per control tick.
+
+    A tick is :meth:`_observe` (CoM state, soles, contacts), :meth:`_schedule` (the phase of the
+    walk and its references: shift, single / double support, stop), :meth:`_measure` (the stance
+    foot's CoP), :meth:`_detect_fall`, :meth:`_whole_body` (ankle commands and IK) and
+    :meth:`_physics`; :meth:`run` loops and returns the :class:`WalkResult`. Loop-carried state
+    lives in the small objects of :mod:`footfall.sim.biped.state`.
+    """
+
+    def __init__(
+        self,
+        scene: Scene,
+        plan: FootstepPlan,
+        opts: WalkOptions,
+        adjuster: FootstepAdjuster | None = None,
+        model_params: WalkerModel | None = None,
+        settings: BipedSimSettings | None = None,
+    ) -> None:
+        self.scene, self.opts = scene, opts
+        self.sim = sim = BipedSim(scene, model_params, settings)
+        step = sim.model.opt.timestep
+        self.substeps = round(opts.control_dt / step)
+        if self.substeps < 1 or abs(self.substeps * step - opts.control_dt) > 1e-9:
             raise InputError(
-                f"plan.robot.{field_name}",
-                planned,
-                f"the {name} model's {actual:.4g} {unit} within {PLAN_ROBOT_RTOL:.0%}: plan with "
-                "footfall.sim.biped.model.planner_params(model) as the robot, or walk a "
-                "mismatched plan on purpose with WalkOptions(check_robot=False)",
+                "control_dt", opts.control_dt, f"a multiple of the physics step {step}"
             )
+        self.dt = opts.control_dt
+        self.src = adjuster if adjuster is not None else self._default_adjuster(plan)
+        self.n_planned = plan.n_steps
+        self.plan = extend_plan(plan, opts.stop_steps)
+        self.robot = robot = plan.robot
+        self.alip = robot.alip()
+        self.ad_tick, self.bd_tick = self.alip.discretize(self.dt)
+        self.ds_map = ds_propagator(self.alip, self.dt)
+        self.n = self.plan.n_steps
+        self.t_ss, self.t_ds = robot.t_ss, robot.t_ds
+        self.t_step = self.t_ss + self.t_ds
+        self.t_walk0 = opts.settle_time + opts.shift_time
+        self.t_end_steps = self.t_walk0 + self.n * self.t_step
+        self.n_ticks = round((self.t_end_steps + opts.stop_time + opts.hold_time) / self.dt)
+        self._init_state()
+
+    def _default_adjuster(self, plan: FootstepPlan) -> MPCAdjuster:
+        """The MPC of eq. (5.19) on the regions with their riser edges moved in."""
+        opts = self.opts
+        terrain = self.scene.terrain
+        regions = {r.name: r for r in terrain.regions}
+        inner = inset_riser_edges(terrain, opts.riser_tolerance) if opts.riser_tolerance else None
+        return MPCAdjuster(
+            plan,
+            {r.name: r for r in inner.regions} if inner is not None else regions,
+            region_margin=plan.region_margin + opts.landing_margin,
+            control_dt=self.dt,
+            stop_steps=opts.stop_steps,
+            torque_limits=sole_torque_limits(plan.robot),
+        )
+
+    def _init_state(self) -> None:
+        """Stand the robot at the start and set up the loop-carried state."""
+        sim, scene, plan = self.sim, self.scene, self.plan
+        start = scene.start
+        sim.set_standing(start.left, start.right, start.heading)
+        self.ik = WholeBodyIK(sim)
+        # the IK's nominal CoM offset: the standing CoM is where the model puts it, not at mid-feet
+        self.com0, _, _ = sim.com_state()
+        regions = {r.name: r for r in scene.terrain.regions}
+        start_region = scene.start_regions()
+        self.feet = FeetState(
+            pos={s: np.array(start.foot(s)) for s in sim.sides},
+            rot={
+                s: foot_rotation(regions[start_region[s]].normal, start.heading) for s in sim.sides
+            },
+        )
+        self.normals = [regions[name].normal for name in plan.regions]
+        self.log = WalkLog.empty(self.n_ticks, self.dt, plan, self.n_planned)
+        stance = plan.sides[0]
+        self.swing = SwingState(
+            stance=stance,
+            start=self.feet.pos[stance.other].copy(),
+            rot0=self.feet.rot[stance.other].copy(),
+        )
+        self.ref = ReferenceState(prev_stance=np.array(start.stance_foot))
+        # CoM height over the footsteps (constraint planes of the 3-D LIPM); standing: over the feet
+        self.height = CoMHeight(plan.footsteps, self.robot.com_height)
+        self.z_stand = 0.5 * (start.left[2] + start.right[2]) + self.robot.com_height
+        ctrl = np.array(sim.data.ctrl[sim.actuators], dtype=float)
+        self.act = ActuationState(
+            ankle_mode={sd: False for sd in sim.sides},
+            ctrl_prev=ctrl,
+            pos_prev=np.zeros(ctrl.shape[0], dtype=bool),  # nothing to ramp from at the start
+        )
+
+    # ------------------------------------------------------------------------------- loop
+    def run(
+        self,
+        video_path: Path | None = None,
+        video_size: tuple[int, int] = (640, 480),
+        progress: Callable[[float], None] | None = None,
+    ) -> WalkResult:
+        """Walk until the end of the hold (or a fall with ``stop_on_fall``) and measure it."""
+        sim = self.sim
+        self.video = Video(sim.mujoco, sim.model, video_path, video_size, self.dt)
+        wall0 = time.perf_counter()
+        k = 0
+        for k in range(self.n_ticks):
+            if not self.step(k):
+                break
+            if progress is not None and k % 100 == 0:
+                progress(k / self.n_ticks)
+        wall = time.perf_counter() - wall0
+        self.video.close()
+        return self._result(k + 1, wall, video_path)
+
+    def step(self, k: int) -> bool:
+        """Control tick ``k``; False when the walk ends at it (a fall with ``stop_on_fall``)."""
+        timing = self.log.timing
+        t = float(self.log.t[k])
+        c0 = time.perf_counter()
+        obs = self._observe(k)
+        cmd = self._schedule(k, t, obs)
+        self._measure(k, cmd, obs)
+        if self._detect_fall(t, cmd, obs) and self.opts.stop_on_fall:
+            timing["control"] += time.perf_counter() - c0
+            return False
+        c1 = time.perf_counter()
+        timing["control"] += c1 - c0
+        ctrl, servoed = self._whole_body(cmd, obs)
+        c2 = time.perf_counter()
+        timing["ik"] += c2 - c1
+        self._physics(t, ctrl, servoed)
+        c3 = time.perf_counter()
+        timing["physics"] += c3 - c2
+        if self.video.frame(k, self.sim.data):
+            timing["render"] += time.perf_counter() - c3
+        return True
+
+    def _observe(self, k: int) -> Observation:
+        """Measure the CoM state, log it and the soles, and read the contacts."""
+        sim, log = self.sim, self.log
+        com, vel, l_g = sim.com_state()
+        log.com[k] = com
+        log.feet[k, 0] = sim.sole(Side.LEFT)[0]
+        log.feet[k, 1] = sim.sole(Side.RIGHT)[0]
+        contacts, body_hit = sim.contacts()
+        return Observation(com, vel, l_g, contacts, body_hit)
+
+    # --------------------------------------------------------------------------- schedule
+    def _schedule(self, k: int, t: float, obs: Observation) -> Command:
+        """References of tick ``k``: the shift over the first stance foot, the steps, the stop."""
+        c_next = obs.com[:2] + obs.vel[:2] * self.dt  # where the CoM is when the references apply
+        if t < self.t_walk0:
+            return self._shift(t)
+        if t < self.t_end_steps:
+            return self._stepping(k, t, obs, c_next)
+        return self._stop(t, c_next)
+
+    def _standing_feet(self) -> SolePoses:
+        return {sd: (self.feet.pos[sd], self.feet.rot[sd]) for sd in self.sim.sides}
+
+    def _shift(self, t: float) -> Command:
+        """Settle, then move the CoM over the first stance foot (the plan starts there at rest)."""
+        opts, start = self.opts, self.scene.start
+        mid = 0.5 * (start.left + start.right)
+        s = smoothstep((t - opts.settle_time) / opts.shift_time)
+        target_xy = mid[:2] + (start.stance_foot[:2] - mid[:2]) * s
+        z_ref = self.z_stand + (self.height(0, target_xy) - self.z_stand) * s
+        com_ref = np.array([target_xy[0], target_xy[1], z_ref])
+        # the standing CoM sits forward of the feet midpoint by the model's offset; keep it
+        com_ref[:2] += (self.com0[:2] - mid[:2]) * (1.0 - s)
+        return Command(com_ref, self._standing_feet(), start.heading)
+
+    def _stepping(self, k: int, t: float, obs: Observation, c_next: FloatArray) -> Command:
+        """Step i of the plan: single support (adjuster, ALIP reference, swing), then double."""
+        tw = t - self.t_walk0
+        i = min(int(tw / self.t_step), self.n - 1)
+        tp = tw - i * self.t_step
+        if i != self.swing.phase:
+            self._begin_step(i)
+        stance = self.feet.pos[self.swing.stance]
+        single = tp < self.t_ss
+        if single:
+            self.log.phase[k] = i
+            ref_xy, feet, yaw = self._single_support(k, i, tp, stance, obs)
+        else:
+            ref_xy, feet, yaw = self._double_support(i, stance)
+        support = i if single else i + 1
+        com_ref = np.array([ref_xy[0], ref_xy[1], self.height(support, c_next)])
+        if k + 1 < self.n_ticks and t + self.dt >= self.t_end_steps - 1e-9:
+            # the stop starts from the measured CoM motion: the reference may have drifted
+            self.ref.stop_from = obs.com[:2].copy()
+            self.ref.stop_vel = obs.vel[:2].copy()
+        return Command(com_ref, feet, yaw, walking=True, phase=i, tp=tp, single=single)
+
+    def _begin_step(self, i: int) -> None:
+        """A new single support: the foot that just landed is the stance foot; plan the swing."""
+        sim, plan, feet, ref, swing = self.sim, self.plan, self.feet, self.ref, self.swing
+        if swing.phase >= 0:
+            sd_landed = plan.sides[i]
+            feet.pos[sd_landed] = sim.sole(sd_landed)[0]
+            self.log.landed[i - 1] = feet.pos[sd_landed]
+            # re-express the reference relative to the new stance (eq. 5.10's -I block)
+            ref.x = ref.ds_aug[:4].copy()
+            ref.x[:2] -= (feet.pos[sd_landed] - ref.prev_stance)[:2]
+        swing.phase = i
+        swing.stance = plan.sides[i]
+        swing_side = swing.stance.other
+        swing.start = sim.sole(swing_side)[0]
+        swing.rot0 = feet.rot[swing_side]
+        target = plan.footsteps[i + 1]
+        half = (self.robot.foot_length / 2, self.robot.foot_width / 2)
+        apex = terrain_height_along(self.scene.terrain.regions, swing.start, target, *half)
+        swing.apex = apex + self.opts.swing_clearance
+        swing.rise, swing.descend = swing_shares(
+            swing.apex - float(swing.start[2]), swing.apex - float(target[2]), self.t_ss
+        )
+
+    def _single_support(
+        self, k: int, i: int, tp: float, stance: FloatArray, obs: Observation
+    ) -> tuple[FloatArray, SolePoses, float]:
+        """Ask the adjuster, advance the ALIP reference (eq. 5.5), place the swing sole.
+
+        Returns the reference CoM (2,) [m], the sole targets and the torso yaw [rad].
+        """
+        opts, alip, ref = self.opts, self.alip, self.ref
+        # measured ALIP state about the stance sole centre (eq. 5.1)
+        r = obs.com - stance
+        x_cv = alip.state_from_velocity(r[:2], obs.vel[:2])
+        if opts.true_momentum:
+            l_c = obs.l_g + self.sim.mass * np.cross(r, obs.vel)
+            x_meas = np.array([r[0], r[1], l_c[0], l_c[1]])
+        else:
+            x_meas = x_cv
+        nxt, u = self.src.update(tp, x_meas, stance, i)
+        self.log.targets[i] = nxt
+        self.log.zmp_planned[k] = alip.zmp(np.zeros(2), u)
+        fb = 1.0 if opts.ankle_torque else opts.com_feedback
+        # the kinematic reference follows the CoM's own velocity: the true momentum also holds
+        # the swing leg's and torso's (L_G), which the CoM does not move with
+        ref.x = ref.x + fb * (x_cv - ref.x)
+        self.act.ankle_u = u
+        ref.x = self.ad_tick @ ref.x + self.bd_tick @ u
+        feet, yaw = self._swing_targets(i, tp, stance, nxt)
+        ref_xy = stance[:2] + ref.x[:2]
+        # the contact point moves from the stance foot to the landing target during DS
+        ref.prev_stance = stance.copy()
+        ref.ds_aug = np.concatenate(
+            [ref.x, np.zeros(3), (self.log.targets[i] - stance) / self.t_ds]
+        )
+        return ref_xy, feet, yaw
+
+    def _swing_targets(
+        self, i: int, tp: float, stance: FloatArray, nxt: FloatArray
+    ) -> tuple[SolePoses, float]:
+        """Sole targets (stance where it stands, swing on its path to ``nxt``) and torso yaw."""
+        opts, plan, swing, feet = self.opts, self.plan, self.swing, self.feet
+        stance_side = swing.stance
+        swing_side = stance_side.other
+        tau = min(1.0, (tp + self.dt) / self.t_ss)
+        gap = self.robot.foot_width + opts.swing_side_gap if opts.swing_side_gap > 0 else 0.0
+        pos, s_h = swing_reference(
+            tau, swing.start, nxt, swing.apex, swing.rise, swing.descend, stance, gap
+        )
+        rot1 = foot_rotation(self.normals[i + 1], plan.headings[i + 1])
+        rot = blend_rot(swing.rot0, rot1 @ pitch_about_y(-opts.heel_strike), s_h)
+        targets = {stance_side: (stance, feet.rot[stance_side]), swing_side: (pos, rot)}
+        yaw = float(plan.headings[i] + (plan.headings[i + 1] - plan.headings[i]) * 0.5 * s_h)
+        if tp + self.dt >= self.t_ss - 1e-9:
+            feet.rot[swing_side] = rot1
+        return targets, yaw
+
+    def _double_support(self, i: int, stance: FloatArray) -> tuple[FloatArray, SolePoses, float]:
+        """The contact point ramps to the new foot (eq. 5.8); both soles stay where they are."""
+        ref, feet = self.ref, self.feet
+        ref.ds_aug = self.ds_map @ ref.ds_aug
+        ref.x = ref.ds_aug[:4]
+        ref_xy = ref.prev_stance[:2] + ref.x[:2]
+        stance_side = self.swing.stance
+        swing_side = stance_side.other
+        targets = {
+            stance_side: (stance, feet.rot[stance_side]),
+            swing_side: (self.log.targets[i], feet.rot[swing_side]),
+        }
+        yaw = float(0.5 * (self.plan.headings[i] + self.plan.headings[i + 1]))
+        return ref_xy, targets, yaw
+
+    def _stop(self, t: float, c_next: FloatArray) -> Command:
+        """After the last step: a cubic Hermite from the measured CoM motion (position, velocity)
+        to the middle of the final feet at rest."""
+        n, feet, log = self.n, self.feet, self.log
+        if math.isnan(log.landed[n - 1, 0]) and self.swing.phase < n:
+            sd_landed = self.plan.sides[n]
+            feet.pos[sd_landed] = self.sim.sole(sd_landed)[0]
+            log.landed[n - 1] = feet.pos[sd_landed]
+            self.swing.phase = n
+        mid = 0.5 * (feet.pos[Side.LEFT] + feet.pos[Side.RIGHT])
+        stop_time = self.opts.stop_time
+        s = min(1.0, (t + self.dt - self.t_end_steps) / stop_time)
+        h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+        h01 = -2 * s**3 + 3 * s**2
+        xy = h00 * self.ref.stop_from + h10 * stop_time * self.ref.stop_vel + h01 * mid[:2]
+        com_ref = np.array([xy[0], xy[1], self.height(n, c_next)])
+        return Command(com_ref, self._standing_feet(), float(self.plan.headings[n]))
+
+    # ------------------------------------------------------------------ measure, fall
+    def _loaded_cop(self, side: Side, obs: Observation) -> FloatArray | None:
+        """CoP offset (2,) [m] of the ``side`` sole if it carries ``CONTACT_FORCE_SHARE`` of the
+        weight, else None."""
+        pos, rot = self.sim.sole(side)
+        cop = sole_cop(*obs.contacts[side], pos, rot)
+        if cop is not None and cop[1] > CONTACT_FORCE_SHARE * self.sim.weight:
+            return cop[0]
+        return None
+
+    def _measure(self, k: int, cmd: Command, obs: Observation) -> None:
+        """Log the single-support stance-foot CoP (the measured ZMP) and the CoM reference."""
+        if cmd.single:
+            cop = self._loaded_cop(self.swing.stance, obs)
+            if cop is not None:
+                self.log.zmp_offset[k] = cop
+        self.log.com_ref[k] = cmd.com_ref
+
+    def _detect_fall(self, t: float, cmd: Command, obs: Observation) -> bool:
+        """Whether the robot falls at ``t`` (first detection only): the pelvis below
+        ``FALL_HEIGHT_SHARE`` of its height above the stance sole, the torso tilted beyond
+        ``FALL_TILT``, or the pelvis or torso on the terrain."""
+        sim, pos = self.sim, self.feet.pos
+        if cmd.single:
+            stance_z = pos[self.swing.stance][2]
+        else:
+            stance_z = max(pos[Side.LEFT][2], pos[Side.RIGHT][2])
+        pelvis_z = float(sim.data.xpos[sim.pelvis][2]) - float(stance_z)
+        up = sim.data.xmat[sim.torso].reshape(3, 3)[:, 2]
+        tilt = math.acos(max(-1.0, min(1.0, float(up[2]))))
+        low = pelvis_z < FALL_HEIGHT_SHARE * sim.params.pelvis_height
+        if self.log.fell or not (obs.body_hit or tilt > FALL_TILT or low):
+            return False
+        self.log.fell, self.log.fall_time = True, t
+        return True
+
+    # ------------------------------------------------------------------------ whole body
+    def _ankle_commands(self, cmd: Command, obs: Observation) -> dict[Side, FloatArray | None]:
+        """Per side, the ALIP torque (2,) [N m] of a torque-driven ankle; None: position servo."""
+        opts, act = self.opts, self.act
+        stance_side = self.swing.stance
+        swing_side = stance_side.other
+        ankle: dict[Side, FloatArray | None] = {sd: None for sd in self.sim.sides}
+        if opts.ankle_torque and cmd.single:
+            ankle[stance_side] = act.ankle_u
+            i = cmd.phase
+            late = cmd.tp >= self.swing.descend * self.t_ss
+            if opts.passive_landing and act.landed_in != i and late:
+                if self._loaded_cop(swing_side, obs) is not None:
+                    act.landed_in = i
+            if act.landed_in == i:
+                # the swing sole touched down: a limp ankle lets it settle flat (see options)
+                ankle[swing_side] = np.zeros(2)
+        elif opts.ankle_torque and cmd.walking:
+            # double support: the legs form a closed chain whose joint servos place the CoM and
+            # the total CoP moves between the feet, where the contact-point ramp of eq. (5.8)
+            # puts it. The landing ankle is passive; the rear ankle's torque ramps from its last
+            # single-support command to zero over T_ds (dropping it at once made the rear foot
+            # pivot and lift as the weight left it).
+            ankle = {sd: np.zeros(2) for sd in self.sim.sides}
+            if cmd.tp >= self.t_ss:
+                ankle[stance_side] = max(0.0, 1.0 - (cmd.tp - self.t_ss) / self.t_ds) * act.ankle_u
+        return ankle
+
+    def _whole_body(self, cmd: Command, obs: Observation) -> tuple[FloatArray, NDArray[np.bool_]]:
+        """Actuator commands (12,) (set points [rad], ankle torques [N m]) and which actuators
+        are position servoed."""
+        opts, sim = self.opts, self.sim
+        stance_side = self.swing.stance
+        com_cmd = cmd.com_ref.copy()
+        ankle = self._ankle_commands(cmd, obs)
+        if ankle[stance_side] is None or not cmd.single:
+            com_cmd[:2] += opts.com_gain * (cmd.com_ref[:2] - obs.com[:2])
+        if opts.closed_loop_ik:
+            torque_ss = ankle[stance_side] is not None and cmd.single
+            if torque_ss:
+                # the torque-driven stance sole is where it is: pin it at its measured pose
+                cmd.feet[stance_side] = sim.sole(stance_side)
+            # a torque-driven stance ankle is not servoed: the IK must leave it where it is (in
+            # double support the passive ankles move with the closed chain of the two legs)
+            q_des = self.ik.solve(
+                cmd.feet,
+                com_cmd,
+                cmd.yaw,
+                self.dt,
+                opts.ik_iterations,
+                q_meas=sim.data.qpos,
+                com_axes=(not torque_ss, not torque_ss, True),
+                hold=sim.ankle_actuators(stance_side) if torque_ss else None,
+            )
+        else:
+            q_des = self.ik.solve(cmd.feet, com_cmd, cmd.yaw, self.dt, opts.ik_iterations)
+        return self._actuator_commands(q_des, ankle, obs)
+
+    def _actuator_commands(
+        self, q_des: FloatArray, ankle: dict[Side, FloatArray | None], obs: Observation
+    ) -> tuple[FloatArray, NDArray[np.bool_]]:
+        """Switch ankle modes and put the ankle joint torques (eq. 5.3) into the set points."""
+        sim, act = self.sim, self.act
+        for sd in sim.sides:
+            u = ankle[sd]
+            if (u is not None) != act.ankle_mode[sd]:
+                sim.set_ankle_torque_mode(sd, u is not None)
+                act.ankle_mode[sd] = u is not None
+            if u is not None:
+                # the CoP bound scales with the normal force the foot carries *now*: during
+                # vertical CoM and swing-leg accelerations it is below the weight, and a torque
+                # sized for the weight would tip the foot onto its edge
+                pos_a, rot_a = sim.sole(sd)
+                cop_a = sole_cop(*obs.contacts[sd], pos_a, rot_a)
+                f_n = min(sim.weight, cop_a[1]) if cop_a is not None else 0.0
+                q_des[sim.ankle_actuators(sd)] = ankle_joint_torque(u, rot_a, f_n, sim.params)
+        ctrl = np.array(q_des, dtype=float)
+        servoed = np.ones(ctrl.shape[0], dtype=bool)
+        for sd in sim.sides:
+            if act.ankle_mode[sd]:
+                servoed[sim.ankle_actuators(sd)] = False
+        return ctrl, servoed
+
+    # --------------------------------------------------------------------------- physics
+    def _physics(self, t: float, ctrl: FloatArray, servoed: NDArray[np.bool_]) -> None:
+        """Apply the pushes and step MuJoCo through one control period.
+
+        Position set points ramp linearly over the physics substeps from the last tick's: a step
+        every 10 ms into 5000 N m/rad servos jolted the stance foot. Torque-driven ankles, and
+        actuators that changed mode this tick, take their new command at once.
+        """
+        sim, act = self.sim, self.act
+        mj, m, d = sim.mujoco, sim.model, sim.data
+        push_force = np.zeros(3)
+        for p in self.opts.pushes:
+            if p.active(t):
+                push_force += p.force
+        d.xfrc_applied[sim.torso, :3] = push_force
+        ramp = servoed & act.pos_prev
+        for j in range(self.substeps):
+            w = (j + 1) / self.substeps
+            d.ctrl[sim.actuators] = np.where(ramp, act.ctrl_prev + w * (ctrl - act.ctrl_prev), ctrl)
+            mj.mj_step(m, d)
+        act.ctrl_prev, act.pos_prev = ctrl, servoed
+
+    # ---------------------------------------------------------------------------- result
+    def _result(self, k_end: int, wall: float, video_path: Path | None) -> WalkResult:
+        """The measurements of the first ``k_end`` ticks and their summary."""
+        self.log.timing["total"] = wall
+        log = self.log.trimmed(k_end, self.dt)
+        t_goal = self.t_walk0 + self.n_planned * self.t_step
+        metrics = summarise(log, self.scene, self.plan, self.sim.params, t_goal)
+        return WalkResult(
+            t=log.t,
+            phase=log.phase,
+            com=log.com,
+            com_ref=log.com_ref,
+            zmp_offset=log.zmp_offset,
+            zmp_planned=log.zmp_planned,
+            feet=log.feet,
+            landed=log.landed,
+            targets=log.targets,
+            planned=log.planned,
+            n_planned=log.n_planned,
+            fell=log.fell,
+            fall_time=log.fall_time,
+            metrics=metrics,
+            timing=log.timing,
+            sim_time=log.sim_time,
+            video=video_path if self.video.writer is not None else None,
+            video_note=self.video.note,
+        )
 
 
 def walk(
@@ -114,7 +573,8 @@ def walk(
         scene: the scene the plan was made for (its terrain becomes MuJoCo geoms).
         plan: a footstep plan with ALIP states and torques (any planner).
         options: controller options.
-        adjuster: footstep / torque source; default :class:`PlanFollower`.
+        adjuster: footstep / torque source; default :class:`MPCAdjuster` (eq. 5.19) on the
+            scene's regions with their riser edges moved in by ``options.riser_tolerance``.
         model_params: the robot (default: our biped, :class:`BipedModel`); any
             :class:`~footfall.sim.biped.model.WalkerModel`, e.g. the G1 of
             :mod:`footfall.sim.biped.g1`. The plan should be made for it
@@ -132,401 +592,6 @@ def walk(
             was made for another robot's mass or CoM height (see ``WalkOptions.check_robot``).
     """
     opts = options if options is not None else WalkOptions()
-    if not plan.has_solution or plan.n_steps < 1:
-        raise InputError("plan", plan.status.value, "a plan with at least one footstep")
-    robot = plan.robot
-    start_stance = scene.start.stance_foot
-    if np.linalg.norm(plan.footsteps[0] - start_stance) > 1e-6:
-        raise InputError(
-            "plan.footsteps[0]",
-            plan.footsteps[0].tolist(),
-            f"the scene's start stance foot {start_stance.tolist()}",
-        )
-    if opts.check_robot:
-        _check_plan_robot(robot, model_params)
-    sim = BipedSim(scene, model_params, settings)
-    mj, m, d = sim.mujoco, sim.model, sim.data
-    substeps = round(opts.control_dt / m.opt.timestep)
-    if substeps < 1 or abs(substeps * m.opt.timestep - opts.control_dt) > 1e-9:
-        raise InputError(
-            "control_dt", opts.control_dt, f"a multiple of the physics step {m.opt.timestep}"
-        )
-    dt = opts.control_dt
-    regions = {r.name: r for r in scene.terrain.regions}
-    inner = inset_riser_edges(scene.terrain, opts.riser_tolerance) if opts.riser_tolerance else None
-    src: FootstepAdjuster = (
-        adjuster
-        if adjuster is not None
-        else MPCAdjuster(
-            plan,
-            {r.name: r for r in inner.regions} if inner is not None else regions,
-            region_margin=plan.region_margin + opts.landing_margin,
-            control_dt=dt,
-            stop_steps=opts.stop_steps,
-            torque_limits=sole_torque_limits(plan.robot),
-        )
-    )
-    n_planned = plan.n_steps
-    plan = extend_plan(plan, opts.stop_steps)
-    alip = robot.alip()
-    ad_tick, bd_tick = alip.discretize(dt)
-    ds_map = ds_propagator(alip, dt)
-    z_h = robot.com_height
-    n = plan.n_steps
-    t_ss, t_ds = robot.t_ss, robot.t_ds
-    t_step = t_ss + t_ds
-
-    sim.set_standing(scene.start.left, scene.start.right, scene.start.heading)
-    ik = WholeBodyIK(sim)
-    # the IK's nominal CoM offset: the standing CoM is where the model puts it, not at mid-feet
-    com0, _, _ = sim.com_state()
-
-    # foot state: where each foot is (measured at its last touchdown) and its planned heading/region
-    foot_pos = {s: np.array(scene.start.foot(s)) for s in sim.sides}
-    start_region = scene.start_regions()
-    foot_rot = {
-        s: foot_rotation(regions[start_region[s]].normal, scene.start.heading) for s in sim.sides
-    }
-    normals = [regions[name].normal for name in plan.regions]
-
-    t_walk0 = opts.settle_time + opts.shift_time
-    t_end_steps = t_walk0 + n * t_step
-    t_total = t_end_steps + opts.stop_time + opts.hold_time
-    n_ticks = round(t_total / dt)
-
-    ts = np.arange(n_ticks, dtype=np.float64) * dt
-    phase_log = np.full(n_ticks, -1, dtype=int)
-    com_log = np.full((n_ticks, 3), np.nan)
-    ref_log = np.full((n_ticks, 3), np.nan)
-    zmp_log = np.full((n_ticks, 2), np.nan)
-    zmp_plan_log = np.full((n_ticks, 2), np.nan)
-    feet_log = np.full((n_ticks, 2, 3), np.nan)
-    landed = np.full((n, 3), np.nan)
-    targets = np.array(plan.footsteps[1:], dtype=float)
-    timing = {"control": 0.0, "ik": 0.0, "physics": 0.0, "render": 0.0}
-
-    renderer: Any = None
-    writer: Any = None
-    video_note = ""
-    if video_path is not None:
-        try:
-            renderer = mj.Renderer(m, height=video_size[1], width=video_size[0])
-        except Exception as exc:  # any GL failure means "no video", never a crash
-            renderer, video_note = (
-                None,
-                f"no offscreen GL ({type(exc).__name__}: {exc}); video skipped",
-            )
-        if renderer is not None:
-            import imageio.v2 as imageio
-
-            video_path.parent.mkdir(parents=True, exist_ok=True)
-            writer = imageio.get_writer(str(video_path), fps=VIDEO_FPS, macro_block_size=8)
-    frame_every = max(1, round(1.0 / (VIDEO_FPS * dt)))
-
-    stance_side = plan.sides[0]
-    x_ref = np.zeros(4)  # ALIP reference relative to the current stance contact point
-    prev_stance = np.array(scene.start.stance_foot)
-    ds_aug = np.zeros(10)
-    swing_start = foot_pos[stance_side.other].copy()
-    swing_rot0 = foot_rot[stance_side.other].copy()
-    apex, rise, descend = 0.0, SWING_SHARES[0], 1.0 - SWING_SHARES[0]
-    cur_phase = -1
-    stop_from = np.zeros(2)
-    stop_vel = np.zeros(2)
-    fell, fall_time = False, math.nan
-    push_force = np.zeros(3)
-
-    # CoM height over the footsteps (constraint planes of the 3-D LIPM); standing: over the feet
-    height = CoMHeight(plan.footsteps, z_h)
-    z_stand = 0.5 * (scene.start.left[2] + scene.start.right[2]) + z_h
-
-    ankle_mode = {sd: False for sd in sim.sides}
-    ctrl_prev = np.array(d.ctrl[sim.actuators], dtype=float)
-    pos_prev = np.zeros(ctrl_prev.shape[0], dtype=bool)  # nothing to ramp from at the start
-    ankle_u = np.zeros(2)
-    landed_in = -1  # the single support in which the swing sole touched down early
-    wall0 = time.perf_counter()
-    for k in range(n_ticks):
-        t = float(ts[k])
-        c0 = time.perf_counter()
-        com, vel, l_g = sim.com_state()
-        com_log[k] = com
-        feet_log[k, 0] = sim.sole(Side.LEFT)[0]
-        feet_log[k, 1] = sim.sole(Side.RIGHT)[0]
-        contacts, body_hit = sim.contacts()
-
-        # ---------------------------------------------------------------- schedule
-        c_next = com[:2] + vel[:2] * dt  # where the CoM will be when the references apply
-        if t < t_walk0:
-            # settle, then move the CoM over the first stance foot (the plan starts there at rest)
-            mid = 0.5 * (scene.start.left + scene.start.right)
-            s = smoothstep((t - opts.settle_time) / opts.shift_time)
-            target_xy = mid[:2] + (start_stance[:2] - mid[:2]) * s
-            z_ref = z_stand + (height(0, target_xy) - z_stand) * s
-            com_ref = np.array([target_xy[0], target_xy[1], z_ref])
-            # the standing CoM sits forward of the feet midpoint by the model's offset; keep it
-            com_ref[:2] += (com0[:2] - mid[:2]) * (1.0 - s)
-            targets_now = {sd: (foot_pos[sd], foot_rot[sd]) for sd in sim.sides}
-            yaw = scene.start.heading
-        elif t < t_end_steps:
-            tw = t - t_walk0
-            i = min(int(tw / t_step), n - 1)
-            tp = tw - i * t_step
-            if i != cur_phase:
-                # a new single support: the foot that just landed is the stance foot
-                if cur_phase >= 0:
-                    sd_landed = plan.sides[i]
-                    foot_pos[sd_landed] = sim.sole(sd_landed)[0]
-                    landed[i - 1] = foot_pos[sd_landed]
-                    # re-express the reference relative to the new stance (eq. 5.10's -I block)
-                    x_ref = ds_aug[:4].copy()
-                    x_ref[:2] -= (foot_pos[sd_landed] - prev_stance)[:2]
-                cur_phase = i
-                stance_side = plan.sides[i]
-                swing_side = stance_side.other
-                swing_start = sim.sole(swing_side)[0]
-                swing_rot0 = foot_rot[swing_side]
-                apex = (
-                    terrain_height_along(
-                        scene.terrain.regions,
-                        swing_start,
-                        plan.footsteps[i + 1],
-                        robot.foot_length / 2,
-                        robot.foot_width / 2,
-                    )
-                    + opts.swing_clearance
-                )
-                rise, descend = swing_shares(
-                    apex - float(swing_start[2]), apex - float(plan.footsteps[i + 1][2]), t_ss
-                )
-            stance = foot_pos[stance_side]
-            swing_side = stance_side.other
-            # measured ALIP state about the stance sole centre (eq. 5.1)
-            r = com - stance
-            l_c = l_g + sim.mass * np.cross(r, vel)
-            x_meas = np.array([r[0], r[1], l_c[0], l_c[1]])
-            if tp < t_ss:
-                phase_log[k] = i
-                nxt, u = src.update(
-                    tp,
-                    x_meas if opts.true_momentum else alip.state_from_velocity(r[:2], vel[:2]),
-                    stance,
-                    i,
-                )
-                targets[i] = nxt
-                zmp_plan_log[k] = alip.zmp(np.zeros(2), u)
-                fb = 1.0 if opts.ankle_torque else opts.com_feedback
-                # the kinematic reference follows the CoM's own velocity: the true momentum also
-                # holds the swing leg's and torso's (L_G), which the CoM does not move with
-                x_cv = alip.state_from_velocity(r[:2], vel[:2])
-                x_ref = x_ref + fb * (x_cv - x_ref)
-                ankle_u = u
-                x_ref = ad_tick @ x_ref + bd_tick @ u
-                tau = min(1.0, (tp + dt) / t_ss)
-                pos, s_h = swing_reference(
-                    tau,
-                    swing_start,
-                    nxt,
-                    apex,
-                    rise,
-                    descend,
-                    stance,
-                    robot.foot_width + opts.swing_side_gap if opts.swing_side_gap > 0 else 0.0,
-                )
-                rot1 = foot_rotation(normals[i + 1], plan.headings[i + 1])
-                rot = blend_rot(swing_rot0, rot1 @ pitch_about_y(-opts.heel_strike), s_h)
-                targets_now = {stance_side: (stance, foot_rot[stance_side]), swing_side: (pos, rot)}
-                yaw = float(
-                    plan.headings[i] + (plan.headings[i + 1] - plan.headings[i]) * 0.5 * s_h
-                )
-                if tp + dt >= t_ss - 1e-9:
-                    foot_rot[swing_side] = rot1
-                ref_xy = stance[:2] + x_ref[:2]
-                # the contact point moves from the stance foot to the landing target during DS
-                prev_stance = stance.copy()
-                ds_aug = np.concatenate([x_ref, np.zeros(3), (targets[i] - stance) / t_ds])
-            else:
-                ds_aug = ds_map @ ds_aug
-                x_ref = ds_aug[:4]
-                ref_xy = prev_stance[:2] + x_ref[:2]
-                targets_now = {
-                    stance_side: (stance, foot_rot[stance_side]),
-                    swing_side: (targets[i], foot_rot[swing_side]),
-                }
-                yaw = float(0.5 * (plan.headings[i] + plan.headings[i + 1]))
-            support = i if tp < t_ss else i + 1
-            com_ref = np.array([ref_xy[0], ref_xy[1], height(support, c_next)])
-            if k + 1 < n_ticks and t + dt >= t_end_steps - 1e-9:
-                # the stop starts from the measured CoM motion: the reference may have drifted
-                stop_from = com[:2].copy()
-                stop_vel = vel[:2].copy()
-        else:
-            if not math.isnan(landed[n - 1, 0]) or cur_phase < n:
-                if math.isnan(landed[n - 1, 0]):
-                    sd_landed = plan.sides[n]
-                    foot_pos[sd_landed] = sim.sole(sd_landed)[0]
-                    landed[n - 1] = foot_pos[sd_landed]
-                    cur_phase = n
-            # stop: cubic Hermite from the last reference (position, velocity) to the middle of
-            # the final feet at rest
-            mid = 0.5 * (foot_pos[Side.LEFT] + foot_pos[Side.RIGHT])
-            s = min(1.0, (t + dt - t_end_steps) / opts.stop_time)
-            h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
-            h01 = -2 * s**3 + 3 * s**2
-            xy = h00 * stop_from + h10 * opts.stop_time * stop_vel + h01 * mid[:2]
-            com_ref = np.array([xy[0], xy[1], height(n, c_next)])
-            targets_now = {sd: (foot_pos[sd], foot_rot[sd]) for sd in sim.sides}
-            yaw = float(plan.headings[n])
-
-        # ---------------------------------------------------------------- measurement: ZMP
-        if phase_log[k] >= 0:
-            pos_s, rot_s = sim.sole(stance_side)
-            pts, frc = contacts[stance_side]
-            cop = sole_cop(pts, frc, pos_s, rot_s)
-            if cop is not None and cop[1] > CONTACT_FORCE_SHARE * sim.weight:
-                zmp_log[k] = cop[0]
-        ref_log[k] = com_ref
-
-        # ---------------------------------------------------------------- fall detection
-        stance_z = (
-            max(foot_pos[Side.LEFT][2], foot_pos[Side.RIGHT][2])
-            if phase_log[k] < 0
-            else foot_pos[stance_side][2]
-        )
-        pelvis_z = float(d.xpos[sim.pelvis][2]) - float(stance_z)
-        up = d.xmat[sim.torso].reshape(3, 3)[:, 2]
-        tilt = math.acos(max(-1.0, min(1.0, float(up[2]))))
-        if not fell and (
-            body_hit or tilt > FALL_TILT or pelvis_z < FALL_HEIGHT_SHARE * sim.params.pelvis_height
-        ):
-            fell, fall_time = True, t
-            if opts.stop_on_fall:
-                timing["control"] += time.perf_counter() - c0
-                break
-        c1 = time.perf_counter()
-        timing["control"] += c1 - c0
-
-        # ---------------------------------------------------------------- whole body
-        com_cmd = com_ref.copy()
-        # which ankles are torque-driven and with what ALIP torque (None = position servo)
-        ankle_cmd: dict[Side, FloatArray | None] = {sd: None for sd in sim.sides}
-        if opts.ankle_torque and phase_log[k] >= 0:
-            ankle_cmd[stance_side] = ankle_u
-            swing_side = stance_side.other
-            if opts.passive_landing and landed_in != i and tp >= descend * t_ss:
-                pos_w, rot_w = sim.sole(swing_side)
-                cop_w = sole_cop(*contacts[swing_side], pos_w, rot_w)
-                if cop_w is not None and cop_w[1] > CONTACT_FORCE_SHARE * sim.weight:
-                    landed_in = i
-            if landed_in == i:
-                # the swing sole touched down: a limp ankle lets it settle flat (see options)
-                ankle_cmd[swing_side] = np.zeros(2)
-        elif opts.ankle_torque and t_walk0 <= t < t_end_steps:
-            # double support: the legs form a closed chain whose joint servos place the CoM and
-            # the total CoP moves between the feet, where the contact-point ramp of eq. (5.8)
-            # puts it. The landing ankle is passive; the rear ankle's torque ramps from its last
-            # single-support command to zero over T_ds. (Dropping it at once made the rear foot
-            # pivot and lift as the weight left it, both feet unloaded for a few ticks: with the
-            # ramp 12 of 12 pushed walks of discrete_steps N = 18 reached the goal, without 10.)
-            ankle_cmd = {sd: np.zeros(2) for sd in sim.sides}
-            if tp >= t_ss:
-                ankle_cmd[stance_side] = max(0.0, 1.0 - (tp - t_ss) / t_ds) * ankle_u
-        if ankle_cmd[stance_side] is None or phase_log[k] < 0:
-            com_cmd[:2] += opts.com_gain * (com_ref[:2] - com[:2])
-        if opts.closed_loop_ik:
-            torque_ss = ankle_cmd[stance_side] is not None and phase_log[k] >= 0
-            if torque_ss:
-                # the torque-driven stance sole is where it is: pin it at its measured pose
-                targets_now[stance_side] = sim.sole(stance_side)
-            # a torque-driven stance ankle is not servoed: the IK must leave it where it is (in
-            # double support the passive ankles move with the closed chain of the two legs)
-            held = [sim.ankle_actuators(stance_side)] if torque_ss else []
-            q_des = ik.solve(
-                targets_now,
-                com_cmd,
-                yaw,
-                dt,
-                opts.ik_iterations,
-                q_meas=d.qpos,
-                com_axes=(not torque_ss, not torque_ss, True),
-                hold=np.concatenate(held) if held else None,
-            )
-        else:
-            q_des = ik.solve(targets_now, com_cmd, yaw, dt, opts.ik_iterations)
-        for sd in sim.sides:
-            cmd = ankle_cmd[sd]
-            if (cmd is not None) != ankle_mode[sd]:
-                sim.set_ankle_torque_mode(sd, cmd is not None)
-                ankle_mode[sd] = cmd is not None
-            if cmd is not None:
-                # the CoP bound scales with the normal force the foot carries *now*: during
-                # vertical CoM and swing-leg accelerations it is below the weight, and a torque
-                # sized for the weight would tip the foot onto its edge
-                pos_a, rot_a = sim.sole(sd)
-                cop_a = sole_cop(*contacts[sd], pos_a, rot_a)
-                f_n = min(sim.weight, cop_a[1]) if cop_a is not None else 0.0
-                q_des[sim.ankle_actuators(sd)] = ankle_joint_torque(cmd, rot_a, f_n, sim.params)
-        # Position set points ramp linearly over the physics substeps from the last tick's: a step
-        # every 10 ms into 5000 N m/rad servos jolted the stance foot (normal force spikes from
-        # 300 to 570 N at every tick); torque-driven ankles, and actuators that changed mode this
-        # tick, take their new command at once.
-        ctrl_new = np.array(q_des, dtype=float)
-        pos_now = np.ones(ctrl_new.shape[0], dtype=bool)
-        for sd in sim.sides:
-            if ankle_mode[sd]:
-                pos_now[sim.ankle_actuators(sd)] = False
-        ramp = pos_now & pos_prev
-        c2 = time.perf_counter()
-        timing["ik"] += c2 - c1
-
-        # ---------------------------------------------------------------- physics
-        push_force[:] = 0.0
-        for p in opts.pushes:
-            if p.active(t):
-                push_force += p.force
-        d.xfrc_applied[sim.torso, :3] = push_force
-        for j in range(substeps):
-            w = (j + 1) / substeps
-            d.ctrl[sim.actuators] = np.where(ramp, ctrl_prev + w * (ctrl_new - ctrl_prev), ctrl_new)
-            mj.mj_step(m, d)
-        ctrl_prev, pos_prev = ctrl_new, pos_now
-        c3 = time.perf_counter()
-        timing["physics"] += c3 - c2
-        if writer is not None and k % frame_every == 0:
-            renderer.update_scene(d, camera=nm.TRACK_CAMERA)
-            writer.append_data(renderer.render())
-            timing["render"] += time.perf_counter() - c3
-        if progress is not None and k % 100 == 0:
-            progress(k / n_ticks)
-    wall = time.perf_counter() - wall0
-    if writer is not None:
-        writer.close()
-    if renderer is not None:
-        renderer.close()
-    k_end = k + 1
-    timing["total"] = wall
-    sim_time = k_end * dt
-    result = WalkResult(
-        t=ts[:k_end],
-        phase=phase_log[:k_end],
-        com=com_log[:k_end],
-        com_ref=ref_log[:k_end],
-        zmp_offset=zmp_log[:k_end],
-        zmp_planned=zmp_plan_log[:k_end],
-        feet=feet_log[:k_end],
-        landed=landed,
-        targets=targets,
-        planned=np.array(plan.footsteps[1:]),
-        n_planned=n_planned,
-        fell=fell,
-        fall_time=fall_time,
-        metrics={},
-        timing=timing,
-        sim_time=sim_time,
-        video=video_path if writer is not None else None,
-        video_note=video_note,
-    )
-    t_goal = t_walk0 + n_planned * t_step
-    metrics = summarise(result, scene, plan, sim.params, t_goal)
-    object.__setattr__(result, "metrics", metrics)
-    return result
+    check_walk_inputs(scene, plan, opts, model_params)
+    walker = BipedWalk(scene, plan, opts, adjuster, model_params, settings)
+    return walker.run(video_path, video_size, progress)
