@@ -875,30 +875,21 @@ def walk_cmd(
             {"start_s": p.start, "duration_s": p.duration, "force_N": p.force.tolist()}
             for p in pushes
         ],
-        "metrics": res.metrics,
-        "timing_s": res.timing,
-        "real_time_factor": res.sim_time / max(res.timing["total"] - res.timing["render"], 1e-9),
-        "footsteps": {
-            "planned": res.planned[: res.n_planned],
-            "commanded": res.targets,
-            "landed": res.landed,
-        },
-        "video": str(res.video) if res.video else None,
-        "video_note": res.video_note,
+        **res.to_dict(),
     }
     write_json(out / "walk.json", _json_clean(payload))
     plot_walk(res, sc, out / "walk.png", title=f"{sc.name}, {planner}, {robot}")
     m = res.metrics
     console.print(
-        f"{sc.name} / {planner} / {robot}: {plan.n_steps} steps, fell={m['fell']}, "
-        f"reached goal={m['reached_goal']}, footstep error mean "
-        f"{m['footstep_error_m']['mean']:.3f} m, ZMP offset mean {m['zmp']['mean']:.3f} m "
-        f"max {m['zmp']['max']:.3f} m"
+        f"{sc.name} / {planner} / {robot}: {plan.n_steps} steps, fell={m.fell}, "
+        f"reached goal={m.reached_goal}, footstep error mean "
+        f"{m.footstep_error_m.mean:.3f} m, ZMP offset mean {m.zmp.mean:.3f} m "
+        f"max {m.zmp.max:.3f} m"
     )
     if res.video_note:
         console.print(res.video_note)
     console.print(f"wrote {out / 'walk.json'}, walk.png" + (", walk.mp4" if res.video else ""))
-    if m["fell"] or not m["reached_goal"]:
+    if m.fell or not m.reached_goal:
         raise typer.Exit(1)
 
 

@@ -102,7 +102,7 @@ def short_walk():  # type: ignore[no-untyped-def]
 def test_short_flat_walk_lands_every_planned_footstep(short_walk) -> None:  # type: ignore[no-untyped-def]
     _, plan, res = short_walk
     m = res.metrics
-    assert m["steps_landed"] == plan.n_steps
+    assert m.steps_landed == plan.n_steps
     # no fall before the last planned footstep is down (the stop afterwards is reported, see
     # the issue 7 note)
     t_last = (
@@ -111,10 +111,10 @@ def test_short_flat_walk_lands_every_planned_footstep(short_walk) -> None:  # ty
         + plan.n_steps * (plan.robot.t_ss + plan.robot.t_ds)
     )
     assert (not res.fell) or res.fall_time >= t_last - 1e-9
-    assert m["footstep_error_vs_target_m"]["mean"] < LANDING_TOL
+    assert m.footstep_error_vs_target_m.mean < LANDING_TOL
     # the single-support CoP is measured and lies inside the sole
-    assert m["zmp"]["samples"] > 0
-    assert m["zmp"]["inside_share"] == 1.0
+    assert m.zmp.samples > 0
+    assert m.zmp.inside_share == 1.0
 
 
 def test_bad_walk_inputs_name_the_field(short_walk) -> None:  # type: ignore[no-untyped-def]
@@ -331,10 +331,10 @@ def test_flat_walk_of_twenty_steps_reaches_the_goal() -> None:
     res = walk(scene, plan)
     m = res.metrics
     assert not res.fell
-    assert m["steps_landed"] == plan.n_steps
-    assert m["reached_goal"]
-    assert m["footstep_error_m"]["mean"] < FLAT20_FOOTSTEP_TOL
-    assert m["zmp"]["inside_share"] == 1.0
+    assert m.steps_landed == plan.n_steps
+    assert m.reached_goal
+    assert m.footstep_error_m.mean < FLAT20_FOOTSTEP_TOL
+    assert m.zmp.inside_share == 1.0
     # the MPC ran at every single-support tick and the measured CoP moved with its torque one
     # for one on average (regression slope; measured 0.85 sagittal, 1.09 lateral). The swing
     # leg's reaction scatters the sagittal CoP around it (RMS 3 cm), hence no tighter bound.
@@ -353,7 +353,7 @@ def test_long_flat_steps_reach_the_goal_with_a_limp_landing_ankle() -> None:
     assert np.linalg.norm(np.diff(plan.footsteps[:, :2], axis=0), axis=1).max() > 0.35
     res = walk(scene, plan, WalkOptions(passive_landing=True))
     assert not res.fell
-    assert res.metrics["reached_goal"]
+    assert res.metrics.reached_goal
 
 
 def test_cli_compare_mujoco_writes_the_table(tmp_path) -> None:  # type: ignore[no-untyped-def]

@@ -246,7 +246,7 @@ def test_g1_walks_a_short_flat_plan_made_for_it() -> None:
     res = walk(scene, plan, model_params=g)
     m = res.metrics
     assert not res.fell
-    assert m["reached_goal"]
-    assert m["steps_landed"] == plan.n_steps
-    assert m["footstep_error_vs_target_m"]["mean"] < WALK_LANDING_TOL
-    assert m["zmp"]["samples"] > 0 and m["zmp"]["inside_share"] == 1.0
+    assert m.reached_goal
+    assert m.steps_landed == plan.n_steps
+    assert m.footstep_error_vs_target_m.mean < WALK_LANDING_TOL
+    assert m.zmp.samples > 0 and m.zmp.inside_share == 1.0

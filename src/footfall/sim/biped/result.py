@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from footfall._typing import FloatArray
+from footfall.sim.biped.metrics import WalkMetrics
 
 
 @dataclass(frozen=True)
@@ -32,7 +33,7 @@ class WalkResult:
         n_planned: the plan's N; entries beyond it are stopping steps.
         fell: whether a fall was detected.
         fall_time: when [s] (NaN if none).
-        metrics: summary numbers (:func:`summarise`).
+        metrics: summary numbers (:func:`~footfall.sim.biped.metrics.summarise`).
         timing: wall-clock seconds per part: ``control`` (measurement, adjuster, references),
             ``ik``, ``physics``, ``render``.
         sim_time: simulated time [s].
@@ -52,8 +53,26 @@ class WalkResult:
     n_planned: int
     fell: bool
     fall_time: float
-    metrics: dict[str, Any]
+    metrics: WalkMetrics
     timing: dict[str, float]
     sim_time: float
     video: Path | None = None
     video_note: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        """The walk's part of ``footfall walk``'s walk.json: metrics, timing [s], real-time factor
+        (simulated over wall seconds, rendering excluded), the planned / commanded / landed
+        footsteps (arrays, N x 3 [m]) and the video."""
+        return {
+            "metrics": self.metrics.to_dict(),
+            "timing_s": self.timing,
+            "real_time_factor": self.sim_time
+            / max(self.timing["total"] - self.timing["render"], 1e-9),
+            "footsteps": {
+                "planned": self.planned[: self.n_planned],
+                "commanded": self.targets,
+                "landed": self.landed,
+            },
+            "video": str(self.video) if self.video else None,
+            "video_note": self.video_note,
+        }
