@@ -25,9 +25,7 @@ from footfall.terrain.region import Region
 
 #: extra footsteps after the plan's last one, onto the plan's final footholds (the goal stance),
 #: corrected by foot placement toward zero momentum: they absorb the momentum the walk ends with
-#: and finish a walk whose last steps the MPC shortened (discrete_steps, smallest N = 15 with 64
-#: heading segments: 0.139 m short of the goal with none, 0.029 m with 2; flat_long N = 20:
-#: 0.004 / 0.024 m, both at the goal)
+#: and finish a walk whose last steps the MPC shortened
 STOP_STEPS = 2
 #: share of the half foot width the planner's ankle-torque bound may use: U_max = share * m g * w/2
 #: keeps the planned ZMP (eq. 5.12d) inside the sole in every direction, with a margin
@@ -120,12 +118,11 @@ class PlanFollower:
             instead of the plan's: the walk must end with the divergent component of motion
             between the feet, whatever the plan's final state was.
         limit_reach: project every corrected footstep into the reach trapezoid (the capture-point
-            final step always is, so the robot ends in a legal stance). Off by default:
-            on flat ground (five goals, issue 7 note) it lowered the share of walks without a
-            fall from 2/5 to 1/5, because this walker's lateral recovery needs steps narrower
-            than the trapezoid's 0.12 m minimum width.
-        reach_margin: with ``limit_reach``, every corrected footstep stays this far inside the reach trapezoid of the
-            measured stance foot (``BipedParams.reach``) [m].
+            final step always is, so the robot ends in a legal stance). Off by default: the
+            MuJoCo walker's lateral recovery needs steps narrower than the trapezoid's minimum
+            width.
+        reach_margin: with ``limit_reach``, every corrected footstep stays this far inside the
+            reach trapezoid of the measured stance foot (``BipedParams.reach``) [m].
     """
 
     plan: FootstepPlan
@@ -313,28 +310,19 @@ class MPCAdjuster(PlanFollower):
     Attributes:
         control_dt: the walker's control period [s] (the MPC runs once per tick).
         weights: MPC weights.
-        freeze_after: as for :class:`PlanFollower`, later by default: on flat ground
-            (20 x 0.2 m) freezing at 0.7 T_ss left every footstep short and the robot 0.6 m
-            from the goal; at 0.9 it reached it with a 0.014 m mean footstep error.
+        freeze_after: as for :class:`PlanFollower`, later by default: the MPC's footstep keeps
+            improving late in the swing, and freezing early left every footstep short.
         capture_stop: off: the MPC's terminal term (Q_f toward the plan's final state at rest)
             places the last footstep.
         torque_limits: semi-axes ``(U_x, U_y)`` [N m] of the MPC's torque ellipse
             (:func:`footfall.control.mpc.build_mpc`); None = the plan's ``U_max`` ball
-            (eq. 5.19e). :func:`walk` passes :func:`sole_torque_limits`.
+            (eq. 5.19e). The MuJoCo walker passes :func:`sole_torque_limits`.
         hold_frozen: once the footstep is frozen, keep applying the torque of the solution it
-            was frozen with (the MPC's torque block is the plan's node interval, 0.1 s, so that
-            solution already holds one torque for the rest of the single support) instead of
-            re-solving. Re-solving with the footstep free returned torques for a footstep the
-            swing foot no longer went to (on discrete_steps N = 20 the stance ankle torque
-            jumped from -14.6 to +5.1 N m at the first frozen tick before a step down).
-            Re-solving with the footstep fixed there is consistent but, with 1-4 ticks left,
-            the torque barely moves the state and the solve spends the whole ellipse on it: a
-            CoP command of -0.064 m at the last tick (measured -0.019 m), which the double
-            support's rear-ankle ramp then held at the heel edge. Holding, together with
-            :attr:`WalkOptions.passive_landing`, reached 5 goals in the battery of cached-plan
-            walks (discrete_steps N = 13/16/18/20, flat_long, flat, turn; 2 before) and 24 of 24
-            seeded 20 N pushes on discrete_steps N = 18 (19 before); re-solving with the
-            footstep fixed reached 5 goals but 19 of 24.
+            was frozen with (the MPC's torque block is the plan's node interval, so that solution
+            already holds one torque for the rest of the single support) instead of re-solving.
+            Re-solving with the footstep free returns torques for a footstep the swing foot no
+            longer goes to; re-solving with it fixed, with a few ticks left the torque barely
+            moves the state and the solve spends the whole torque ellipse on it.
         footstep_in_region: solve the MPC with the next footstep kept in its planned region
             (``region_margin`` inside, :meth:`footfall.control.mpc.MPC.solve_in_polygon`)
             instead of clamping the document's unconstrained footstep afterwards, so the ankle

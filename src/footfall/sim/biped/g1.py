@@ -230,7 +230,8 @@ def _prepared_urdf(path: Path) -> str:
 
 
 def g1_spec(params: G1Model | None = None) -> Any:
-    """The G1 as a ``mujoco.MjSpec`` named as :mod:`biped_names` (see the module docstring)."""
+    """The G1 as a ``mujoco.MjSpec`` named as :mod:`footfall.sim.biped.names` (see the module
+    docstring)."""
     mujoco = require_mujoco()
     p = params if params is not None else G1Model()
     path = g1_urdf_path()

@@ -18,8 +18,8 @@ from footfall.sim.pushes import Push
 from footfall.terrain.scene import Scene
 
 #: landing error [m] the walk leaves room for at riser edges (:mod:`footfall.terrain.edges`):
-#: landings fall 2-4 cm short of their targets, and on stairs_slope_gap a heel that landed on the
-#: edge of the tread above (step down from ``top``, footstep 0.10 m from the riser) tipped the foot
+#: landings fall short of their targets, and a heel landing on the edge of the tread above a
+#: step down tips the foot
 RISER_LANDING_TOLERANCE = 0.04
 #: a plan's robot mass and CoM height may differ this much (relative) from the walker model's
 #: (:func:`~footfall.sim.biped.model.planner_params` measures them: 0.0 exactly)
@@ -38,17 +38,12 @@ class WalkOptions:
         heel_strike: the swing sole turns toe-up by this angle [rad] about its lateral axis
             (relative to lying flat on the landing region) as it moves, so it touches down heel
             first and the limp ankle (``passive_landing``) lets it roll flat; beyond the document.
-            Landing flat, the sole met the ground toe-first (about 1 deg toe-down from the IK's
-            lag) and stayed on its toe through double support: the CoP sat at the toe for the
-            first 1-3 ticks of the next single support, costing 0.03-0.09 m/s of walking speed
-            per step, and on stairs_slope_gap (N = 15, one footstep per tread) the robot stalled
-            on stair2 and fell. With 1.5-4 deg it walks to the goal (1 deg falls). The angle
-            trades against push recovery on discrete_steps N = 18 (seeded 20 N pushes: 0 deg
-            23/24, 1.5 deg 24/24, 2.5 deg 19/24; 30 N: 8/12 at 1.5 deg, 12/12 before any); 1.5 deg
-            kept the unpushed battery (discrete_steps N = 16/18/20, flat_long, flat) at the goal.
-            0 = land flat.
+            A sole landing flat meets the ground toe-first (the IK lags) and the CoP stays at the
+            toe into the next single support. It trades against push recovery (benchmarks/
+            RESULTS.md, "Biped walk"). 0 = land flat.
         swing_side_gap: the swing sole passes the stance sole at least this far apart sideways
-            [m]: their centres at least the sole width plus this (:func:`swing_bow`; beyond the
+            [m]: their centres at least the sole width plus this
+            (:func:`~footfall.sim.biped.references.swing_bow`; beyond the
             document). 0 = straight swing paths.
         com_feedback: share in [0, 1] by which the ALIP reference is pulled toward the measured
             state every tick: 0 tracks the planned CoM motion stiffly (the ankle absorbs every
@@ -59,8 +54,10 @@ class WalkOptions:
         stop_time: time to bring the CoM to the middle of the final feet after the last step [s].
         hold_time: standing time at the end [s].
         pushes: external pushes.
-        stop_steps: stopping steps after the plan (:func:`extend_plan`); the adjuster must
-            answer for phases up to ``N + stop_steps - 1`` (:class:`PlanFollower` does).
+        stop_steps: stopping steps after the plan
+            (:func:`~footfall.control.adjusters.extend_plan`); the adjuster must answer for phases
+            up to ``N + stop_steps - 1`` (:class:`~footfall.control.adjusters.PlanFollower`
+            does).
         com_gain: gain of the CoM tracking feedback: the IK's CoM target is the reference plus
             ``com_gain`` times the horizontal tracking error. Without it the joint servos'
             compliance lets a robot standing on one foot roll slowly over it.
@@ -71,38 +68,33 @@ class WalkOptions:
             (``com_feedback`` = 1 and no ``com_gain`` in single support). False: every joint is
             position-servoed and the ankle torque is whatever tracking the CoM reference needs.
         true_momentum: give the adjuster the true angular momentum about the stance point
-            (``L_G + m (c - p) x v``, Gong & Grizzle) instead of ``m z_H (-v_y, v_x)`` from the
-            CoM velocity. Default True: with the MPC it lowered the mean single-support ZMP
-            offset on flat ground (20 x 0.2 m: 0.042 -> 0.027 m) and kept the 0.33 m steps of
-            the ``flat`` scene from falling.
+            (``L_G + m (c - p) x v``, Gong & Grizzle; eq. 5.1's L) instead of
+            ``m z_H (-v_y, v_x)`` from the CoM velocity: the swing leg and torso carry momentum
+            the CoM velocity does not show.
         stop_on_fall: end the simulation when a fall is detected.
         landing_margin: the walker's MPC keeps each footstep this much further inside its region
             than the plan did (its ``region_margin``, half the sole length for
-            :func:`footfall.experiments.compare_mujoco.plan_for_walk`) [m]: landings fall ~2 cm short of
-            their targets, and a heel over a block's edge on a step down tipped the landing foot.
+            :func:`footfall.sim.biped.plans.plan_for_walk`) [m]: landings fall short of their
+            targets, and a heel over a block's edge on a step down tips the landing foot.
         riser_tolerance: the MPC keeps each footstep in its region with the riser edges moved
             in by :func:`footfall.terrain.edges.inset_riser_edges` with this landing tolerance
             [m] (on top of ``region_margin`` + ``landing_margin``), as
-            :func:`footfall.experiments.compare_mujoco.plan_for_walk` plans; 0 = the regions as they are.
-            Without it the MPC moved the footstep below ``top``'s riser of stairs_slope_gap
-            (N = 15) from the plan's 0.147 m to 0.12 m from the riser, the heel landed on the
-            riser edge and the robot fell at 6.4 s (8 steps); with it, at 7.5 s (10 steps).
+            :func:`footfall.sim.biped.plans.plan_for_walk` plans; 0 = the regions as they are.
+            Without it the MPC may move a footstep below a riser toward it until the heel lands
+            on the riser's edge.
         passive_landing: the swing ankle goes limp (torque mode, zero torque) from the first
             contact of the swing sole during its descent until the double support, where the
-            landing ankle is passive anyway. A position-servoed ankle (5000 N m / rad) met the
-            ground on the toe (0.6 deg off flat) and held the foot's angle: 900 N on the toe for
-            20 ms lifted the robot (CoM vertical velocity -0.02 -> +0.29 m/s), both feet left the
-            ground for 30-50 ms and the landing lost 10-20 % of the angular momentum about the new
-            foot (flat, 0.33 m steps: 0.22 m short of the goal before, 0.05 m after). See
-            :attr:`MPCAdjuster.hold_frozen` for what the two did together.
+            landing ankle is passive anyway. A stiff position-servoed ankle that meets the ground
+            on the toe holds the foot's angle, and the toe's load lifts the robot and loses
+            angular momentum about the new foot at the reset (eq. 5.10).
         closed_loop_ik: start the IK from the measured configuration every tick, so the torso
             orientation, the CoM height and the swing foot are fed back through the joint
             servos; a torque-driven stance ankle is held at its measured angles and its sole at
             its measured pose, leaving the horizontal CoM to the pendulum and the adjuster.
-            False: the IK integrates its own kinematic copy (open loop; the robot fell within a
-            few steps on every scene).
+            False: the IK integrates its own kinematic copy (open loop, nothing fed back).
         check_robot: refuse a plan whose robot mass or CoM height differs by more than
-            ``PLAN_ROBOT_RTOL`` from the walker model's (:func:`planner_params`): its ALIP motion
+            ``PLAN_ROBOT_RTOL`` from the walker model's
+            (:func:`~footfall.sim.biped.model.planner_params`): its ALIP motion
             is then another pendulum's. False walks such a plan on purpose (a mismatch study).
     """
 
@@ -157,7 +149,8 @@ class WalkOptions:
 
 def _check_plan_robot(robot: BipedParams, model: WalkerModel | None) -> None:
     """Raise :class:`InputError` when the plan's robot is not the walker model's pendulum (mass
-    and CoM height within ``PLAN_ROBOT_RTOL``, see :func:`planner_params`)."""
+    and CoM height within ``PLAN_ROBOT_RTOL``, see
+    :func:`~footfall.sim.biped.model.planner_params`)."""
     info = measure_model(model)
     name = (model if model is not None else BipedModel()).name
     for field_name, planned, actual, unit in (
@@ -177,7 +170,8 @@ def _check_plan_robot(robot: BipedParams, model: WalkerModel | None) -> None:
 def check_walk_inputs(
     scene: Scene, plan: FootstepPlan, opts: WalkOptions, model: WalkerModel | None
 ) -> None:
-    """Raise :class:`InputError` for a plan this walk cannot follow (see :func:`walk`)."""
+    """Raise :class:`InputError` for a plan the walk cannot follow
+    (:func:`footfall.sim.biped.walk.walk` lists why)."""
     if not plan.has_solution or plan.n_steps < 1:
         raise InputError("plan", plan.status.value, "a plan with at least one footstep")
     start_stance = scene.start.stance_foot

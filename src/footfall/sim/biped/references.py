@@ -1,4 +1,4 @@
-"""Reference motions of the MuJoCo biped's walk: swing-sole paths and the CoM height (000 section 5.5).
+"""Reference motions of the MuJoCo biped's walk: swing paths and the CoM height (000 section 5.5).
 
 The swing sole rises above every region it passes over before it moves (:func:`swing_reference`,
 :func:`terrain_height_along`, :func:`swing_shares`) and bows around the stance foot
@@ -128,7 +128,7 @@ def swing_shares(rise_height: float, fall_height: float, t_ss: float) -> tuple[f
     Each vertical motion takes at least ``SWING_SHARES[0]`` of the swing (the sole must clear the
     ground before it moves, else it scuffs) and longer when its quintic profile's peak
     acceleration ``5.77 h / T^2`` would exceed ``SWING_ACC_MAX``, up to half the swing (a swing
-    leg lifted 0.2 m within 0.14 s unloaded the stance foot on the discrete steps).
+    leg lifted fast unloads the stance foot).
     """
     lo, hi = SWING_SHARES
 
@@ -151,9 +151,8 @@ def terrain_height_along(
     The swept area is approximated by the segment start -> target extended by ``half_length``
     at both ends (heel behind the start, toe beyond the target) and widened by ``half_width``
     on both sides: a region counts when a sample of the extended segment lies within
-    ``half_width`` of it. (Widening by the half length as well counted blocks the toe never
-    reaches: a step onto a block 0.08 m before a higher one swung 0.15 m too high, and the swing
-    leg's acceleration lifted the stance foot off its block.)
+    ``half_width`` of it. (Widening by the half length as well would count blocks the toe never
+    reaches, and a needlessly high swing's acceleration lifts the stance foot.)
     """
     d = target[:2] - start[:2]
     length = float(np.linalg.norm(d))
@@ -184,8 +183,7 @@ class CoMHeight:
     acceleration of the rounding hardly pushes it horizontally.
 
     A height that rises in *time* (from one mid single support to the next) pushes the CoM forward
-    whenever it rises ahead of the stance foot: on the discrete steps the walking speed grew from
-    0.62 to 1.0 m/s within two step-ups and the robot fell.
+    whenever it rises ahead of the stance foot, and the walk speeds up at every step-up.
     """
 
     def __init__(self, footsteps: FloatArray, z_h: float, kink: float = 0.05) -> None:

@@ -3,26 +3,36 @@
 Control loop (every ``control_dt``):
 
 1. **Measure** the ALIP state (eq. 5.1) of the robot about the stance contact point: the CoM
-   relative to the stance sole centre and either ``m z_H (-v_y, v_x)`` from the CoM velocity
-   (default) or the true angular momentum ``L = L_G + m (c - p) x v`` (MuJoCo's subtree CoM,
-   velocity and angular momentum; ``WalkOptions.true_momentum``).
-2. **Footstep / ankle-torque source** (:class:`FootstepAdjuster`): returns the next footstep and
-   the ankle torque of this tick. The built-in :class:`PlanFollower` uses the plan's footsteps and
-   ALIP torques, corrected by one-step ALIP foot placement; the MPC of eq. (5.19) plugs in here.
+   relative to the stance sole centre and either the true angular momentum
+   ``L = L_G + m (c - p) x v`` (default; MuJoCo's subtree CoM, velocity and angular momentum) or
+   ``m z_H (-v_y, v_x)`` from the CoM velocity (``WalkOptions.true_momentum``).
+2. **Footstep / ankle-torque source** (:class:`~footfall.control.adjusters.FootstepAdjuster`):
+   returns the next footstep and the ankle torque of this tick. The default
+   :class:`~footfall.control.adjusters.MPCAdjuster` solves the MPC of eq. (5.19);
+   :class:`~footfall.control.adjusters.PlanFollower` uses the plan's footsteps and ALIP torques,
+   corrected by one-step ALIP foot placement.
 3. **Reference**: the ALIP reference state is advanced by one tick with that torque, exactly
    (zero-order hold, eq. 5.5), after blending it toward the measured state by ``com_feedback``.
    In double support the contact point moves linearly to the new foot (the model behind the reset
    map, eq. 5.8-5.10). The CoM height lies on the planes through z_H above consecutive
-   footsteps (:class:`CoMHeight`), on which the horizontal motion is exactly the ALIP's.
+   footsteps (:class:`~footfall.sim.biped.references.CoMHeight`), on which the horizontal motion
+   is exactly the ALIP's.
 4. **Whole body**: differential inverse kinematics with ``mink`` (one QP per iteration, solved by
-   ``daqp``) tracks the CoM, both sole poses (stance: where it stands; swing: a trajectory that
-   rises above every region it passes over before moving, see :func:`swing_reference`) and an
-   upright torso; the resulting joint angles are the set points of the joint servos.
+   ``daqp``, :mod:`footfall.sim.biped.ik`) tracks the CoM, both sole poses (stance: where it
+   stands; swing: a trajectory that rises above every region it passes over before moving,
+   :func:`~footfall.sim.biped.references.swing_reference`) and an upright torso; the resulting
+   joint angles are the set points of the joint servos.
 
 Everything reported is *measured* in the simulation: the centre of pressure (ZMP) of the stance
 foot's contact forces (``mj_contactForce``), its offset from the sole centre in the foot frame,
 where each foot lands, whether the robot fell. Planned quantities are only used for errors.
+
+:class:`BipedWalk` runs the loop, one :meth:`BipedWalk.step` per tick; :func:`walk` is the entry
+point. Options are in :mod:`footfall.sim.biped.options`, the plant in
+:mod:`footfall.sim.biped.plant`, the summary in :mod:`footfall.sim.biped.metrics`.
 """
+
+from __future__ import annotations
 
 import math
 import time
