@@ -35,13 +35,13 @@ def main() -> None:
     summary = {
         "n_steps": plan.n_steps,
         "mean_step_m": float(np.mean(steps)),
-        "fell": m["fell"],
-        "fall_time_s": m["fall_time_s"],
-        "steps_landed": m["steps_landed"],
-        "reached_goal": m["reached_goal"],
-        "footstep_error_m": m["footstep_error_m"],
-        "footstep_error_vs_target_m": m["footstep_error_vs_target_m"],
-        "zmp": m["zmp"],
+        "fell": m.fell,
+        "fall_time_s": m.fall_time_s,
+        "steps_landed": m.steps_landed,
+        "reached_goal": m.reached_goal,
+        "footstep_error_m": m.footstep_error_m.to_dict(),
+        "footstep_error_vs_target_m": m.footstep_error_vs_target_m.to_dict(),
+        "zmp": m.zmp.to_dict(),
     }
     (out / "walk_flat20.json").write_text(json.dumps(summary, indent=2, default=float))
     plot_walk(res, scene, out / "walk_flat20.png", title="flat, 20 x 0.2 m, MIQCQP + MPC")

@@ -231,6 +231,14 @@ def scenes_command(
 
 
 # --- footstep planning (document 000, section 5.3) ---
+def _walker_params(robot: str, base: Any) -> Any:
+    """The planner's robot parameters measured on the named MuJoCo walker model."""
+    from footfall.sim.biped.model import planner_params
+    from footfall.sim.biped.plans import robot_model
+
+    return planner_params(robot_model(robot), base=base)
+
+
 @app.command()
 def plan(
     scene_file: Path | None = typer.Argument(None, help="Scene YAML file (or use --scene)."),
@@ -285,12 +293,7 @@ def plan(
         reach_both_frames=reach_both_frames,
         swing_max=swing_max,
     )
-    robot_params = None
-    if robot is not None:
-        from footfall.sim.biped.model import planner_params
-        from footfall.sim.biped.plans import robot_model
-
-        robot_params = planner_params(robot_model(robot), base=sc.robot)
+    robot_params = None if robot is None else _walker_params(robot, sc.robot)
     with console.status(f"planning {sc.name} with {planner} ...") as status:
 
         def progress(n: int, result: Any) -> None:
@@ -707,25 +710,6 @@ def _compare_mujoco(
 
 
 # --- walk (issue 7) ---
-def _json_clean(value: Any) -> Any:
-    """JSON has no NaN/inf and no numpy types: convert recursively (unknown numbers -> null)."""
-    import math
-
-    import numpy as np
-
-    if isinstance(value, dict):
-        return {str(k): _json_clean(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_json_clean(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _json_clean(value.tolist())
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
 @app.command("walk")
 def walk_cmd(
     scene_file: Path | None = typer.Argument(None, help="Scene YAML file (or use --scene)."),
@@ -767,8 +751,10 @@ def walk_cmd(
         # headless offscreen rendering; MuJoCo picks its GL backend when it is first imported
         os.environ.setdefault("MUJOCO_GL", "egl")
     from footfall.planning.plan import check_planner_name
+    from footfall.sim.biped.options import WalkOptions
     from footfall.sim.biped.plans import plan_for_walk, random_push, robot_model
-    from footfall.sim.biped.walk import WalkOptions, walk
+    from footfall.sim.biped.result import walk_report
+    from footfall.sim.biped.walk import walk
     from footfall.viz.walk_plot import plot_walk
 
     check_planner_name(planner)
@@ -777,6 +763,7 @@ def walk_cmd(
     push = non_negative("push", push)
     model = robot_model(robot)
     sc = resolve_scene_arguments(scene_file, scene)
+    output_folder(out)
     with console.status(f"planning {sc.name} with {planner} for the {robot} ..."):
         plan = plan_for_walk(
             sc,
@@ -792,51 +779,25 @@ def walk_cmd(
     if not plan.has_solution:
         console.print(f"{sc.name}: {planner} found no plan ({plan.status.value}). {plan.message}")
         raise typer.Exit(1)
-    opts = WalkOptions()
-    pushes = (random_push(seed, push, plan, opts),) if push > 0 else ()
+    pushes = (random_push(seed, push, plan, WalkOptions()),) if push > 0 else ()
     opts = WalkOptions(pushes=pushes)
     with console.status(f"walking {plan.n_steps} steps in MuJoCo ..."):
         res = walk(
             sc, plan, opts, model_params=model, video_path=out / "walk.mp4" if video else None
         )
-    payload = {
-        "scene": sc.name,
-        "planner": planner,
-        "robot": robot,
-        "plan": {
-            "status": plan.status.value,
-            "n_steps": plan.n_steps,
-            "solve_time_s": plan.solve_time,
-            "message": plan.message,
-        },
-        "push": [
-            {"start_s": p.start, "duration_s": p.duration, "force_N": p.force.tolist()}
-            for p in pushes
-        ],
-        "metrics": res.metrics,
-        "timing_s": res.timing,
-        "real_time_factor": res.sim_time / max(res.timing["total"] - res.timing["render"], 1e-9),
-        "footsteps": {
-            "planned": res.planned[: res.n_planned],
-            "commanded": res.targets,
-            "landed": res.landed,
-        },
-        "video": str(res.video) if res.video else None,
-        "video_note": res.video_note,
-    }
-    write_json(out / "walk.json", _json_clean(payload))
+    write_json(out / "walk.json", walk_report(sc.name, planner, robot, plan, pushes, res))
     plot_walk(res, sc, out / "walk.png", title=f"{sc.name}, {planner}, {robot}")
     m = res.metrics
     console.print(
-        f"{sc.name} / {planner} / {robot}: {plan.n_steps} steps, fell={m['fell']}, "
-        f"reached goal={m['reached_goal']}, footstep error mean "
-        f"{m['footstep_error_m']['mean']:.3f} m, ZMP offset mean {m['zmp']['mean']:.3f} m "
-        f"max {m['zmp']['max']:.3f} m"
+        f"{sc.name} / {planner} / {robot}: {plan.n_steps} steps, fell={m.fell}, "
+        f"reached goal={m.reached_goal}, footstep error mean "
+        f"{m.footstep_error_m.mean:.3f} m, ZMP offset mean {m.zmp.mean:.3f} m "
+        f"max {m.zmp.max:.3f} m"
     )
     if res.video_note:
         console.print(res.video_note)
     console.print(f"wrote {out / 'walk.json'}, walk.png" + (", walk.mp4" if res.video else ""))
-    if m["fell"] or not m["reached_goal"]:
+    if m.fell or not m.reached_goal:
         raise typer.Exit(1)
 
 

@@ -9,11 +9,11 @@ import pytest
 
 mujoco = pytest.importorskip("mujoco")
 
+from footfall.control.adjusters import U_MAX_FOOT_SHARE  # noqa: E402
 from footfall.errors import InputError  # noqa: E402
 from footfall.models.biped import BipedParams, Side  # noqa: E402
 from footfall.sim.biped import names as nm  # noqa: E402
 from footfall.sim.biped.model import (  # noqa: E402
-    U_MAX_FOOT_SHARE,
     BipedModel,
     biped_mjcf,
     measure_model,

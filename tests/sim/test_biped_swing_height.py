@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from footfall.sim.biped.walk import (
+from footfall.sim.biped.references import (
     QUINTIC_PEAK_ACC,
     SWING_ACC_MAX,
     SWING_SHARES,

@@ -12,25 +12,23 @@ pytest.importorskip("mink")
 
 from typer.testing import CliRunner  # noqa: E402
 
+from footfall._geometry import inset_polygon  # noqa: E402
 from footfall.cli import app  # noqa: E402
+from footfall.control.adjusters import (  # noqa: E402
+    MPCAdjuster,
+    PlanFollower,
+    project_to_polygon,
+    sole_torque_limits,
+)
 from footfall.errors import FootfallError, InputError  # noqa: E402
 from footfall.models.biped import Side  # noqa: E402
 from footfall.planning import make_plan  # noqa: E402
 from footfall.sim.biped.model import planner_params  # noqa: E402
-from footfall.sim.biped.walk import (  # noqa: E402
-    BipedSim,
-    MPCAdjuster,
-    PlanFollower,
-    Push,
-    WalkOptions,
-    _ds_propagator,
-    ankle_joint_torque,
-    inset_polygon,
-    project_to_polygon,
-    sole_cop,
-    sole_torque_limits,
-    walk,
-)
+from footfall.sim.biped.options import WalkOptions  # noqa: E402
+from footfall.sim.biped.plant import BipedSim, ankle_joint_torque, sole_cop  # noqa: E402
+from footfall.sim.biped.references import ds_propagator  # noqa: E402
+from footfall.sim.biped.walk import walk  # noqa: E402
+from footfall.sim.pushes import Push  # noqa: E402
 from footfall.terrain import Goal, Region, builtin_scene  # noqa: E402
 
 #: exact arithmetic of the CoP formula
@@ -104,7 +102,7 @@ def short_walk():  # type: ignore[no-untyped-def]
 def test_short_flat_walk_lands_every_planned_footstep(short_walk) -> None:  # type: ignore[no-untyped-def]
     _, plan, res = short_walk
     m = res.metrics
-    assert m["steps_landed"] == plan.n_steps
+    assert m.steps_landed == plan.n_steps
     # no fall before the last planned footstep is down (the stop afterwards is reported, see
     # the issue 7 note)
     t_last = (
@@ -113,10 +111,10 @@ def test_short_flat_walk_lands_every_planned_footstep(short_walk) -> None:  # ty
         + plan.n_steps * (plan.robot.t_ss + plan.robot.t_ds)
     )
     assert (not res.fell) or res.fall_time >= t_last - 1e-9
-    assert m["footstep_error_vs_target_m"]["mean"] < LANDING_TOL
+    assert m.footstep_error_vs_target_m.mean < LANDING_TOL
     # the single-support CoP is measured and lies inside the sole
-    assert m["zmp"]["samples"] > 0
-    assert m["zmp"]["inside_share"] == 1.0
+    assert m.zmp.samples > 0
+    assert m.zmp.inside_share == 1.0
 
 
 def test_bad_walk_inputs_name_the_field(short_walk) -> None:  # type: ignore[no-untyped-def]
@@ -306,7 +304,7 @@ def test_stop_target_leaves_the_capture_point_midway(short_walk) -> None:  # typ
     a, b = alip.discretize(robot.t_ss - t)
     x = a @ state + b @ u
     step = round(robot.t_ds / 1e-3)
-    ds = _ds_propagator(alip, robot.t_ds / step)
+    ds = ds_propagator(alip, robot.t_ds / step)
     aug = np.concatenate([x, np.zeros(3), np.array([d[0], d[1], 0.0]) / robot.t_ds])
     for _ in range(step):
         aug = ds @ aug
@@ -333,10 +331,10 @@ def test_flat_walk_of_twenty_steps_reaches_the_goal() -> None:
     res = walk(scene, plan)
     m = res.metrics
     assert not res.fell
-    assert m["steps_landed"] == plan.n_steps
-    assert m["reached_goal"]
-    assert m["footstep_error_m"]["mean"] < FLAT20_FOOTSTEP_TOL
-    assert m["zmp"]["inside_share"] == 1.0
+    assert m.steps_landed == plan.n_steps
+    assert m.reached_goal
+    assert m.footstep_error_m.mean < FLAT20_FOOTSTEP_TOL
+    assert m.zmp.inside_share == 1.0
     # the MPC ran at every single-support tick and the measured CoP moved with its torque one
     # for one on average (regression slope; measured 0.85 sagittal, 1.09 lateral). The swing
     # leg's reaction scatters the sagittal CoP around it (RMS 3 cm), hence no tighter bound.
@@ -355,7 +353,7 @@ def test_long_flat_steps_reach_the_goal_with_a_limp_landing_ankle() -> None:
     assert np.linalg.norm(np.diff(plan.footsteps[:, :2], axis=0), axis=1).max() > 0.35
     res = walk(scene, plan, WalkOptions(passive_landing=True))
     assert not res.fell
-    assert res.metrics["reached_goal"]
+    assert res.metrics.reached_goal
 
 
 def test_cli_compare_mujoco_writes_the_table(tmp_path) -> None:  # type: ignore[no-untyped-def]
@@ -391,8 +389,8 @@ def test_plan_for_walk_plans_on_the_riser_inset_regions(monkeypatch: pytest.Monk
     # the planner sees stairs_slope_gap's treads below a riser moved in by the landing tolerance
     # at that edge only, and keeps its uniform half-sole region margin (the planner is unchanged)
     import footfall.planning.cache as run
+    from footfall.sim.biped.options import RISER_LANDING_TOLERANCE
     from footfall.sim.biped.plans import plan_for_walk
-    from footfall.sim.biped.walk import RISER_LANDING_TOLERANCE
 
     seen = {}
 

@@ -33,7 +33,7 @@ from footfall.sim.biped import names as nm  # noqa: E402
 from footfall.sim.biped.g1 import G1Model, g1_urdf_path, urdf_joint  # noqa: E402
 from footfall.sim.biped.model import measure_model, planner_params  # noqa: E402
 from footfall.sim.biped.plans import robot_model  # noqa: E402
-from footfall.sim.biped.walk import BipedSim, ankle_joint_torque  # noqa: E402
+from footfall.sim.biped.plant import BipedSim, ankle_joint_torque  # noqa: E402
 from footfall.terrain import builtin_scene  # noqa: E402
 
 pytestmark = pytest.mark.robots
@@ -246,7 +246,7 @@ def test_g1_walks_a_short_flat_plan_made_for_it() -> None:
     res = walk(scene, plan, model_params=g)
     m = res.metrics
     assert not res.fell
-    assert m["reached_goal"]
-    assert m["steps_landed"] == plan.n_steps
-    assert m["footstep_error_vs_target_m"]["mean"] < WALK_LANDING_TOL
-    assert m["zmp"]["samples"] > 0 and m["zmp"]["inside_share"] == 1.0
+    assert m.reached_goal
+    assert m.steps_landed == plan.n_steps
+    assert m.footstep_error_vs_target_m.mean < WALK_LANDING_TOL
+    assert m.zmp.samples > 0 and m.zmp.inside_share == 1.0

@@ -1,5 +1,13 @@
-"""Feedback control on top of a footstep plan: the MPC footstep / ankle-torque adjuster (eq. 5.19)."""
+"""Feedback control on top of a footstep plan: the MPC (eq. 5.19) and the footstep / ankle-torque
+adjusters a walking controller asks every tick (:mod:`footfall.control.adjusters`)."""
 
+from footfall.control.adjusters import (
+    FootstepAdjuster,
+    MPCAdjuster,
+    PlanFollower,
+    extend_plan,
+    sole_torque_limits,
+)
 from footfall.control.mpc import (
     MPC,
     CondensedMPC,
@@ -13,9 +21,14 @@ from footfall.control.mpc import (
 __all__ = [
     "MPC",
     "CondensedMPC",
+    "FootstepAdjuster",
+    "MPCAdjuster",
     "MPCSolution",
     "MPCStatus",
     "MPCWeights",
+    "PlanFollower",
     "build_mpc",
+    "extend_plan",
+    "sole_torque_limits",
     "solve_ball_qp",
 ]

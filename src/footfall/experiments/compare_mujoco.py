@@ -17,8 +17,10 @@ from typing import Any
 import numpy as np
 
 from footfall.errors import InputError
+from footfall.sim.biped.options import WalkOptions
 from footfall.sim.biped.plans import plan_for_walk, random_push
-from footfall.sim.biped.walk import WalkOptions, WalkResult, walk
+from footfall.sim.biped.result import WalkResult
+from footfall.sim.biped.walk import walk
 from footfall.terrain.scene import Scene, builtin_scene
 from footfall.viz.compare_plots import plot_mujoco_table
 
@@ -31,16 +33,16 @@ def walk_row(scene: Scene, planner: str, seed: int, push: float, res: WalkResult
         "planner": planner,
         "seed": seed,
         "push_N": push,
-        "fell": m["fell"],
-        "reached_goal": m["reached_goal"],
-        "steps_landed": m["steps_landed"],
-        "steps_planned": m["steps_planned"],
-        "zmp_mean_m": m["zmp"]["mean"],
-        "zmp_max_m": m["zmp"]["max"],
-        "zmp_at_edge_share": m["zmp"].get("at_edge_share", math.nan),
-        "footstep_error_mean_m": m["footstep_error_m"]["mean"],
-        "time_to_goal_s": m["time_to_goal_s"],
-        "wall_time_s": m["wall_time_s"],
+        "fell": m.fell,
+        "reached_goal": m.reached_goal,
+        "steps_landed": m.steps_landed,
+        "steps_planned": m.steps_planned,
+        "zmp_mean_m": m.zmp.mean,
+        "zmp_max_m": m.zmp.max,
+        "zmp_at_edge_share": m.zmp.at_edge_share if m.zmp.at_edge_share is not None else math.nan,
+        "footstep_error_mean_m": m.footstep_error_m.mean,
+        "time_to_goal_s": m.time_to_goal_s,
+        "wall_time_s": m.wall_time_s,
     }
 
 

@@ -1,27 +1,98 @@
-"""Figure of a simulated biped walk: footsteps, CoM path, measured ZMP offset, CoM height."""
+"""Figure of a simulated biped walk: footsteps, CoM path, measured ZMP offset, CoM height.
+
+The figure reads a walk result through :class:`WalkLike` and the sole through :class:`SoleLike`
+(both satisfied by :class:`footfall.sim.biped.result.WalkResult` and the walker models), so that
+pictures never import the simulation.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
+from numpy.typing import NDArray
 
-from footfall.sim.biped.model import BipedModel
-from footfall.sim.biped.walk import WalkResult
+from footfall._typing import FloatArray
 from footfall.terrain.scene import Scene
+
+#: the sole drawn without a model: our biped's (``footfall.sim.biped.model.BipedModel``) [m]
+DEFAULT_FOOT_LENGTH, DEFAULT_FOOT_WIDTH = 0.20, 0.10
+
+
+class ZMPSummaryLike(Protocol):
+    """Mean and max norm [m] of the measured single-support ZMP offsets."""
+
+    @property
+    def mean(self) -> float: ...
+    @property
+    def max(self) -> float: ...
+
+
+class WalkMetricsLike(Protocol):
+    """The walk's summary numbers the figure prints."""
+
+    @property
+    def zmp(self) -> ZMPSummaryLike: ...
+
+
+class WalkLike(Protocol):
+    """What :func:`plot_walk` reads of a walk (shapes and units as in ``WalkResult``)."""
+
+    @property
+    def t(self) -> FloatArray: ...
+    @property
+    def phase(self) -> NDArray[np.int_]: ...
+    @property
+    def com(self) -> FloatArray: ...
+    @property
+    def com_ref(self) -> FloatArray: ...
+    @property
+    def zmp_offset(self) -> FloatArray: ...
+    @property
+    def zmp_planned(self) -> FloatArray: ...
+    @property
+    def feet(self) -> FloatArray: ...
+    @property
+    def landed(self) -> FloatArray: ...
+    @property
+    def targets(self) -> FloatArray: ...
+    @property
+    def planned(self) -> FloatArray: ...
+    @property
+    def n_planned(self) -> int: ...
+    @property
+    def fell(self) -> bool: ...
+    @property
+    def fall_time(self) -> float: ...
+    @property
+    def metrics(self) -> WalkMetricsLike: ...
+
+
+class SoleLike(Protocol):
+    """The sole's size [m] (a walker model)."""
+
+    @property
+    def foot_length(self) -> float: ...
+    @property
+    def foot_width(self) -> float: ...
 
 
 def plot_walk(
-    res: WalkResult, scene: Scene, path: Path, params: BipedModel | None = None, title: str = ""
+    res: WalkLike, scene: Scene, path: Path, params: SoleLike | None = None, title: str = ""
 ) -> Path:
-    """Write a three-panel PNG: top view, single-support ZMP offset in the foot frame, heights."""
+    """Write a three-panel PNG: top view, single-support ZMP offset in the foot frame, heights.
+
+    ``params``: the sole drawn in the ZMP panel (None: our biped's).
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.patches import Polygon, Rectangle
 
-    p = params if params is not None else BipedModel()
+    length = params.foot_length if params is not None else DEFAULT_FOOT_LENGTH
+    width = params.foot_width if params is not None else DEFAULT_FOOT_WIDTH
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.8))
     ax = axes[0]
     for r in scene.terrain.regions:
@@ -43,11 +114,7 @@ def plot_walk(
     ax = axes[1]
     ss = res.phase >= 0
     z = res.zmp_offset
-    ax.add_patch(
-        Rectangle(
-            (-p.foot_length / 2, -p.foot_width / 2), p.foot_length, p.foot_width, fc="none", ec="k"
-        )
-    )
+    ax.add_patch(Rectangle((-length / 2, -width / 2), length, width, fc="none", ec="k"))
     ax.scatter(z[ss, 0], z[ss, 1], s=4, c=res.t[ss], cmap="viridis", label="measured CoP")
     zp = res.zmp_planned
     ax.plot(zp[ss, 0], zp[ss, 1], ".", ms=2, c="tab:red", alpha=0.4, label="commanded")
@@ -56,10 +123,9 @@ def plot_walk(
     ax.set_aspect("equal")
     ax.set_xlabel("x in the foot frame [m]")
     ax.set_ylabel("y [m]")
-    m = res.metrics.get("zmp", {})
+    m = res.metrics.zmp
     ax.set_title(
-        f"single-support ZMP offset: mean {m.get('mean', np.nan):.3f} m, "
-        f"max {m.get('max', np.nan):.3f} m",
+        f"single-support ZMP offset: mean {m.mean:.3f} m, max {m.max:.3f} m",
         fontsize=9,
     )
     ax.legend(fontsize=7, loc="upper left")

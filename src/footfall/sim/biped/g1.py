@@ -229,8 +229,16 @@ def _prepared_urdf(path: Path) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
+#: colours of the G1's geoms (RGBA): links, feet, pelvis and torso boxes
+_GREY, _DARK, _BLUE = [0.7, 0.7, 0.72, 1.0], [0.15, 0.15, 0.15, 1.0], [0.25, 0.35, 0.6, 1.0]
+#: contact bits of the robot's colliding geoms, and of its visual-only geoms
+_ROBOT_COL = {"contype": nm.ROBOT_CONTYPE, "conaffinity": nm.ROBOT_CONAFFINITY}
+_VISUAL = {"contype": 0, "conaffinity": 0, "group": nm.ROBOT_GROUP}
+
+
 def g1_spec(params: G1Model | None = None) -> Any:
-    """The G1 as a ``mujoco.MjSpec`` named as :mod:`biped_names` (see the module docstring)."""
+    """The G1 as a ``mujoco.MjSpec`` named as :mod:`footfall.sim.biped.names` (see the module
+    docstring)."""
     mujoco = require_mujoco()
     p = params if params is not None else G1Model()
     path = g1_urdf_path()
@@ -247,11 +255,15 @@ def g1_spec(params: G1Model | None = None) -> Any:
     spec.option.impratio = p.impratio
     spec.visual.global_.offwidth = 1280
     spec.visual.global_.offheight = 720
+    _add_trunk(mujoco, spec)
+    for side in (Side.LEFT, Side.RIGHT):
+        _add_leg(mujoco, spec, p, side, efforts)
+    _add_sticks(mujoco, spec)
+    return spec
 
-    robot_col = {"contype": nm.ROBOT_CONTYPE, "conaffinity": nm.ROBOT_CONAFFINITY}
-    visual = {"contype": 0, "conaffinity": 0, "group": nm.ROBOT_GROUP}
-    grey, dark, blue = [0.7, 0.7, 0.72, 1.0], [0.15, 0.15, 0.15, 1.0], [0.25, 0.35, 0.6, 1.0]
 
+def _add_trunk(mujoco: Any, spec: Any) -> None:
+    """Free joint and tracking camera on the pelvis; pelvis and torso boxes, renamed as ours."""
     pelvis = spec.body(nm.PELVIS_BODY)
     pelvis.add_freejoint(name=nm.ROOT_JOINT)
     cam = pelvis.add_camera(
@@ -270,55 +282,61 @@ def g1_spec(params: G1Model | None = None) -> Any:
             type=mujoco.mjtGeom.mjGEOM_BOX,
             pos=list(centre),
             size=list(half),
-            rgba=blue,
+            rgba=_BLUE,
             group=nm.ROBOT_GROUP,
-            **robot_col,
+            **_ROBOT_COL,
         )
 
-    for side in (Side.LEFT, Side.RIGHT):
-        for name in nm.LEG_JOINTS:
-            j = spec.joint(urdf_joint(side, name))
-            effort = efforts[urdf_joint(side, name)]
-            j.name = nm.joint(side, name)
-            j.armature = p.armature
-            j.damping[0] = p.joint_damping  # MuJoCo 4: (linear, quadratic, cubic) coefficients
-            body = j.parent
-            body.name = nm.link_body(side, name)
-            kp = effort / p.servo_saturation
-            act = spec.add_actuator(
-                name=nm.actuator(side, name),
-                target=nm.joint(side, name),
-                trntype=mujoco.mjtTrn.mjTRN_JOINT,
-            )
-            act.set_to_position(kp=kp, kv=kp * p.servo_damping_time)
-            act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
-            act.forcerange = [-effort, effort]
-        foot = spec.body(nm.foot_body(side))
-        r = G1_SPHERE_RADIUS
-        for k, pos in enumerate(_sole_corners()):
-            foot.add_geom(
-                name=nm.corner_geom(side, k),
-                type=mujoco.mjtGeom.mjGEOM_SPHERE,
-                size=[r, 0, 0],
-                pos=list(pos),
-                rgba=dark,
-                friction=[p.friction, 0.02, 0.002],
-                solref=[0.004, 1.0],
-                group=nm.ROBOT_GROUP,
-                **robot_col,
-            )
-        sole_z = G1_SPHERE_Z - r
-        dx, _ = p.ankle_offset
-        foot.add_site(name=nm.sole_site(side), pos=[dx, 0.0, sole_z], size=[0.01, 0, 0])
-        foot.add_geom(
-            name=nm.foot_geom(side),
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            pos=[dx, 0.0, sole_z + 0.01],
-            size=[p.foot_length / 2, G1_TOE_HALF_WIDTH + r, 0.01],
-            rgba=dark,
-            **visual,
+
+def _add_leg(mujoco: Any, spec: Any, p: G1Model, side: Side, efforts: dict[str, float]) -> None:
+    """The ``side`` leg's joints and position servos renamed as ours, and its foot's contact
+    spheres, sole site and visual sole box."""
+    for name in nm.LEG_JOINTS:
+        j = spec.joint(urdf_joint(side, name))
+        effort = efforts[urdf_joint(side, name)]
+        j.name = nm.joint(side, name)
+        j.armature = p.armature
+        j.damping[0] = p.joint_damping  # MuJoCo 4: (linear, quadratic, cubic) coefficients
+        body = j.parent
+        body.name = nm.link_body(side, name)
+        kp = effort / p.servo_saturation
+        act = spec.add_actuator(
+            name=nm.actuator(side, name),
+            target=nm.joint(side, name),
+            trntype=mujoco.mjtTrn.mjTRN_JOINT,
         )
-    # a stick figure for videos: a capsule from each body to each of its children
+        act.set_to_position(kp=kp, kv=kp * p.servo_damping_time)
+        act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        act.forcerange = [-effort, effort]
+    foot = spec.body(nm.foot_body(side))
+    r = G1_SPHERE_RADIUS
+    for k, pos in enumerate(_sole_corners()):
+        foot.add_geom(
+            name=nm.corner_geom(side, k),
+            type=mujoco.mjtGeom.mjGEOM_SPHERE,
+            size=[r, 0, 0],
+            pos=list(pos),
+            rgba=_DARK,
+            friction=[p.friction, 0.02, 0.002],
+            solref=[0.004, 1.0],
+            group=nm.ROBOT_GROUP,
+            **_ROBOT_COL,
+        )
+    sole_z = G1_SPHERE_Z - r
+    dx, _ = p.ankle_offset
+    foot.add_site(name=nm.sole_site(side), pos=[dx, 0.0, sole_z], size=[0.01, 0, 0])
+    foot.add_geom(
+        name=nm.foot_geom(side),
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        pos=[dx, 0.0, sole_z + 0.01],
+        size=[p.foot_length / 2, G1_TOE_HALF_WIDTH + r, 0.01],
+        rgba=_DARK,
+        **_VISUAL,
+    )
+
+
+def _add_sticks(mujoco: Any, spec: Any) -> None:
+    """A stick figure for videos: a capsule from each body to each of its children."""
     for body in spec.bodies:
         if body.name in ("world", nm.PELVIS_BODY) or body.parent is None:
             continue
@@ -330,10 +348,9 @@ def g1_spec(params: G1Model | None = None) -> Any:
                 type=mujoco.mjtGeom.mjGEOM_CAPSULE,
                 fromto=[0.0, 0.0, 0.0, *d.tolist()],
                 size=[LINK_RADIUS, 0, 0],
-                rgba=grey,
-                **visual,
+                rgba=_GREY,
+                **_VISUAL,
             )
-    return spec
 
 
 @functools.cache

@@ -2,17 +2,18 @@
 
 A ~30 kg humanoid lower body for document 000's validation (section 5.5): a pelvis carrying a torso
 box, two 6-DoF legs (hip yaw / roll / pitch, knee, ankle pitch / roll, axes as in
-:data:`footfall.sim.biped.names.LEG_JOINT_AXES`) and flat rectangular feet. The ankle axes sit straight above the
-sole centre, which is the footstep point of the planner and the ALIP contact point. Each foot
-touches the ground through four small spheres at the sole corners; the foot box is visual only.
-Joints are driven by position actuators (PD servos).
+:data:`footfall.sim.biped.names.LEG_JOINT_AXES`) and flat rectangular feet. The ankle axes sit
+straight above the sole centre, which is the footstep point of the planner and the ALIP contact
+point. Each foot touches the ground through four small spheres at the sole corners; the foot box is
+visual only. Joints are driven by position actuators (PD servos).
 
 The planner's :class:`~footfall.models.biped.BipedParams` are *derived* from this model
 (:func:`planner_params`): mass and CoM height come from MuJoCo at the nominal walking posture.
 
 MuJoCo notes (as for the quadruped): angles in radians need ``<compiler angle="radian"/>``; robot
-geoms collide only with terrain through the contype/conaffinity bits of :mod:`footfall.sim.biped.names`;
-``cone="elliptic"`` with a high ``impratio`` keeps the feet from creeping on the slope.
+geoms collide only with terrain through the contype/conaffinity bits of
+:mod:`footfall.sim.biped.names`; ``cone="elliptic"`` with a high ``impratio`` keeps the feet from
+creeping on the slope.
 """
 
 from __future__ import annotations
@@ -25,32 +26,21 @@ import numpy as np
 
 from footfall._typing import FloatArray
 from footfall._validate import non_negative, positive
+from footfall.control.adjusters import U_MAX_FOOT_SHARE
 from footfall.errors import FootfallError, InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.sim._mjcf import SimSettings, box_inertia, fmt, rod_inertia
 from footfall.sim.biped import names as nm
 
-#: share of the half foot width the planner's ankle-torque bound may use: U_max = share * m g * w/2
-#: keeps the planned ZMP (eq. 5.12d) inside the sole in every direction, with a margin
-U_MAX_FOOT_SHARE = 0.8
 #: the planner's swing bound L_swing for this biped [m] (``PlannerOptions.swing_max``, beyond the
-#: document; :func:`footfall.experiments.compare_mujoco.plan_for_walk` uses it): the longest swing this
-#: biped has walked. Measured (walker of 6f8c4b6, plans with ``reach_both_frames``): the swings
-#: of walks that reached the goal were at most 0.684 m (flat, N = 8) and 0.611 m (discrete_steps
-#: N = 16); the N = 13 plan of the one-frame reach swings 0.60-0.71 m and falls. 0.70 m keeps
-#: 0.684 m inside the inscribed 16-gon. Tighter bounds did not walk better on discrete_steps
-#: (goal reached without a push and with 6 seeds of 10 and 20 N each: 0.55-0.60 m: N = 16,
-#: 1 of 13, 10 falls; 0.50 m: N = 17, 12 of 13; 0.45 m: N = 18, 13 of 13; 0.70 m: N = 16,
-#: 13 of 13) and 0.50 m made the turn fall, so the bound is the measured range, not a tuning
-#: knob.
+#: document; :func:`footfall.sim.biped.plans.plan_for_walk` uses it): the longest swing this biped
+#: has walked (the measured range, benchmarks/RESULTS.md "Biped walk"), not a tuning knob
 SWING_MAX = 0.70
 
 #: Heading segments L (eq. 5.12g-h) of the robot-aware miqcqp / kinematic plans this biped walks
 #: (the document's problem and the :class:`PlannerOptions` default: 16). See
-#: :func:`footfall.experiments.compare_mujoco.plan_for_walk`: with 16, straight plans with both reach
-#: frames alternate 0.12 and 0.24 m wide steps and drift sideways, and the stairs walks fell at
-#: the step-downs (stairs_slope_gap N = 16-20 all fell); with 64 the smallest N (16) reaches the
-#: goal.
+#: :func:`footfall.sim.biped.plans.plan_for_walk`: with 16, straight plans with both reach frames
+#: alternate narrow and wide steps and drift sideways.
 WALK_HEADING_SEGMENTS = 64
 
 

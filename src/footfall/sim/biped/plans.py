@@ -26,7 +26,7 @@ from footfall.sim.biped.model import (
     WalkerModel,
     planner_params,
 )
-from footfall.sim.biped.walk import RISER_LANDING_TOLERANCE, WalkOptions
+from footfall.sim.biped.options import RISER_LANDING_TOLERANCE, WalkOptions
 from footfall.sim.pushes import Push
 from footfall.terrain.edges import inset_riser_edges
 from footfall.terrain.scene import Scene

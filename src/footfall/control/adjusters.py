@@ -1,0 +1,444 @@
+"""Footstep / ankle-torque sources of a walking controller (document 000, eq. 5.10, 5.12, 5.19).
+
+A walking controller asks its :class:`FootstepAdjuster` once per control tick for the next
+footstep and the ankle torque to apply now, given the measured ALIP state (eq. 5.1) about the
+stance foot. :class:`PlanFollower` follows the plan's footsteps and torques with one-step ALIP foot
+placement (through the reset map, eq. 5.10) and capture-point feedback; :class:`MPCAdjuster`
+re-solves the MPC of eq. (5.19) every tick. Both keep the footstep inside its planned region and
+freeze it late in the swing. Arrays in, arrays out: nothing here knows about a simulator.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Protocol
+
+import numpy as np
+
+from footfall._geometry import inset_polygon
+from footfall._typing import FloatArray
+from footfall.control.mpc import MPC, MPCWeights, build_mpc
+from footfall.models.biped import BipedParams
+from footfall.planning.plan import FootstepPlan
+from footfall.terrain.region import Region
+
+#: extra footsteps after the plan's last one, onto the plan's final footholds (the goal stance),
+#: corrected by foot placement toward zero momentum: they absorb the momentum the walk ends with
+#: and finish a walk whose last steps the MPC shortened
+STOP_STEPS = 2
+#: share of the half foot width the planner's ankle-torque bound may use: U_max = share * m g * w/2
+#: keeps the planned ZMP (eq. 5.12d) inside the sole in every direction, with a margin
+U_MAX_FOOT_SHARE = 0.8
+#: share of the sole's contact rectangle the commanded ankle torque may use (CoP margin)
+SOLE_TORQUE_SHARE = 0.9
+#: corrected footsteps stay this far inside the reach trapezoid [m]; the planners use its
+#: boundary (the first lateral step of the reactive plan lies on it), so no margin
+REACH_MARGIN = 0.0
+
+
+class FootstepAdjuster(Protocol):
+    """Source of the next footstep and the ankle torque, called once per control tick.
+
+    This is where the MPC of document 000 eq. (5.19) plugs in: it receives the measured ALIP state
+    of the current single support and returns the (re-optimised) next footstep and the torque to
+    apply now.
+    """
+
+    def update(
+        self, t: float, state: FloatArray, stance: FloatArray, phase: int
+    ) -> tuple[FloatArray, FloatArray]:
+        """One control tick.
+
+        Args:
+            t: time since the start of single-support phase ``phase`` [s], in [0, T_ss).
+            state: measured ALIP state ``[x_c, y_c, L_x, L_y]`` (4,) relative to the stance
+                sole centre [m, m, kg m^2/s, kg m^2/s] (eq. 5.1).
+            stance: measured stance sole centre (3,) [m], world frame.
+            phase: single-support phase index i (stance on footstep i of the plan).
+
+        Returns:
+            ``(next_footstep (3,) [m] world, ankle torque (2,) [N m])`` with the torque in the
+            ALIP convention (ground on robot, ZMP = stance + (-tau_y, tau_x) / (m g)).
+        """
+        ...
+
+
+def extend_plan(plan: FootstepPlan, extra: int = STOP_STEPS) -> FootstepPlan:
+    """``plan`` with ``extra`` stopping steps appended (each foot steps onto its last foothold).
+
+    Their ALIP states and torques are zero (the CoM at rest over the stance foot): as a foot
+    placement reference this asks to end the next phase with zero momentum, i.e. to capture the
+    remaining motion.
+    """
+    if extra <= 0:
+        return plan
+    n = plan.n_steps
+    idx = [n - 1 + (j % 2) for j in range(extra)]
+    k = plan.states.shape[1]
+    return replace(
+        plan,
+        footsteps=np.vstack([plan.footsteps, plan.footsteps[idx]]),
+        headings=np.concatenate([plan.headings, plan.headings[idx]]),
+        sides=plan.sides + tuple(plan.sides[i] for i in idx),
+        regions=plan.regions + tuple(plan.regions[i] for i in idx),
+        states=np.concatenate([plan.states, np.zeros((extra, k, 4))]),
+        torques=np.concatenate([plan.torques, np.zeros((extra, k - 1, 2))]),
+    )
+
+
+def _point_in_region(region: Region, xy: FloatArray, margin: float) -> bool:
+    return float(region.signed_distance(xy)) <= -margin
+
+
+@dataclass
+class PlanFollower:
+    """Built-in source: the plan's footsteps and ALIP torques plus one-step foot placement.
+
+    The torque is the plan's zero-order-hold torque of the current node interval (eq. 5.12b). The
+    footstep correction is the one-step ALIP foot placement of Gong & Grizzle: the measured state
+    is predicted to the end of the phase with the planned torques, and the next footstep moves by
+    the ``dp`` that cancels the resulting angular-momentum error at the end of the *next* single
+    support (through the reset map, eq. 5.10: ``L`` after the next phase is linear in ``dp``).
+    The corrected footstep is kept inside the planned region (``region_margin`` from its edges),
+    its height is that region's plane, and it is frozen for the last ``1 - freeze_after`` of the
+    swing so the landing is not chased.
+
+    Attributes:
+        plan: the footstep plan.
+        regions: the scene's regions by name.
+        gain: share of the computed correction that is applied (0 = follow the plan exactly).
+        max_correction: bound on the correction's length [m].
+        region_margin: the corrected footstep stays this far inside its region [m].
+        freeze_after: phase share after which the footstep is frozen.
+        dcm_gain: gain of the capture-point feedback on the ZMP (0 = planned torque only).
+        stop_steps: stopping steps appended to the plan (:func:`extend_plan`); the walker asks
+            for phases up to ``N + stop_steps - 1``.
+        capture_stop: place the final footstep by the capture point (:meth:`stop_target`)
+            instead of the plan's: the walk must end with the divergent component of motion
+            between the feet, whatever the plan's final state was.
+        limit_reach: project every corrected footstep into the reach trapezoid (the capture-point
+            final step always is, so the robot ends in a legal stance). Off by default: the
+            MuJoCo walker's lateral recovery needs steps narrower than the trapezoid's minimum
+            width.
+        reach_margin: with ``limit_reach``, every corrected footstep stays this far inside the
+            reach trapezoid of the measured stance foot (``BipedParams.reach``) [m].
+    """
+
+    plan: FootstepPlan
+    regions: dict[str, Region]
+    gain: float = 1.0
+    max_correction: float = 0.12
+    region_margin: float = 0.05
+    freeze_after: float = 0.7
+    dcm_gain: float = 2.5
+    stop_steps: int = STOP_STEPS
+    capture_stop: bool = True
+    limit_reach: bool = False
+    reach_margin: float = REACH_MARGIN
+    _frozen: dict[int, FloatArray] = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        self.plan = extend_plan(self.plan, self.stop_steps)
+        robot = self.plan.robot
+        self._alip = robot.alip()
+        self._dt = robot.node_dt
+        self._ad, self._bd = self._alip.discretize(self._dt)
+        a_r, b_r = self._alip.reset_map(robot.t_ds)
+        ad_ss = np.linalg.matrix_power(self._ad, robot.n_nodes - 1)
+        self._to_next_end = ad_ss @ a_r  # end-of-phase state -> end of next phase (dp = 0)
+        self._dp_to_next_end = (ad_ss @ b_r)[2:4, 0:2]  # dp (x, y) -> L at end of next phase
+        self._dp_inv = np.linalg.inv(self._dp_to_next_end)
+
+    def torque(self, t: float, phase: int) -> FloatArray:
+        """Planned torque (2,) [N m] of ``phase`` at time ``t`` in it (zero-order hold)."""
+        k = min(int(t / self._dt), self.plan.torques.shape[1] - 1)
+        return np.array(self.plan.torques[phase, k])
+
+    def predict_end(self, t: float, state: FloatArray, phase: int) -> FloatArray:
+        """Measured ``state`` at ``t`` propagated to the end of the phase with planned torques."""
+        k = min(int(t / self._dt), self.plan.torques.shape[1] - 1)
+        # partial interval first, then the remaining whole node intervals
+        rest = (k + 1) * self._dt - t
+        a_p, b_p = self._alip.discretize(rest) if rest > 1e-9 else (np.eye(4), np.zeros((4, 2)))
+        x = a_p @ state + b_p @ self.plan.torques[phase, k]
+        for j in range(k + 1, self.plan.torques.shape[1]):
+            x = self._ad @ x + self._bd @ self.plan.torques[phase, j]
+        return np.asarray(x)
+
+    def planned_state(self, t: float, phase: int) -> FloatArray:
+        """The plan's ALIP state (4,) at ``t`` in ``phase`` (exact ZOH from the previous node)."""
+        k = min(int(t / self._dt), self.plan.torques.shape[1] - 1)
+        a_p, b_p = self._alip.discretize(max(t - k * self._dt, 1e-9))
+        return np.asarray(a_p @ self.plan.states[phase, k] + b_p @ self.plan.torques[phase, k])
+
+    def dcm_torque(self, t: float, state: FloatArray, phase: int) -> FloatArray:
+        """Planned torque plus divergent-component-of-motion feedback (capture point tracking).
+
+        With ``xi = c + v / omega`` the ALIP obeys ``xi' = omega (xi - zmp)``; the ZMP command
+        ``zmp_plan + dcm_gain (xi - xi_plan)`` makes the error decay as
+        ``exp(omega (1 - dcm_gain) t)``.
+        """
+        u = self.torque(t, phase)
+        if self.dcm_gain <= 0.0:
+            return u
+        omega = self._alip.omega
+        ref = self.planned_state(t, phase)
+        xi = state[:2] + self._alip.velocity(state) / omega
+        xi_ref = ref[:2] + self._alip.velocity(ref) / omega
+        zmp = self._alip.zmp(np.zeros(2), u) + self.dcm_gain * (xi - xi_ref)
+        return np.asarray(self._alip.torque_for_zmp(zmp))
+
+    def update(
+        self, t: float, state: FloatArray, stance: FloatArray, phase: int
+    ) -> tuple[FloatArray, FloatArray]:
+        """See :class:`FootstepAdjuster`."""
+        plan = self.plan
+        ref_next = np.array(plan.footsteps[phase + 1])
+        u = self.dcm_torque(t, state, phase)
+        if phase in self._frozen:
+            return self._frozen[phase], u
+        # the plan's footstep relative to where the stance foot really is
+        target = ref_next.copy()
+        if self.capture_stop and phase == plan.n_steps - 1:
+            target[:2] = self.stop_target(t, state, stance, phase, u)
+            target = self._limit_reach(target, stance, phase)
+            target = self._clamp_to_region(target, ref_next, plan.regions[phase + 1])
+        elif self.gain > 0.0:
+            x_end = self.predict_end(t, state, phase)
+            err = self._to_next_end @ (x_end - plan.states[phase, -1])
+            # The reset acts on the step p_{i+1} - p_i: if the robot stands off its planned
+            # footstep by s, keeping the planned step vector needs dp = s. The foot-placement
+            # term then cancels the angular-momentum error at the end of the next phase.
+            shift = (stance - plan.footsteps[phase])[:2]
+            fb = -self.gain * (self._dp_inv @ err[2:4])
+            norm = float(np.linalg.norm(fb))
+            if norm > self.max_correction:
+                fb *= self.max_correction / norm
+            target[:2] = ref_next[:2] + shift + fb
+            target = self._legal(target, ref_next, stance, phase)
+        return self._maybe_freeze(t, phase, target), u
+
+    def _legal(
+        self, target: FloatArray, ref_next: FloatArray, stance: FloatArray, phase: int
+    ) -> FloatArray:
+        """``target`` in the reach trapezoid (with ``limit_reach``) and in its planned region."""
+        if self.limit_reach:
+            target = self._limit_reach(target, stance, phase)
+        return self._clamp_to_region(target, ref_next, self.plan.regions[phase + 1])
+
+    def _maybe_freeze(self, t: float, phase: int, target: FloatArray) -> FloatArray:
+        """Freeze the footstep of ``phase`` once ``t`` passes ``freeze_after`` of T_ss."""
+        if t >= self.freeze_after * self.plan.robot.t_ss:
+            self._frozen[phase] = target
+        return target
+
+    def stop_target(
+        self, t: float, state: FloatArray, stance: FloatArray, phase: int, u: FloatArray
+    ) -> FloatArray:
+        """Final footstep (x, y) [m] that leaves the capture point midway between the feet.
+
+        The measured state is propagated to the end of the phase with the torque ``u`` of this
+        tick held (the ankle's, clipped to the sole). In the following double support the
+        contact point moves linearly from the stance foot to the new foot ``d`` away (eq. 5.8);
+        the divergent component ``xi = c + v / omega`` then ends at
+        ``e^(w) xi_0 - d (e^(w) - 1 - w) / w`` with ``w = omega T_ds``. Asking it to end at the
+        feet's midpoint ``d / 2`` gives ``d``: the robot can then shift its CoM between its feet
+        and stand.
+        """
+        robot = self.plan.robot
+        alip = self._alip
+        sole_half = SOLE_TORQUE_SHARE * np.array([robot.foot_length / 2, robot.foot_width / 2])
+        zmp = np.clip(alip.zmp(np.zeros(2), u), -sole_half, sole_half)
+        u_hold = alip.torque_for_zmp(zmp)
+        rest = max(robot.t_ss - t, 0.0)
+        a_p, b_p = alip.discretize(rest) if rest > 1e-9 else (np.eye(4), np.zeros((4, 2)))
+        x_end = a_p @ state + b_p @ u_hold
+        xi = x_end[:2] + alip.velocity(x_end) / alip.omega
+        w = alip.omega * robot.t_ds
+        d = math.exp(w) * xi / (0.5 + (math.exp(w) - 1.0 - w) / w)
+        return np.asarray(stance[:2] + d)
+
+    def _limit_reach(self, target: FloatArray, stance: FloatArray, phase: int) -> FloatArray:
+        """``target`` moved into the reach trapezoid of the measured stance foot (eq. 5.12f)."""
+        robot = self.plan.robot
+        side = self.plan.sides[phase]
+        rot = _rot2(float(self.plan.headings[phase]))
+        q = rot.T @ (target[:2] - stance[:2])
+        poly = shrink_polygon(robot.reach.for_stance(side), self.reach_margin)
+        q = project_to_polygon(q, poly)
+        out = np.array(target, dtype=float)
+        out[:2] = stance[:2] + rot @ q
+        return out
+
+    def _clamp_to_region(self, target: FloatArray, ref: FloatArray, name: str) -> FloatArray:
+        region = self.regions.get(name)
+        if region is None:
+            return ref
+        xy = target[:2]
+        if not _point_in_region(region, xy, self.region_margin):
+            if not _point_in_region(region, ref[:2], self.region_margin):
+                # the plan's own footstep is nearer the edge than the margin: the nearest point
+                # of the region moved in by the margin (the plan's footstep if there is none)
+                inner = inset_polygon(region.vertices, self.region_margin)
+                if inner is None:
+                    return ref
+                xy = project_to_polygon(xy, inner)
+                return np.array([xy[0], xy[1], float(region.height_at(xy))])
+            # bisect on the segment from the planned footstep (inside) to the corrected one
+            lo, hi = 0.0, 1.0
+            for _ in range(20):
+                mid = 0.5 * (lo + hi)
+                if _point_in_region(region, ref[:2] + mid * (xy - ref[:2]), self.region_margin):
+                    lo = mid
+                else:
+                    hi = mid
+            xy = ref[:2] + lo * (xy - ref[:2])
+        return np.array([xy[0], xy[1], float(region.height_at(xy))])
+
+
+@dataclass
+class MPCAdjuster(PlanFollower):
+    """The MPC of document 000 eq. (5.19) as the walking controller's footstep / torque source.
+
+    Every control tick of a single support it solves eq. (5.19) from the measured ALIP state:
+    the remaining ankle torques and the next footstep, tracking the plan's next footstep (W) and
+    the plan's state after the next reset (Q_f). The footstep is then kept in its planned region
+    and frozen late in the swing as for :class:`PlanFollower` (whose helpers it reuses); the
+    torque of the current tick is applied by the stance ankle.
+
+    Attributes:
+        control_dt: the walker's control period [s] (the MPC runs once per tick).
+        weights: MPC weights.
+        freeze_after: as for :class:`PlanFollower`, later by default: the MPC's footstep keeps
+            improving late in the swing, and freezing early left every footstep short.
+        capture_stop: off: the MPC's terminal term (Q_f toward the plan's final state at rest)
+            places the last footstep.
+        torque_limits: semi-axes ``(U_x, U_y)`` [N m] of the MPC's torque ellipse
+            (:func:`footfall.control.mpc.build_mpc`); None = the plan's ``U_max`` ball
+            (eq. 5.19e). The MuJoCo walker passes :func:`sole_torque_limits`.
+        hold_frozen: once the footstep is frozen, keep applying the torque of the solution it
+            was frozen with (the MPC's torque block is the plan's node interval, so that solution
+            already holds one torque for the rest of the single support) instead of re-solving.
+            Re-solving with the footstep free returns torques for a footstep the swing foot no
+            longer goes to; re-solving with it fixed, with a few ticks left the torque barely
+            moves the state and the solve spends the whole torque ellipse on it.
+        footstep_in_region: solve the MPC with the next footstep kept in its planned region
+            (``region_margin`` inside, :meth:`footfall.control.mpc.MPC.solve_in_polygon`)
+            instead of clamping the document's unconstrained footstep afterwards, so the ankle
+            torque makes up for a correction the region does not allow.
+    """
+
+    control_dt: float = 0.01
+    freeze_after: float = 0.9
+    weights: MPCWeights = field(default_factory=MPCWeights)
+    capture_stop: bool = False
+    torque_limits: tuple[float, float] | None = None
+    footstep_in_region: bool = True
+    hold_frozen: bool = True
+    mpc: MPC = field(init=False, repr=False)
+    _frozen_torque: dict[int, FloatArray] = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        mdl = build_mpc(self.plan.robot, self.weights, self.control_dt, None, self.torque_limits)
+        self.mpc = MPC(mdl)
+
+    def update(
+        self, t: float, state: FloatArray, stance: FloatArray, phase: int
+    ) -> tuple[FloatArray, FloatArray]:
+        """See :class:`FootstepAdjuster`."""
+        plan = self.plan
+        mdl = self.mpc.model
+        k_s = min(max(round(t / mdl.control_dt), 0), mdl.n_ticks - 1)
+        ref_next = np.array(plan.footsteps[phase + 1])
+        x_next = plan.states[phase + 1, 0] if phase + 1 < plan.n_steps else plan.final_state
+        # Solve in the stance foot's heading frame: the ALIP and the cost are isotropic, so this
+        # changes nothing but the orientation of the torque ellipse, whose long axis must lie
+        # along the sole.
+        rot = _rot2(float(plan.headings[phase]))
+        rot4 = np.kron(np.eye(2), rot)
+        region = self.regions.get(plan.regions[phase + 1])
+        args = (
+            k_s,
+            rot4.T @ state,
+            _rotate_xy(rot.T, stance),
+            _rotate_xy(rot.T, ref_next),
+            rot4.T @ x_next,
+        )
+        if phase in self._frozen and self.hold_frozen:
+            return self._frozen[phase], self._frozen_torque[phase]
+        if self.footstep_in_region and region is not None and phase not in self._frozen:
+            a, b = region.halfspaces()
+            sol = self.mpc.solve_in_polygon(*args, a @ rot, b - self.region_margin)
+        else:
+            sol = self.mpc.solve(*args)
+        u = rot @ sol.torques[0]
+        if phase in self._frozen:
+            return self._frozen[phase], u
+        if self.capture_stop and phase == plan.n_steps - 1:
+            target = np.array(ref_next)
+            target[:2] = self.stop_target(t, state, stance, phase, u)
+        else:
+            target = _rotate_xy(rot, sol.next_footstep)
+        target = self._legal(target, ref_next, stance, phase)
+        target = self._maybe_freeze(t, phase, target)
+        if phase in self._frozen:
+            self._frozen_torque[phase] = u
+        return target, u
+
+
+def _rot2(theta: float) -> FloatArray:
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s], [s, c]])
+
+
+def _rotate_xy(rot: FloatArray, p: FloatArray) -> FloatArray:
+    """``p`` (3,) with its horizontal part multiplied by ``rot`` (2, 2); height unchanged."""
+    out = np.array(p, dtype=float)
+    out[:2] = rot @ out[:2]
+    return out
+
+
+def sole_torque_limits(robot: BipedParams) -> tuple[float, float]:
+    """Ankle torque semi-axes ``(U_x, U_y)`` [N m] that keep the CoP on the sole.
+
+    ``U_MAX_FOOT_SHARE`` of the weight times half the sole width (roll torque ``u_x`` moves the
+    CoP across the foot) and half the sole length (pitch torque ``u_y`` moves it along). The
+    planner keeps the document's smaller ball ``U_max`` (a cost on torque as much as a limit);
+    the walker's MPC may use the sole's length.
+    """
+    weight = U_MAX_FOOT_SHARE * robot.mass * robot.g
+    return (weight * robot.foot_width / 2.0, weight * robot.foot_length / 2.0)
+
+
+def shrink_polygon(vertices: FloatArray, margin: float) -> FloatArray:
+    """Convex CCW polygon (n, 2) moved ``margin`` [m] inward toward its centroid (scaled).
+
+    Scaling about the centroid is enough for the reach trapezoid (a small margin, a fat shape);
+    a margin larger than the polygon leaves its centroid.
+    """
+    v = np.asarray(vertices, dtype=float)
+    c = v.mean(axis=0)
+    r = float(np.min(np.linalg.norm(v - c, axis=1)))
+    scale = max(0.0, 1.0 - margin / r) if r > 0 else 0.0
+    return np.asarray(c + (v - c) * scale)
+
+
+def project_to_polygon(q: FloatArray, vertices: FloatArray) -> FloatArray:
+    """Closest point (2,) of a convex CCW polygon (n, 2) to ``q`` (itself when inside)."""
+    v = np.asarray(vertices, dtype=float)
+    nxt = np.roll(v, -1, axis=0)
+    edge = nxt - v
+    # inside when left of every CCW edge
+    cross = edge[:, 0] * (q[1] - v[:, 1]) - edge[:, 1] * (q[0] - v[:, 0])
+    if np.all(cross >= 0.0):
+        return np.array(q, dtype=float)
+    best, best_d = np.array(q, dtype=float), math.inf
+    for a, e in zip(v, edge, strict=True):
+        s = float(np.clip((q - a) @ e / (e @ e), 0.0, 1.0))
+        p = a + s * e
+        dist = float(np.linalg.norm(q - p))
+        if dist < best_d:
+            best, best_d = p, dist
+    return best

@@ -1,0 +1,185 @@
+"""Options of the MuJoCo biped's walking controller (:mod:`footfall.sim.biped.walk`) and the checks
+of what it is asked to walk."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from footfall._validate import non_negative, positive
+from footfall.control.adjusters import STOP_STEPS
+from footfall.errors import InputError
+from footfall.models.biped import BipedParams
+from footfall.planning.plan import FootstepPlan
+from footfall.sim.biped.model import BipedModel, WalkerModel, measure_model
+from footfall.sim.pushes import Push
+from footfall.terrain.scene import Scene
+
+#: landing error [m] the walk leaves room for at riser edges (:mod:`footfall.terrain.edges`):
+#: landings fall short of their targets, and a heel landing on the edge of the tread above a
+#: step down tips the foot
+RISER_LANDING_TOLERANCE = 0.04
+#: a plan's robot mass and CoM height may differ this much (relative) from the walker model's
+#: (:func:`~footfall.sim.biped.model.planner_params` measures them: 0.0 exactly)
+PLAN_ROBOT_RTOL = 0.01
+
+
+@dataclass(frozen=True)
+class WalkOptions:
+    """Options of the walking controller.
+
+    Attributes:
+        control_dt: control period (measurement, adjuster, reference, IK) [s]; a multiple of the
+            physics step.
+        ik_iterations: differential-IK QP solves per control tick.
+        swing_clearance: height of the swing sole above the highest region it passes over [m].
+        heel_strike: the swing sole turns toe-up by this angle [rad] about its lateral axis
+            (relative to lying flat on the landing region) as it moves, so it touches down heel
+            first and the limp ankle (``passive_landing``) lets it roll flat; beyond the document.
+            A sole landing flat meets the ground toe-first (the IK lags) and the CoP stays at the
+            toe into the next single support. It trades against push recovery (benchmarks/
+            RESULTS.md, "Biped walk"). 0 = land flat.
+        swing_side_gap: the swing sole passes the stance sole at least this far apart sideways
+            [m]: their centres at least the sole width plus this
+            (:func:`~footfall.sim.biped.references.swing_bow`; beyond the
+            document). 0 = straight swing paths.
+        com_feedback: share in [0, 1] by which the ALIP reference is pulled toward the measured
+            state every tick: 0 tracks the planned CoM motion stiffly (the ankle absorbs every
+            error), 1 lets the CoM move as an ALIP from the measured state (errors are corrected
+            only by foot placement and torque).
+        settle_time: standing time before the CoM shifts over the first stance foot [s].
+        shift_time: duration of that shift [s].
+        stop_time: time to bring the CoM to the middle of the final feet after the last step [s].
+        hold_time: standing time at the end [s].
+        pushes: external pushes.
+        stop_steps: stopping steps after the plan
+            (:func:`~footfall.control.adjusters.extend_plan`); the adjuster must answer for phases
+            up to ``N + stop_steps - 1`` (:class:`~footfall.control.adjusters.PlanFollower`
+            does).
+        com_gain: gain of the CoM tracking feedback: the IK's CoM target is the reference plus
+            ``com_gain`` times the horizontal tracking error. Without it the joint servos'
+            compliance lets a robot standing on one foot roll slowly over it.
+        ankle_torque: in single support, drive the stance ankle (pitch and roll) with the ALIP
+            torque instead of a position servo: the sole then lies flat whatever the body does and
+            the CoP is the commanded torque over the weight (the ALIP input, eq. 5.3); the CoM
+            moves as the pendulum it is, with the reference following the measured state
+            (``com_feedback`` = 1 and no ``com_gain`` in single support). False: every joint is
+            position-servoed and the ankle torque is whatever tracking the CoM reference needs.
+        true_momentum: give the adjuster the true angular momentum about the stance point
+            (``L_G + m (c - p) x v``, Gong & Grizzle; eq. 5.1's L) instead of
+            ``m z_H (-v_y, v_x)`` from the CoM velocity: the swing leg and torso carry momentum
+            the CoM velocity does not show.
+        stop_on_fall: end the simulation when a fall is detected.
+        landing_margin: the walker's MPC keeps each footstep this much further inside its region
+            than the plan did (its ``region_margin``, half the sole length for
+            :func:`footfall.sim.biped.plans.plan_for_walk`) [m]: landings fall short of their
+            targets, and a heel over a block's edge on a step down tips the landing foot.
+        riser_tolerance: the MPC keeps each footstep in its region with the riser edges moved
+            in by :func:`footfall.terrain.edges.inset_riser_edges` with this landing tolerance
+            [m] (on top of ``region_margin`` + ``landing_margin``), as
+            :func:`footfall.sim.biped.plans.plan_for_walk` plans; 0 = the regions as they are.
+            Without it the MPC may move a footstep below a riser toward it until the heel lands
+            on the riser's edge.
+        passive_landing: the swing ankle goes limp (torque mode, zero torque) from the first
+            contact of the swing sole during its descent until the double support, where the
+            landing ankle is passive anyway. A stiff position-servoed ankle that meets the ground
+            on the toe holds the foot's angle, and the toe's load lifts the robot and loses
+            angular momentum about the new foot at the reset (eq. 5.10).
+        closed_loop_ik: start the IK from the measured configuration every tick, so the torso
+            orientation, the CoM height and the swing foot are fed back through the joint
+            servos; a torque-driven stance ankle is held at its measured angles and its sole at
+            its measured pose, leaving the horizontal CoM to the pendulum and the adjuster.
+            False: the IK integrates its own kinematic copy (open loop, nothing fed back).
+        check_robot: refuse a plan whose robot mass or CoM height differs by more than
+            ``PLAN_ROBOT_RTOL`` from the walker model's
+            (:func:`~footfall.sim.biped.model.planner_params`): its ALIP motion
+            is then another pendulum's. False walks such a plan on purpose (a mismatch study).
+    """
+
+    control_dt: float = 0.01
+    ik_iterations: int = 2
+    swing_clearance: float = 0.05
+    swing_side_gap: float = 0.03
+    heel_strike: float = math.radians(1.5)
+    com_feedback: float = 0.0
+    settle_time: float = 0.3
+    shift_time: float = 2.0
+    stop_time: float = 1.0
+    hold_time: float = 0.5
+    pushes: tuple[Push, ...] = ()
+    stop_steps: int = STOP_STEPS
+    com_gain: float = 1.5
+    ankle_torque: bool = True
+    true_momentum: bool = True
+    stop_on_fall: bool = True
+    closed_loop_ik: bool = True
+    landing_margin: float = 0.02
+    riser_tolerance: float = RISER_LANDING_TOLERANCE
+    passive_landing: bool = True
+    check_robot: bool = True
+
+    def __post_init__(self) -> None:
+        for name in ("control_dt", "swing_clearance", "shift_time", "stop_time"):
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        for name in (
+            "settle_time",
+            "hold_time",
+            "com_gain",
+            "landing_margin",
+            "swing_side_gap",
+            "heel_strike",
+            "riser_tolerance",
+        ):
+            object.__setattr__(self, name, non_negative(name, getattr(self, name)))
+        fb = non_negative("com_feedback", self.com_feedback)
+        if fb > 1.0:
+            raise InputError("com_feedback", self.com_feedback, "a share in [0, 1]")
+        object.__setattr__(self, "com_feedback", fb)
+        it = self.ik_iterations
+        if isinstance(it, bool) or not isinstance(it, int) or it < 1:
+            raise InputError("ik_iterations", it, "an integer >= 1")
+        pushes = tuple(self.pushes)
+        for i, p in enumerate(pushes):
+            if not isinstance(p, Push):
+                raise InputError(f"pushes[{i}]", p, "a Push")
+        object.__setattr__(self, "pushes", pushes)
+
+
+def _check_plan_robot(robot: BipedParams, model: WalkerModel | None) -> None:
+    """Raise :class:`InputError` when the plan's robot is not the walker model's pendulum (mass
+    and CoM height within ``PLAN_ROBOT_RTOL``, see
+    :func:`~footfall.sim.biped.model.planner_params`)."""
+    info = measure_model(model)
+    name = (model if model is not None else BipedModel()).name
+    for field_name, planned, actual, unit in (
+        ("mass", robot.mass, info.mass, "kg"),
+        ("com_height", robot.com_height, info.com_height, "m"),
+    ):
+        if abs(planned - actual) > PLAN_ROBOT_RTOL * abs(actual):
+            raise InputError(
+                f"plan.robot.{field_name}",
+                planned,
+                f"the {name} model's {actual:.4g} {unit} within {PLAN_ROBOT_RTOL:.0%}: plan with "
+                "footfall.sim.biped.model.planner_params(model) as the robot, or walk a "
+                "mismatched plan on purpose with WalkOptions(check_robot=False)",
+            )
+
+
+def check_walk_inputs(
+    scene: Scene, plan: FootstepPlan, opts: WalkOptions, model: WalkerModel | None
+) -> None:
+    """Raise :class:`InputError` for a plan the walk cannot follow
+    (:func:`footfall.sim.biped.walk.walk` lists why)."""
+    if not plan.has_solution or plan.n_steps < 1:
+        raise InputError("plan", plan.status.value, "a plan with at least one footstep")
+    start_stance = scene.start.stance_foot
+    if np.linalg.norm(plan.footsteps[0] - start_stance) > 1e-6:
+        raise InputError(
+            "plan.footsteps[0]",
+            plan.footsteps[0].tolist(),
+            f"the scene's start stance foot {start_stance.tolist()}",
+        )
+    if opts.check_robot:
+        _check_plan_robot(plan.robot, model)
