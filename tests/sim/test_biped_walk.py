@@ -12,12 +12,11 @@ pytest.importorskip("mink")
 
 from typer.testing import CliRunner  # noqa: E402
 
-from footfall._geometry import inset_polygon  # noqa: E402
+from footfall._geometry import inset_polygon, project_to_polygon  # noqa: E402
 from footfall.cli import app  # noqa: E402
 from footfall.control.adjusters import (  # noqa: E402
     MPCAdjuster,
     PlanFollower,
-    project_to_polygon,
     sole_torque_limits,
 )
 from footfall.errors import FootfallError, InputError  # noqa: E402

@@ -16,7 +16,7 @@ from typing import Protocol
 
 import numpy as np
 
-from footfall._geometry import inset_polygon
+from footfall._geometry import inset_polygon, project_to_polygon, rot2
 from footfall._typing import FloatArray
 from footfall.control.mpc import MPC, MPCWeights, build_mpc
 from footfall.models.biped import BipedParams
@@ -263,7 +263,7 @@ class PlanFollower:
         """``target`` moved into the reach trapezoid of the measured stance foot (eq. 5.12f)."""
         robot = self.plan.robot
         side = self.plan.sides[phase]
-        rot = _rot2(float(self.plan.headings[phase]))
+        rot = rot2(float(self.plan.headings[phase]))
         q = rot.T @ (target[:2] - stance[:2])
         poly = shrink_polygon(robot.reach.for_stance(side), self.reach_margin)
         q = project_to_polygon(q, poly)
@@ -356,7 +356,7 @@ class MPCAdjuster(PlanFollower):
         # Solve in the stance foot's heading frame: the ALIP and the cost are isotropic, so this
         # changes nothing but the orientation of the torque ellipse, whose long axis must lie
         # along the sole.
-        rot = _rot2(float(plan.headings[phase]))
+        rot = rot2(float(plan.headings[phase]))
         rot4 = np.kron(np.eye(2), rot)
         region = self.regions.get(plan.regions[phase + 1])
         args = (
@@ -386,11 +386,6 @@ class MPCAdjuster(PlanFollower):
         if phase in self._frozen:
             self._frozen_torque[phase] = u
         return target, u
-
-
-def _rot2(theta: float) -> FloatArray:
-    c, s = math.cos(theta), math.sin(theta)
-    return np.array([[c, -s], [s, c]])
 
 
 def _rotate_xy(rot: FloatArray, p: FloatArray) -> FloatArray:
@@ -423,22 +418,3 @@ def shrink_polygon(vertices: FloatArray, margin: float) -> FloatArray:
     r = float(np.min(np.linalg.norm(v - c, axis=1)))
     scale = max(0.0, 1.0 - margin / r) if r > 0 else 0.0
     return np.asarray(c + (v - c) * scale)
-
-
-def project_to_polygon(q: FloatArray, vertices: FloatArray) -> FloatArray:
-    """Closest point (2,) of a convex CCW polygon (n, 2) to ``q`` (itself when inside)."""
-    v = np.asarray(vertices, dtype=float)
-    nxt = np.roll(v, -1, axis=0)
-    edge = nxt - v
-    # inside when left of every CCW edge
-    cross = edge[:, 0] * (q[1] - v[:, 1]) - edge[:, 1] * (q[0] - v[:, 0])
-    if np.all(cross >= 0.0):
-        return np.array(q, dtype=float)
-    best, best_d = np.array(q, dtype=float), math.inf
-    for a, e in zip(v, edge, strict=True):
-        s = float(np.clip((q - a) @ e / (e @ e), 0.0, 1.0))
-        p = a + s * e
-        dist = float(np.linalg.norm(q - p))
-        if dist < best_d:
-            best, best_d = p, dist
-    return best
