@@ -51,7 +51,7 @@ STAND_SAG = 0.005
 STAND_DRIFT = 0.01
 STAND_TILT = math.radians(1.0)
 #: short flat walk: mean distance of the landed soles from the commanded footsteps [m] (as for
-#: our biped, test_biped_walk.LANDING_TOL)
+#: our biped, tests.sim.biped.test_walk.LANDING_TOL)
 WALK_LANDING_TOL = 0.06
 #: footsteps of the short flat walk
 WALK_STEPS = 6
