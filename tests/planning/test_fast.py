@@ -1,4 +1,4 @@
-"""The fast planner (``bnb`` backend) solves exactly the direct model's problem.
+"""The ``bnb`` backend (the planner's default) solves exactly the direct model's problem.
 
 Objective equality against the direct SCIP model on small seeded instances (N = 4..6, K = 3), the
 independent checker on every plan, infeasibility detected by both, and unit checks of the
@@ -7,6 +7,7 @@ relaxation (a valid lower bound, exact at a fixed assignment) and of the fallbac
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import ClassVar
@@ -16,10 +17,10 @@ import pytest
 
 from footfall.models.biped import BipedParams
 from footfall.planning.check import check_plan
-from footfall.planning.fast import FAST_SOLVER, plan_footsteps_fast
 from footfall.planning.miqcqp import build_footstep_problem, plan_footsteps
 from footfall.planning.plan import PlannerOptions
 from footfall.solvers import ProblemBuilder, SolverOptions, SolveStatus, bnb, solve
+from footfall.solvers.bnb import BnbSettings
 from footfall.solvers.problem import MIQCQP, fix_variables
 from footfall.terrain.scene import random_stepping_stones
 
@@ -31,15 +32,15 @@ OBJ_RTOL = 3 * GAP
 BOUND_RTOL = 1e-7
 
 ROBOT = BipedParams(n_nodes=3)
+#: the default settings of the search (tolerances, drain timeout)
+DEFAULTS = BnbSettings()
+#: probing at the root of every search (small searches never reach it), without a budget
+PROBING = BnbSettings(probe_after=0, probe_budget=math.inf)
+#: no probing
+NO_PROBING = BnbSettings(probe_rounds=0)
 
 # (regions, seed, steps): feasible small instances where SCIP finishes in seconds
 CASES = [(4, 0, 4), (4, 1, 4), (5, 0, 5), (5, 1, 5), (5, 2, 6), (5, 3, 6), (6, 0, 6)]
-
-
-def _force_probing(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Probe at the root of every search (small searches never reach it), without a budget."""
-    monkeypatch.setattr(bnb, "PROBE_AFTER", 0)
-    monkeypatch.setattr(bnb, "PROBE_BUDGET", math.inf)
 
 
 def _scene(regions: int, seed: int):  # type: ignore[no-untyped-def]
@@ -47,21 +48,19 @@ def _scene(regions: int, seed: int):  # type: ignore[no-untyped-def]
 
 
 @pytest.mark.parametrize(("regions", "seed", "n"), CASES)
-def test_fast_objective_equals_direct(
-    regions: int, seed: int, n: int, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_fast_objective_equals_direct(regions: int, seed: int, n: int) -> None:
     scene = _scene(regions, seed)
     opts = PlannerOptions(gap=GAP, time_limit=60.0)
-    direct = plan_footsteps(scene, ROBOT, n, opts)
-    fast = plan_footsteps_fast(scene, ROBOT, n, opts)
+    direct = plan_footsteps(scene, ROBOT, n, dataclasses.replace(opts, solver="scip"))
+    assert direct.solver == "scip"
+    fast = plan_footsteps(scene, ROBOT, n, dataclasses.replace(opts, solver="bnb"))
     # these searches are too small to reach probing: force it at the root (and its heuristics)
-    _force_probing(monkeypatch)
-    probed = plan_footsteps_fast(scene, ROBOT, n, opts)
+    probed = plan_footsteps(scene, ROBOT, n, dataclasses.replace(opts, solver="bnb", bnb=PROBING))
     assert probed.stats["probes"] > 0
     assert direct.status is SolveStatus.OPTIMAL, direct.message
     for plan in (fast, probed):
         assert plan.status is SolveStatus.OPTIMAL, plan.message
-        assert plan.solver == FAST_SOLVER
+        assert plan.solver == "bnb"
         assert plan.objective == pytest.approx(direct.objective, rel=OBJ_RTOL)
     for plan in (direct, fast, probed):
         report = check_plan(plan, scene)
@@ -85,21 +84,20 @@ def test_infeasible_detected_by_both() -> None:
     res_direct = solve(fp.problem, "scip", SolverOptions(time_limit=60.0))
     assert res_fast.status is SolveStatus.INFEASIBLE
     assert res_direct.status is SolveStatus.INFEASIBLE
-    plan = plan_footsteps_fast(scene, ROBOT, 5)
+    plan = plan_footsteps(scene, ROBOT, 5, PlannerOptions(solver="bnb"))
     assert plan.status is SolveStatus.INFEASIBLE
     assert plan.message.startswith("infeasible")
     assert not check_plan(plan, scene).ok
 
 
-def test_unsolvable_node_relaxations_are_an_error_that_says_so(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_unsolvable_node_relaxations_are_an_error_that_says_so() -> None:
     """Clarabel stopping early on every node (one iteration allowed, also in the retry) must
     not read as infeasible: the plan says how many nodes failed and with which status."""
-    monkeypatch.setattr(bnb, "CLARABEL_SETTINGS", {**bnb.CLARABEL_SETTINGS, "max_iter": 1})
-    monkeypatch.setattr(bnb, "CLARABEL_RETRY_SETTINGS", {"max_iter": 1})
+    one_step = BnbSettings(
+        clarabel=(*DEFAULTS.clarabel, ("max_iter", 1)), clarabel_retry=(("max_iter", 1),)
+    )
     scene = _scene(4, 0)
-    plan = plan_footsteps_fast(scene, ROBOT, 4, PlannerOptions(time_limit=30.0))
+    plan = plan_footsteps(scene, ROBOT, 4, PlannerOptions(time_limit=30.0, bnb=one_step))
     assert plan.status is SolveStatus.ERROR
     assert plan.stats["failed_nodes"] == {"MaxIterations": plan.stats["nodes"]}
     assert "infeasibility not proven" in plan.message
@@ -154,17 +152,14 @@ def test_fixed_binaries_are_respected() -> None:
 
 
 @pytest.mark.parametrize("probe_at_root", [False, True])
-def test_time_limit_returns_an_honest_gap(
-    probe_at_root: bool, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    if probe_at_root:
-        _force_probing(monkeypatch)
+def test_time_limit_returns_an_honest_gap(probe_at_root: bool) -> None:
+    settings = PROBING if probe_at_root else DEFAULTS
     scene = random_stepping_stones(0, 8, robot=ROBOT)
     fp = build_footstep_problem(scene, ROBOT, 10)
-    res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.3, gap=0.0))
+    res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.3, gap=0.0, bnb=settings))
     assert res.status in (SolveStatus.TIME_LIMIT, SolveStatus.OPTIMAL)
     if res.x is not None:
-        assert fp.problem.violation(res.x) <= bnb.FEAS_TOL
+        assert fp.problem.violation(res.x) <= DEFAULTS.feas_tol
         assert res.objective == pytest.approx(fp.problem.objective(res.x))
         assert res.bound <= res.objective * (1 + BOUND_RTOL)
         expected = (res.objective - res.bound) / min(abs(res.objective), abs(res.bound))
@@ -200,18 +195,17 @@ def test_parallel_workers_find_the_same_optimum(seed: int, n: int) -> None:
         return
     assert serial.status is SolveStatus.OPTIMAL
     assert parallel.objective == pytest.approx(serial.objective, rel=OBJ_RTOL)
-    assert fp.problem.violation(parallel.x) <= bnb.FEAS_TOL
+    assert fp.problem.violation(parallel.x) <= DEFAULTS.feas_tol
     if parallel.stats["nodes"] > 1:  # the search branched, so the workers were used
         assert parallel.stats["workers"] == 2
 
 
-def test_search_process_solving_beside_one_worker_finds_the_same_optimum(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_search_process_solving_beside_one_worker_finds_the_same_optimum() -> None:
     fp = build_footstep_problem(random_stepping_stones(1, 8, robot=ROBOT), ROBOT, 8)
     serial = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=1))
-    monkeypatch.setattr(bnb, "LOCAL_SOLVES", True)
-    local = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=2))
+    local = solve(
+        fp.problem, "bnb", SolverOptions(gap=GAP, threads=2, bnb=BnbSettings(local_solves=True))
+    )
     assert local.status is serial.status is SolveStatus.OPTIMAL
     assert local.objective == pytest.approx(serial.objective, rel=OBJ_RTOL)
     assert local.stats["workers"] == 1
@@ -355,20 +349,17 @@ def test_bench_plan_cli_writes_the_table(tmp_path) -> None:  # type: ignore[no-u
 
 
 @pytest.mark.parametrize("probe_at_root", [False, True])
-def test_parallel_time_limit_returns_an_honest_gap(
-    probe_at_root: bool, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_parallel_time_limit_returns_an_honest_gap(probe_at_root: bool) -> None:
     # the asynchronous search stops with solves (and possibly the dive) in flight; with probing
     # at the root, the time limit falls in probing or its heuristics
-    if probe_at_root:
-        _force_probing(monkeypatch)
+    settings = PROBING if probe_at_root else DEFAULTS
     scene = random_stepping_stones(0, 8, robot=ROBOT)
     fp = build_footstep_problem(scene, ROBOT, 10)
-    res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.5, gap=0.0, threads=2))
+    res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.5, gap=0.0, threads=2, bnb=settings))
     assert res.status in (SolveStatus.TIME_LIMIT, SolveStatus.OPTIMAL)
-    assert res.solve_time < 0.5 + bnb.DRAIN_TIMEOUT
+    assert res.solve_time < 0.5 + settings.drain_timeout
     if res.x is not None:
-        assert fp.problem.violation(res.x) <= bnb.FEAS_TOL
+        assert fp.problem.violation(res.x) <= settings.feas_tol
         assert res.bound <= res.objective * (1 + BOUND_RTOL)
 
 
@@ -379,7 +370,7 @@ def test_dropping_redundant_member_rows_keeps_the_member_set() -> None:
     lb, ub = np.array([-1.0, -2.0]), np.array([1.0, 2.0])
     a_v = np.array([[1.0, 0.0], [2.0, 0.0], [-1.0, 0.0], [-0.5, 0.0], [0.1, 0.1], [1.0, 1.0]])
     beta = np.array([0.5, 3.0, 0.8, 0.2, 5.0, 1.0])
-    a_r, b_r = bnb._drop_redundant(a_v, beta, lb, ub)
+    a_r, b_r = bnb._drop_redundant(a_v, beta, lb, ub, DEFAULTS.redundant_tol)
     assert len(b_r) == 3  # x0 <= 0.5, x0 >= -0.4, x0 + x1 <= 1
     pts = rng.uniform(lb, ub, size=(2000, 2))
     inside = np.all(pts @ a_v.T <= beta, axis=1)
@@ -400,20 +391,16 @@ def test_member_violations_are_the_largest_row_violations() -> None:
 
 
 def _link_structure(
-    monkeypatch: pytest.MonkeyPatch, problem: MIQCQP, staircase: bool = True
+    problem: MIQCQP, staircase: bool = True, min_drop: float = DEFAULTS.link_min_drop
 ) -> bnb._Structure:
-    monkeypatch.setattr(bnb, "LINKS", True)
-    monkeypatch.setattr(bnb, "STAIRCASE", staircase)
-    return bnb.analyse(problem)
+    settings = BnbSettings(links=True, staircase=staircase, link_min_drop=min_drop)
+    return bnb.analyse(problem, settings=settings)
 
 
-def test_link_pairs_are_exactly_the_rate_feasible_segment_pairs(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_link_pairs_are_exactly_the_rate_feasible_segment_pairs() -> None:
     scene = random_stepping_stones(0, 8, robot=ROBOT)
     fp = build_footstep_problem(scene, ROBOT, 8)
-    monkeypatch.setattr(bnb, "LINK_MIN_DROP", 0.0)
-    structure = _link_structure(monkeypatch, fp.problem)
+    structure = _link_structure(fp.problem, min_drop=0.0)
     pr, br, tmax = fp.problem, fp.breakpoints, ROBOT.theta_max
     by_groups = {link.groups: link for link in structure.compat}
     checked = 0
@@ -447,9 +434,7 @@ def test_link_pairs_are_exactly_the_rate_feasible_segment_pairs(
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2, 3])
-def test_linked_relaxation_is_tighter_and_below_the_optimum(
-    monkeypatch: pytest.MonkeyPatch, seed: int
-) -> None:
+def test_linked_relaxation_is_tighter_and_below_the_optimum(seed: int) -> None:
     scene = random_stepping_stones(seed, 8, robot=ROBOT)
     fp = build_footstep_problem(scene, ROBOT, 8)
     best = solve(fp.problem, "bnb", SolverOptions(gap=GAP))
@@ -458,7 +443,7 @@ def test_linked_relaxation_is_tighter_and_below_the_optimum(
     plain = bnb.HullRelaxation(plain_s).solve(bnb._root_allowed(plain_s))
     bounds = []
     for staircase in (True, False):  # prefix rows and pair weights: the same polytope
-        linked_s = _link_structure(monkeypatch, fp.problem, staircase)
+        linked_s = _link_structure(fp.problem, staircase)
         linked = bnb.HullRelaxation(linked_s).solve(bnb._root_allowed(linked_s))
         assert linked.status == plain.status == "solved"
         assert linked.bound >= plain.bound * (1 - BOUND_RTOL)
@@ -472,22 +457,17 @@ def test_linked_relaxation_is_tighter_and_below_the_optimum(
 
 
 @pytest.mark.parametrize(("regions", "seed", "n"), CASES[:4])
-def test_linked_search_finds_the_same_optimum(
-    monkeypatch: pytest.MonkeyPatch, regions: int, seed: int, n: int
-) -> None:
+def test_linked_search_finds_the_same_optimum(regions: int, seed: int, n: int) -> None:
     fp = build_footstep_problem(_scene(regions, seed), ROBOT, n)
     plain = solve(fp.problem, "bnb", SolverOptions(gap=GAP))
-    monkeypatch.setattr(bnb, "LINKS", True)
-    linked = solve(fp.problem, "bnb", SolverOptions(gap=GAP))
+    linked = solve(fp.problem, "bnb", SolverOptions(gap=GAP, bnb=BnbSettings(links=True)))
     assert plain.status is linked.status is SolveStatus.OPTIMAL
     assert linked.objective == pytest.approx(plain.objective, rel=OBJ_RTOL)
 
 
-def test_propagation_drops_only_members_without_a_compatible_partner(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_propagation_drops_only_members_without_a_compatible_partner() -> None:
     fp = build_footstep_problem(random_stepping_stones(0, 8, robot=ROBOT), ROBOT, 10)
-    structure = _link_structure(monkeypatch, fp.problem)
+    structure = _link_structure(fp.problem)
     root = bnb._root_allowed(structure)
     # pin footstep 5 to its first live segment
     z5 = int(fp.segments[5][fp.segments[5] >= 0][0])
@@ -554,16 +534,14 @@ def test_clarabel_gets_the_same_problem_from_lists() -> None:
     assert got.obj_val == pytest.approx(ref_sol.obj_val, abs=1e-12)
 
 
-def test_compact_node_problems_are_the_same_relaxation(monkeypatch: pytest.MonkeyPatch) -> None:
-    """``bnb.COMPACT`` leaves out free columns, excluded binaries and implied ``z >= 0`` rows and
+def test_compact_node_problems_are_the_same_relaxation() -> None:
+    """``BnbSettings.compact`` leaves out free columns, excluded binaries and implied ``z >= 0`` rows and
     projects the separable forms' copies out: the node bounds (condensed and full) and statuses
     stay those of the plain node problems."""
     fp = build_footstep_problem(_scene(5, 0), ROBOT, 5)
     structure = bnb.analyse(fp.problem)
-    monkeypatch.setattr(bnb, "COMPACT", False)
-    plain = bnb.HullRelaxation(structure)
-    monkeypatch.setattr(bnb, "COMPACT", True)
-    compact = bnb.HullRelaxation(structure)
+    plain = bnb.HullRelaxation(structure, settings=BnbSettings(compact=False))
+    compact = bnb.HullRelaxation(structure, settings=BnbSettings(compact=True))
     assert compact.condensed is not None
     dropped = compact._tpl[id(compact.condensed)].drop_col
     # the private sin/cos of the heading segments (and footstep 0's, fixed by their bounds)
@@ -587,9 +565,7 @@ def test_compact_node_problems_are_the_same_relaxation(monkeypatch: pytest.Monke
     statuses = set()
     for allowed in nodes:
         for full in (False, True):
-            monkeypatch.setattr(bnb, "COMPACT", False)
             ref = plain.solve(allowed, full=full)
-            monkeypatch.setattr(bnb, "COMPACT", True)
             got = compact.solve(allowed, full=full)
             assert got.status == ref.status
             statuses.add(ref.status)
@@ -604,30 +580,25 @@ def test_compact_node_problems_are_the_same_relaxation(monkeypatch: pytest.Monke
 
 @pytest.mark.parametrize("threads", [1, 2])
 @pytest.mark.parametrize(("seed", "n"), [(1, 8), (3, 8)])
-def test_probing_and_heuristics_keep_the_optimum(
-    seed: int, n: int, threads: int, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_probing_and_heuristics_keep_the_optimum(seed: int, n: int, threads: int) -> None:
     fp = build_footstep_problem(random_stepping_stones(seed, 8, robot=ROBOT), ROBOT, n)
-    monkeypatch.setattr(bnb, "PROBE_ROUNDS", 0)
-    plain = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads))
-    monkeypatch.setattr(bnb, "PROBE_ROUNDS", 8)
-    _force_probing(monkeypatch)
-    probed = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads))
+    plain = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads, bnb=NO_PROBING))
+    probed = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads, bnb=PROBING))
     assert plain.status is probed.status is SolveStatus.OPTIMAL
     assert plain.stats["probes"] == 0
     assert probed.stats["probes"] > 0 and probed.stats["probe_dropped"] > 0
     assert probed.stats["heuristic_nodes"] + probed.stats["local_search_solves"] > 0
     assert probed.objective == pytest.approx(plain.objective, rel=OBJ_RTOL)
-    assert probed.x is not None and fp.problem.violation(probed.x) <= bnb.FEAS_TOL
+    assert probed.x is not None and fp.problem.violation(probed.x) <= DEFAULTS.feas_tol
     assert probed.bound <= probed.objective * (1 + BOUND_RTOL)
 
 
-def test_probing_drops_only_members_no_better_plan_uses(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_probing_drops_only_members_no_better_plan_uses() -> None:
     """Every member probing kills is checked by SCIP (an independent solver) on the problem with
     that binary fixed to 1: infeasible, or no better than the plan the search returned."""
     fp = build_footstep_problem(_scene(5, 1), ROBOT, 5)
-    _force_probing(monkeypatch)
-    search = bnb._Search(bnb.analyse(fp.problem), SolverOptions(gap=GAP), time.perf_counter())
+    options = SolverOptions(gap=GAP, bnb=PROBING)
+    search = bnb._Search(bnb.analyse(fp.problem), options, time.perf_counter())
     res = search.run()
     assert res.status is SolveStatus.OPTIMAL
     dead = sorted(search.dead)
@@ -660,31 +631,27 @@ def test_worker_map_keeps_many_tasks_flowing_and_stops_at_its_deadline() -> None
 
 
 @pytest.mark.parametrize("threads", [1, 2])
-def test_probing_in_the_middle_of_a_search_keeps_the_optimum(
-    threads: int, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_probing_in_the_middle_of_a_search_keeps_the_optimum(threads: int) -> None:
     # probing after some nodes: the open nodes lose the killed members and are solved again
     fp = build_footstep_problem(random_stepping_stones(1, 8, robot=ROBOT), ROBOT, 8)
-    monkeypatch.setattr(bnb, "PROBE_ROUNDS", 0)
-    plain = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads))
-    monkeypatch.setattr(bnb, "PROBE_ROUNDS", 8)
-    monkeypatch.setattr(bnb, "PROBE_AFTER", 0.2)
-    monkeypatch.setattr(bnb, "PROBE_BUDGET", math.inf)
-    probed = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads))
+    plain = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads, bnb=NO_PROBING))
+    middle = BnbSettings(probe_after=0.2, probe_budget=math.inf)
+    probed = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads, bnb=middle))
     assert plain.status is probed.status is SolveStatus.OPTIMAL
     assert probed.stats["probed_at_node"] > 1 and probed.stats["probes"] > 0
     assert probed.stats["probe_dropped"] > 0
     assert probed.objective == pytest.approx(plain.objective, rel=OBJ_RTOL)
-    assert probed.x is not None and fp.problem.violation(probed.x) <= bnb.FEAS_TOL
+    assert probed.x is not None and fp.problem.violation(probed.x) <= DEFAULTS.feas_tol
 
 
-def test_probing_stays_within_its_budget(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_probing_stays_within_its_budget() -> None:
     fp = build_footstep_problem(random_stepping_stones(1, 8, robot=ROBOT), ROBOT, 8)
-    monkeypatch.setattr(bnb, "PROBE_AFTER", 1.0)
-    res = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=1))
+    settings = BnbSettings(probe_after=1.0)
+    res = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=1, bnb=settings))
     assert res.status is SolveStatus.OPTIMAL
     at = res.stats["probed_at_node"]
     assert at is not None, "the search ended before probing: the test checks nothing"
     for key in ("probes", "local_search_solves", "heuristic_nodes"):
-        assert res.stats[key] <= bnb.PROBE_BUDGET * at, key
+        assert res.stats[key] <= settings.probe_budget * at, key
+    assert res.stats["settings"] == dataclasses.asdict(settings)
     assert res.stats["probes"] > 0

@@ -32,14 +32,14 @@ Relaxation of a node (each group ``G`` may use the members ``Z`` still allowed):
   the rest, from one KKT solve. Dropping their bounds and cones keeps a lower bound; when a node's
   recovered point violates one, the node is re-solved with the full model.
 
-* Compact node problems (``COMPACT``). The same relaxation with a smaller KKT system (a node
+* Compact node problems (``BnbSettings.compact``). The same relaxation with a smaller KKT system (a node
   solve costs about linearly in its size): excluded binaries are left out instead of fixed to 0,
   as are columns that only their own bounds constrain (the private sin/cos) and the rows
   ``z >= 0`` that a perspective cone implies; a form that every member bounds only by its own
   interval (a segment's heading) loses its copies, ``sum_z lo_z z <= B_j x_V <= sum_z hi_z z``
   being their exact projection (:func:`_separable_forms`).
 
-* Links (``LINKS``, off: tighter but dearer per node, see ``benchmarks/RESULTS.md``). Two groups
+* Links (``BnbSettings.links``, off: tighter but dearer per node, see ``benchmarks/RESULTS.md``). Two groups
   coupled by a plain row (the heading rate, eq. 5.12e, between the segment groups of consecutive
   steps) keep only the member pairs that row allows on the members' boxes; the group weights must
   be the marginals of weights on those pairs, written as prefix rows when the pairs form a
@@ -52,14 +52,14 @@ group is a feasible point of the MIQCQP (the binaries are then set to those memb
 is solved exactly even when the interior-point weights are spread. Otherwise the group whose nearest
 member is violated most is split where the cumulative weight of its members (in index order, the
 angle order for segments) crosses 1/2 (SOS1 branching). Incumbents come from such nodes and a dive
-from the root (periodic rounding is available, off).
+from the root.
 
-Probing (``PROBE_ROUNDS``). A search still open after ``PROBE_AFTER`` nodes per undecided root member
+Probing (``probe_rounds``). A search still open after ``probe_after`` nodes per undecided root member
 solves the root once with each member fixed and kills the members whose bound reaches the
 incumbent (or that are infeasible): no better point uses them, so every open node drops them (a
 node that loses any is solved again before it is branched), and the node problems shrink. One
 round ranks the members; two primal heuristics then look for a better incumbent (a search of at
-most ``HEUR_NODES`` nodes over each group's ``HEUR_TOP`` members of the lowest probe bound, and a
+most ``heur_nodes`` nodes over each group's ``heur_top`` members of the lowest probe bound, and a
 one-group-at-a-time local search), and further rounds probe with it until a round kills nothing.
 
 With ``threads >= 2`` forked worker processes (:class:`_Workers`) solve the nodes asynchronously:
@@ -79,6 +79,7 @@ import dataclasses
 import heapq
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -87,98 +88,133 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from footfall._typing import FloatArray, IntArray
+from footfall._validate import non_negative
+from footfall.errors import InputError
 from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
 from footfall.solvers.problem import MIQCQP
 
 NAME = "bnb"
 
 
-#: a relaxation weight within this of 0 or 1 counts as integral
-INT_TOL = 1e-6
-#: largest violation [problem units] accepted for a solution returned to the caller
-FEAS_TOL = 1e-6
-#: the z = 0 form of a big-M row must be implied by the bounds within this
-REDUNDANT_TOL = 1e-7
-#: also bound every copy by the variable bounds (lb z <= f^z <= ub z); the member rows bound the
-#: footstep groups already, and without these rows node solves are about 20 % faster
-COPY_BOUNDS = False
-#: a member's indicator rows count as satisfied by a relaxation solution within this
-ROW_TOL = 1e-7
-#: try rounding the relaxation solution to an incumbent at every this many nodes (0: never). Off:
-#: on N = 10 and 15 (K = 10, seeds 0-3) no rounding ever improved the incumbent (same node
-#: counts), and a rounding whose condensed point breaks a dropped bound is re-solved with the full
-#: model in the main process (N = 15: 683 such solves, 75.6 s -> 45.6 s in total without rounding)
-ROUNDING_EVERY = 0
-#: dive from the root relaxation for an early incumbent
-DIVE = True
-#: drop members whose dual bound (node bound + multiplier of z >= 0) reaches the incumbent
-REDUCED_COST_FIXING = False
-#: branching group: "violation" (its nearest member is violated most), "fractional" (smallest
-#: largest weight) or "first" (lowest group index, i.e. step order)
-BRANCH_SELECT = "violation"
-#: drop the members of a child that no compatible member pair of its links reaches
-PROPAGATE = True
-#: split: "sos" (members in index order at the weighted mean) or "nearest" (one member vs rest)
-BRANCH_SPLIT = "sos"
-#: strong branching: solve the children of this many best candidate groups and split the one whose
-#: weaker child bound rises most (0 or 1: no strong branching)
-STRONG = 0
-#: Clarabel settings of the node solves. Iterative refinement and equilibration cost about 45 % of
-#: a node solve here (100 node problems of N = 10 and 15: 3.06 s -> 1.68 s, 1885 -> 1503
-#: iterations) and change no status and no bound by more than 1e-7
-CLARABEL_SETTINGS: dict[str, Any] = {
-    "iterative_refinement_enable": False,
-    "equilibrate_enable": False,
-}
 #: Clarabel statuses that end a node solve (anything else is retried once, then "failed")
 _CLARABEL_DONE = ("Solved", "AlmostSolved", "PrimalInfeasible", "AlmostPrimalInfeasible")
-#: the retry of a node whose solve ended in another status: Clarabel's defaults (equilibration,
-#: iterative refinement) with more iterations
-CLARABEL_RETRY_SETTINGS: dict[str, Any] = {"max_iter": 200}
-#: couple groups linked by plain rows through weights on their compatible member pairs
-LINKS = False
-#: keep a link only when its rows rule out at least this share of the member pairs
-LINK_MIN_DROP = 0.25
-#: write a staircase link as prefix rows on its binaries instead of pair weights
-STAIRCASE = True
-#: node problems leave out the columns only their own bounds constrain (see
-#: :func:`_dropped_columns`), the binaries of excluded members (instead of rows fixing them to 0)
-#: and the rows ``z >= 0`` that a member's perspective cone implies: the same relaxation with a
-#: smaller KKT system (a node's cost grows about linearly with its size)
-COMPACT = True
-#: with threads >= 2, keep the workers busy asynchronously (else: synchronous batches)
-ASYNC = True
-#: with threads >= 2, the search process solves nodes too, beside ``threads - 1`` workers (each
-#: kept two tasks deep so that it never waits while the search process is busy solving)
-LOCAL_SOLVES = False
-#: probing at the root: rounds in which the root relaxation is solved once with each member of every
-#: undecided group fixed; a member whose bound reaches the incumbent (or that is infeasible) is
-#: dropped for the whole search (0: no probing)
-PROBE_ROUNDS = 8
-#: probing rounds before the primal heuristics (whose incumbent the other rounds then use)
-PROBE_FIRST_ROUNDS = 1
-#: probe once the search has solved this many nodes per member of the root's undecided groups
-#: without finishing
-PROBE_AFTER = 2
-#: probing, the restricted search and the local search each solve at most this many relaxations
-#: per node the search had solved before probing: together at most three times the work before
-#: probing, for a search that would have ended just after it
-PROBE_BUDGET = 1.0
-#: stop probing when a round dropped less than this share of the members it probed (and found
-#: no better incumbent)
-PROBE_MIN_DROP = 0.0
-#: after probing, search the root restricted to each group's ``HEUR_TOP`` members of the lowest
-#: probe bound (a small problem) for an incumbent, at most ``HEUR_NODES`` nodes (0: off)
-HEUR_TOP = 2
-HEUR_NODES = 1000
-#: then improve the incumbent by moving one group to another allowed member at a time (best
-#: improvement per sweep), at most this many sweeps (0: off)
-LS_SWEEPS = 20
-#: tasks in flight per worker in :meth:`_Workers.map`
-MAP_DEPTH = 2
-#: at the end of a parallel search, give the workers this long [s] to finish their solves in flight
-#: and exit before they are terminated (a node solve takes milliseconds; dives stop on a flag)
-DRAIN_TIMEOUT = 1.0
+
+
+def _pairs(name: str, value: object) -> tuple[tuple[str, bool | int | float], ...]:
+    """``value`` as a tuple of ``(Clarabel setting name, value)`` pairs (a mapping is accepted)."""
+    items: Any = value.items() if isinstance(value, Mapping) else value
+    try:
+        out = tuple((str(k), v) for k, v in items)
+    except (TypeError, ValueError):
+        raise InputError(name, value, "(name, value) pairs of Clarabel settings") from None
+    if any(not isinstance(v, bool | int | float) for _, v in out):
+        raise InputError(name, value, "Clarabel settings with bool, int or float values")
+    return out
+
+
+@dataclass(frozen=True)
+class BnbSettings:
+    """Settings of the ``bnb`` branch and bound (see :mod:`footfall.solvers.bnb`).
+
+    Passed in with the solve (``SolverOptions.bnb``, ``PlannerOptions.bnb``) and echoed in the
+    result (``stats["settings"]``); the defaults are the tuned search.
+
+    Attributes:
+        feas_tol: largest violation [problem units] accepted for a solution returned to the
+            caller; also the slack of a link's pair test (default 1e-6).
+        redundant_tol: the ``z = 0`` form of a big-M row must be implied by the variable bounds
+            within this (relative to max(1, |rhs|)); a member row implied by its box within
+            it is dropped (default 1e-7).
+        row_tol: a member's indicator rows count as satisfied by a relaxation point within this
+            [problem units] (default 1e-7).
+        rank_tol: singular values below this (relative to the largest) do not count in a group's
+            row space (default 1e-10).
+        max_fm_rows: eliminate a private variable only when Fourier-Motzkin makes at most this
+            many rows per member (default 8).
+        compact: node problems leave out the columns only their own bounds constrain, the
+            binaries of excluded members (instead of rows fixing them to 0), the rows ``z >= 0``
+            that a member's perspective cone implies, and the copies of separable forms: the same
+            relaxation with a smaller KKT system (default True).
+        links: couple groups linked by plain rows (the heading rate, eq. 5.12e) through weights on
+            their compatible member pairs: tighter, dearer per node (default False).
+        link_min_drop: keep a link only when its rows rule out at least this share of the member
+            pairs, in [0, 1] (default 0.25).
+        staircase: write a staircase link as prefix rows on its binaries instead of pair weights
+            (default True).
+        local_solves: with threads >= 2, the search process solves nodes too, beside
+            ``threads - 1`` workers, each kept two tasks deep (default False).
+        clarabel: Clarabel settings of the node solves, ``(name, value)`` pairs over Clarabel's
+            defaults (default: iterative refinement and equilibration off).
+        clarabel_retry: Clarabel settings of the one retry of a node whose solve ended in a status
+            other than solved or infeasible (default: Clarabel's defaults, ``max_iter`` 200).
+        probe_rounds: probing rounds at most: the root relaxation solved once with each member of
+            every undecided group fixed, a member whose bound reaches the incumbent (or that is
+            infeasible) dropped for the whole search (0: no probing; default 8).
+        probe_first_rounds: probing rounds before the primal heuristics, whose incumbent the
+            other rounds then use (default 1).
+        probe_after: probe once the search has solved this many nodes per member of the root's
+            undecided groups without finishing (default 2).
+        probe_budget: probing, the restricted search and the local search each solve at most this
+            many relaxations per node solved before probing (default 1: together at most three
+            times the work before probing).
+        probe_min_drop: stop probing when a round dropped less than this share of the members it
+            probed and found no better incumbent, in [0, 1] (default 0).
+        heur_top: the restricted search after probing keeps each group's this many members of the
+            lowest probe bound (0: off; default 2).
+        heur_nodes: the restricted search solves at most this many nodes (0: off; default 1000).
+        ls_sweeps: local-search sweeps at most (one group moved to another member at a time,
+            best improvement per sweep; 0: off; default 20).
+        map_depth: tasks in flight per worker in a synchronous batch (default 2).
+        drain_timeout: at the end of a parallel search, the workers get this long [s] to finish
+            their solves in flight and exit before they are terminated (default 1.0).
+    """
+
+    feas_tol: float = 1e-6
+    redundant_tol: float = 1e-7
+    row_tol: float = 1e-7
+    rank_tol: float = 1e-10
+    max_fm_rows: int = 8
+    compact: bool = True
+    links: bool = False
+    link_min_drop: float = 0.25
+    staircase: bool = True
+    local_solves: bool = False
+    clarabel: tuple[tuple[str, bool | int | float], ...] = (
+        ("iterative_refinement_enable", False),
+        ("equilibrate_enable", False),
+    )
+    clarabel_retry: tuple[tuple[str, bool | int | float], ...] = (("max_iter", 200),)
+    probe_rounds: int = 8
+    probe_first_rounds: int = 1
+    probe_after: float = 2.0
+    probe_budget: float = 1.0
+    probe_min_drop: float = 0.0
+    heur_top: int = 2
+    heur_nodes: int = 1000
+    ls_sweeps: int = 20
+    map_depth: int = 2
+    drain_timeout: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("feas_tol", "redundant_tol", "row_tol", "rank_tol", "probe_min_drop",
+                     "drain_timeout", "link_min_drop"):  # fmt: skip
+            object.__setattr__(self, name, non_negative(name, getattr(self, name)))
+        for name in ("probe_after", "probe_budget"):  # inf: never / no budget
+            value = getattr(self, name)
+            if value != math.inf:
+                object.__setattr__(self, name, non_negative(name, value))
+        for name in ("max_fm_rows", "probe_rounds", "probe_first_rounds", "heur_top",
+                     "heur_nodes", "ls_sweeps", "map_depth"):  # fmt: skip
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+                raise InputError(name, value, "an integer >= 0")
+        for name in ("compact", "links", "staircase", "local_solves"):
+            if not isinstance(getattr(self, name), bool):
+                raise InputError(name, getattr(self, name), "True or False")
+        if self.map_depth < 1:
+            raise InputError("map_depth", self.map_depth, "an integer >= 1")
+        for name in ("clarabel", "clarabel_retry"):
+            object.__setattr__(self, name, _pairs(name, getattr(self, name)))
 
 
 class UnsupportedProblem(ValueError):
@@ -273,21 +309,15 @@ class _Structure:
     )
 
 
-#: eliminate a private variable only when Fourier-Motzkin makes at most this many rows per member
-MAX_FM_ROWS = 8
-#: singular values below this (relative) do not count in a group's row space
-RANK_TOL = 1e-10
-
-
 def _eliminate(
-    rows: list[tuple[dict[int, float], float]], v: int, lb: float, ub: float
+    rows: list[tuple[dict[int, float], float]], v: int, lb: float, ub: float, max_rows: int
 ) -> list[tuple[dict[int, float], float]] | None:
     """Fourier-Motzkin elimination of ``v`` from ``rows`` (each ``sum coef x <= rhs``) given
-    ``lb <= v <= ub``: the exact projection. None when it would make too many rows."""
+    ``lb <= v <= ub``: the exact projection. None when it would make more than ``max_rows`` rows."""
     upper = [(r, b) for r, b in rows if r.get(v, 0.0) > 0.0]
     lower = [(r, b) for r, b in rows if r.get(v, 0.0) < 0.0]
     rest = [(r, b) for r, b in rows if r.get(v, 0.0) == 0.0]
-    if len(upper) * len(lower) + len(upper) + len(lower) > MAX_FM_ROWS:
+    if len(upper) * len(lower) + len(upper) + len(lower) > max_rows:
         return None
     out = list(rest)
     for r, b in upper:  # v <= (b - r x)/a and v >= lb
@@ -311,14 +341,14 @@ def _eliminate(
 
 
 def _drop_redundant(
-    a_v: FloatArray, beta: FloatArray, lb: FloatArray, ub: FloatArray
+    a_v: FloatArray, beta: FloatArray, lb: FloatArray, ub: FloatArray, tol: float
 ) -> tuple[FloatArray, FloatArray]:
     """Remove rows implied by the box that the bounds and the single-variable rows define.
 
     The single-variable rows of one variable and direction are replaced by the tightest of them
     (they bound the member's copies; e.g. the Fourier-Motzkin rows of the private sin/cos bound the
     heading less than the segment's own rows do). Removing implied rows leaves the member's set
-    unchanged.
+    unchanged. ``tol``: a row implied within ``tol * max(1, |rhs|)`` counts as implied.
     """
     if not len(beta):
         return a_v, beta
@@ -336,20 +366,24 @@ def _drop_redundant(
             lo[c] = max(lo[c], beta[j] / v)
             has_lo[c] = True
     top = np.sum(np.maximum(a_v * lo, a_v * hi), axis=1)
-    keep = (nnz > 1) & ~(top <= beta - REDUNDANT_TOL * np.maximum(1.0, np.abs(beta)))
+    keep = (nnz > 1) & ~(top <= beta - tol * np.maximum(1.0, np.abs(beta)))
     # a row with no variables left is kept only if it is violated (the member is impossible)
-    keep |= (nnz == 0) & (beta < -REDUNDANT_TOL)
+    keep |= (nnz == 0) & (beta < -tol)
     eye = np.eye(len(lb))
     rows = [a_v[keep], eye[has_hi], -eye[has_lo]]
     rhs = [beta[keep], hi[has_hi], -lo[has_lo]]
     return np.vstack(rows), np.concatenate(rhs)
 
 
-def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
+def analyse(
+    problem: MIQCQP, perspective: bool = True, settings: BnbSettings | None = None
+) -> _Structure:
     """Split ``problem`` into choice groups and indicator rows; raise :class:`UnsupportedProblem`.
 
-    With ``perspective``, objective rows within one group's forms are assigned to that group.
+    With ``perspective``, objective rows within one group's forms are assigned to that group;
+    ``settings`` give the tolerances and whether to build links (default :class:`BnbSettings`).
     """
+    settings = BnbSettings() if settings is None else settings
     n = problem.n
     integer = problem.integer
     if np.any(integer & ((problem.lb < 0.0) | (problem.ub > 1.0))):
@@ -398,7 +432,9 @@ def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
         big_m = float(vals[ints][0])
         cc, vv = cols[~ints].astype(np.int64), vals[~ints].astype(float)
         top = float(np.sum(np.where(vv > 0, vv * problem.ub[cc], vv * problem.lb[cc])))
-        if not math.isfinite(top) or top > problem.b_le[r] + REDUNDANT_TOL * max(1.0, abs(top)):
+        if not math.isfinite(top) or top > problem.b_le[r] + settings.redundant_tol * max(
+            1.0, abs(top)
+        ):
             raise UnsupportedProblem(f"row {problem.le_labels[r]!r}: its z = 0 form is not implied")
         ind_rows.setdefault(z, []).append((cc, vv, float(problem.b_le[r]) - big_m))
 
@@ -430,7 +466,10 @@ def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
         for c in cols_all:
             if used[c] or owner[c] != {g}:
                 continue
-            reduced = {z: _eliminate(rows_of[z], c, problem.lb[c], problem.ub[c]) for z in mem}
+            reduced = {
+                z: _eliminate(rows_of[z], c, problem.lb[c], problem.ub[c], settings.max_fm_rows)
+                for z in mem
+            }
             if any(r is None for r in reduced.values()):
                 continue
             rows_of = {z: r for z, r in reduced.items() if r is not None}
@@ -448,11 +487,13 @@ def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
                 for c, v in row.items():
                     a_v[j, where[c]] += v
                 beta[j] = rhs
-            dense[z] = _drop_redundant(a_v, beta, problem.lb[variables], problem.ub[variables])
+            dense[z] = _drop_redundant(
+                a_v, beta, problem.lb[variables], problem.ub[variables], settings.redundant_tol
+            )
         stacked = np.vstack([dense[z][0] for z in mem] + [np.zeros((0, len(variables)))])
         if stacked.shape[0] and len(variables):
             _, sv, vt = np.linalg.svd(stacked, full_matrices=False)
-            k = int(np.count_nonzero(sv > RANK_TOL * max(float(sv[0]), 1e-300)))
+            k = int(np.count_nonzero(sv > settings.rank_tol * max(float(sv[0]), 1e-300)))
             basis = vt[:k]
         else:
             basis = np.zeros((0, len(variables)))
@@ -524,11 +565,11 @@ def analyse(problem: MIQCQP, perspective: bool = True) -> _Structure:
         plain_b=problem.b_le[plain],
         assigned=assigned,
     )
-    if LINKS:
+    if settings.links:
         zero: list[int] = []
-        out.compat = _links(out)
+        out.compat = _links(out, settings)
         for link in out.compat:
-            spec = _staircase(out, link) if STAIRCASE else None
+            spec = _staircase(out, link) if settings.staircase else None
             if spec is None:
                 out.links.append(link)
             else:
@@ -605,7 +646,7 @@ def _member_box(s: _Structure, g: int, z: int) -> tuple[FloatArray, FloatArray]:
     return lo, hi
 
 
-def _links(s: _Structure) -> list[_Link]:
+def _links(s: _Structure, settings: BnbSettings) -> list[_Link]:
     """Member pairs of two groups that the plain rows between them allow.
 
     A plain row whose variables all lie in the variables of two groups ``g1 != g2`` (e.g. the
@@ -651,12 +692,13 @@ def _links(s: _Structure) -> list[_Link]:
                 lo[pos1], hi[pos1] = np.maximum(lo[pos1], lo1), np.minimum(hi[pos1], hi1)
                 lo[pos2], hi[pos2] = np.maximum(lo[pos2], lo2), np.minimum(hi[pos2], hi2)
                 low = np.sum(np.minimum(sub * lo, sub * hi), axis=1)
-                if np.all(lo <= hi + FEAS_TOL) and np.all(
-                    low <= rhs + FEAS_TOL * np.maximum(1.0, np.abs(rhs))
+                tol = settings.feas_tol
+                if np.all(lo <= hi + tol) and np.all(
+                    low <= rhs + tol * np.maximum(1.0, np.abs(rhs))
                 ):
                     pairs.append((z1, z2))
         n_all = len(s.groups[g1].members) * len(s.groups[g2].members)
-        if len(pairs) <= (1.0 - LINK_MIN_DROP) * n_all:
+        if len(pairs) <= (1.0 - settings.link_min_drop) * n_all:
             links.append(_Link((g1, g2), np.array(pairs, dtype=np.int64).reshape(-1, 2)))
     return links
 
@@ -678,10 +720,6 @@ class _Relaxation:
     bound: float = math.inf
     x: FloatArray | None = None
     iterations: int = 0
-    #: per variable, the multiplier of ``z >= 0`` for binaries with a choice at the node (else 0):
-    #: any solution of the node with ``z = 1`` costs at least ``bound + zdual[z]`` (the value of a
-    #: convex program is convex in the right-hand side; the multiplier is a subgradient)
-    zdual: FloatArray | None = None
     #: Clarabel's status when ``status`` is "failed"
     raw: str = ""
 
@@ -1068,7 +1106,7 @@ def _dropped_columns(s: _Structure, t: _Templates) -> _Templates:
 
 
 def _separable_forms(
-    s: _Structure, grp: _Group
+    s: _Structure, grp: _Group, compact: bool
 ) -> tuple[IntArray, IntArray, FloatArray, FloatArray, dict[int, NDArray[np.bool_]]]:
     """Forms of ``grp`` whose copies can be projected out of the hull exactly.
 
@@ -1078,8 +1116,8 @@ def _separable_forms(
     perspective cone) its projection is ``sum_z lo_z z <= B_j x_V <= sum_z hi_z z``: two rows per
     group instead of a copy and two rows per member, the same relaxation. A side is written when
     every member bounds it and left out when none does; a form where only some members bound a
-    side, or a member's interval is empty, keeps its copies (so does every form with
-    ``COPY_BOUNDS`` or without ``COMPACT``).
+    side, or a member's interval is empty, keeps its copies (so does every form without
+    ``compact``).
 
     Returns:
         The kept forms, the separable forms, per member and separable form ``lo`` and ``hi``
@@ -1088,11 +1126,7 @@ def _separable_forms(
     """
     k = grp.basis.shape[0]
     mem = grp.members
-    sep = (
-        np.ones(k, dtype=bool)
-        if COMPACT and not COPY_BOUNDS and len(mem) > 1
-        else np.zeros(k, dtype=bool)
-    )
+    sep = np.ones(k, dtype=bool) if compact and len(mem) > 1 else np.zeros(k, dtype=bool)
     if len(grp.cost_rows):
         sep &= ~np.any(grp.cost_f != 0.0, axis=0)
     for z in mem:
@@ -1120,7 +1154,7 @@ def _separable_forms(
     return np.flatnonzero(~sep), sepf, lo[:, sepf], hi[:, sepf], rows
 
 
-def _templates(s: _Structure, base: _Base) -> _Templates:
+def _templates(s: _Structure, base: _Base, compact: bool) -> _Templates:
     col = base.col
     groups: list[int] = []
     zcol: list[int] = []
@@ -1140,7 +1174,7 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
     mi = 0
     for g, grp in enumerate(s.groups):
         vcols = col[grp.variables]
-        keepf, sepf, s_lo, s_hi, is_sep_row = _separable_forms(s, grp)
+        keepf, sepf, s_lo, s_hi, is_sep_row = _separable_forms(s, grp, compact)
         basis = grp.basis[keepf]
         k = len(keepf)
         br, bc = np.nonzero(basis)
@@ -1181,21 +1215,15 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
             a_f = mb.a_f[~is_sep_row[z]][:, keepf]
             beta = mb.beta[~is_sep_row[z]]
             nb = len(beta)
-            nrows.append(2 * k + nb if COPY_BOUNDS else nb)
+            nrows.append(nb)
             has_cost.append(n_cost > 0)
             cdim.append(n_cost + 2 if n_cost else 0)
-            # hull rows: f - f_ub z <= 0 ; -f + f_lb z <= 0 ; a_f f - beta z <= 0
-            ar = np.arange(k)
+            # hull rows: a_f f - beta z <= 0 (the copies are bounded through the member rows)
             rr, cc2 = np.nonzero(a_f)
-            rows = np.r_[ar, ar, ar + k, ar + k, rr + 2 * k, np.arange(nb) + 2 * k]
-            kind = np.r_[np.zeros(k), np.ones(k), np.zeros(k), np.ones(k), np.zeros(len(rr)),
-                         np.ones(nb)].astype(np.int64)  # fmt: skip
-            loc = np.r_[ar, ar, ar, ar, cc2, np.zeros(nb)].astype(np.int64)
-            val = np.r_[np.ones(k), -grp.f_ub[keepf], -np.ones(k), grp.f_lb[keepf], a_f[rr, cc2],
-                        -beta]  # fmt: skip
-            if not COPY_BOUNDS:
-                keep = rows >= 2 * k
-                rows, kind, loc, val = rows[keep] - 2 * k, kind[keep], loc[keep], val[keep]
+            rows = np.r_[rr, np.arange(nb)]
+            kind = np.r_[np.zeros(len(rr)), np.ones(nb)].astype(np.int64)
+            loc = np.r_[cc2, np.zeros(nb)].astype(np.int64)
+            val = np.r_[a_f[rr, cc2], -beta]
             h[0].append(np.full(len(rows), mi))
             h[1].append(rows)
             h[2].append(kind)
@@ -1299,7 +1327,7 @@ def _templates(s: _Structure, base: _Base) -> _Templates:
     is_bin[out.zcol] = True
     nonbin = np.bincount(out.le_r, weights=~is_bin[out.le_c], minlength=out.m_le)
     out = dataclasses.replace(out, le_bin_rows=np.flatnonzero(nonbin == 0))
-    return _dropped_columns(s, out) if COMPACT else out
+    return _dropped_columns(s, out) if compact else out
 
 
 class _CscLists:
@@ -1337,22 +1365,25 @@ class HullRelaxation:
     A node's relaxation is assembled from flat templates by masking (no Python loop per member).
     """
 
-    def __init__(self, structure: _Structure, condense: bool = True) -> None:
+    def __init__(
+        self, structure: _Structure, condense: bool = True, settings: BnbSettings | None = None
+    ) -> None:
         import clarabel
 
         self._clarabel = clarabel
         self.s = structure
+        self.settings = BnbSettings() if settings is None else settings
+        compact = self.settings.compact
         self.full = _with_prefix(structure, _full_base(structure))
         condensed = _condensed_base(structure) if condense else None
         self.condensed = None if condensed is None else _with_prefix(structure, condensed)
-        self._tpl = {id(self.full): _templates(structure, self.full)}
+        self._tpl = {id(self.full): _templates(structure, self.full, compact)}
         if self.condensed is not None:
-            self._tpl[id(self.condensed)] = _templates(structure, self.condensed)
+            self._tpl[id(self.condensed)] = _templates(structure, self.condensed, compact)
         n = structure.problem.n
         self.member_index = np.full(n, -1, dtype=np.int64)
         order = [z for grp in structure.groups for z in grp.members]
         self.member_index[order] = np.arange(len(order))
-        self.member_vars = np.array(order, dtype=np.int64)
         self.n_members = len(order)
         # link flows: one marginal row per (link, side, member), one weight column per pair
         lr_mem: list[IntArray] = []
@@ -1373,8 +1404,8 @@ class HullRelaxation:
         self.lr_mem = _cat(lr_mem, np.int64)
         self.p_r = np.vstack([*p_r, np.zeros((0, 2), dtype=np.int64)])
         self.p_m = np.vstack([*p_m, np.zeros((0, 2), dtype=np.int64)])
-        self._settings = _clarabel_settings(clarabel, CLARABEL_SETTINGS)
-        self._robust_settings = _clarabel_settings(clarabel, CLARABEL_RETRY_SETTINGS)
+        self._settings = _clarabel_settings(clarabel, dict(self.settings.clarabel))
+        self._robust_settings = _clarabel_settings(clarabel, dict(self.settings.clarabel_retry))
         self._cones: dict[int, Any] = {}
         self.solves = 0
         self.solve_time = 0.0
@@ -1410,7 +1441,7 @@ class HullRelaxation:
 
         # equalities: static, excluded binaries = 0 (unless left out), linking rows of multi groups
         ex_cols = t.zcol[excluded]
-        n_ex = 0 if COMPACT else len(ex_cols)
+        n_ex = 0 if self.settings.compact else len(ex_cols)
         k_group = np.zeros(n_groups, dtype=np.int64)
         k_group[t.group] = t.k
         link_start = t.m_eq + n_ex + _offsets(k_group, multi_g)
@@ -1442,7 +1473,7 @@ class HullRelaxation:
 
         # inequalities: static, -z <= 0 for multi members (not where the perspective cone implies
         # it), hull rows, direct rows
-        zrow = multi & ~t.has_cost if COMPACT else multi
+        zrow = multi & ~t.has_cost if self.settings.compact else multi
         zm = t.zcol[zrow]
         nzm = len(zm)
         row0 = t.m_le + nzm
@@ -1511,9 +1542,8 @@ class HullRelaxation:
         q[t_col[persp]] = 1.0
         const = base.const + float(np.sum(t.d_const[single]))
 
-        zrows = m_eq + t.m_le + np.arange(nzm)  # rows of -z <= 0, for the multipliers
         keep_col = None
-        if COMPACT:
+        if self.settings.compact:
             # leave out the excluded binaries (0 at the node) and the free columns of the base
             keep_col = np.ones(ncol, dtype=bool)
             keep_col[ex_cols] = False
@@ -1534,7 +1564,7 @@ class HullRelaxation:
                     keep_row = np.ones(n_rows, dtype=bool)
                     keep_row[empty] = False
                     row_map = np.cumsum(keep_row) - 1
-                    rows, b, zrows = row_map[rows], b[keep_row], row_map[zrows]
+                    rows, b = row_map[rows], b[keep_row]
                     m_le -= len(empty)
                     n_rows -= len(empty)
         n_var = len(q)
@@ -1570,9 +1600,7 @@ class HullRelaxation:
             x[mapped] = xs[col[mapped]]
             if base is self.condensed:
                 self.recover(x)
-            zdual = np.zeros(pr.n)
-            zdual[self.member_vars[zrow]] = np.maximum(np.asarray(sol.z)[zrows], 0.0)
-            return _Relaxation("solved", bound, x, int(sol.iterations), zdual)
+            return _Relaxation("solved", bound, x, int(sol.iterations))
         if status in ("PrimalInfeasible", "AlmostPrimalInfeasible"):
             return _Relaxation("infeasible", iterations=int(sol.iterations))
         return _Relaxation("failed", iterations=int(sol.iterations), raw=status)
@@ -1593,7 +1621,6 @@ class _Node:
     x: FloatArray | None = field(compare=False, default=None)
     depth: int = field(compare=False, default=0)
     full: bool = field(compare=False, default=False)
-    zdual: FloatArray | None = field(compare=False, default=None)
 
 
 def _weights(x: FloatArray, mem: tuple[int, ...]) -> FloatArray:
@@ -1645,17 +1672,6 @@ def _without(allowed: tuple[tuple[int, ...], ...], drop: set[int]) -> tuple[tupl
     )
 
 
-def _fix_by_duals(
-    allowed: tuple[tuple[int, ...], ...], member_bound: FloatArray, incumbent: float
-) -> tuple[tuple[int, ...], ...]:
-    """Drop the members whose bound with ``z = 1`` (``member_bound[z]``) reaches the incumbent."""
-    return _without(allowed, {z for mem in allowed for z in mem if member_bound[z] >= incumbent})
-
-
-def _rounded(x: FloatArray, allowed: tuple[tuple[int, ...], ...]) -> tuple[tuple[int, ...], ...]:
-    return tuple(m if len(m) == 1 else (m[int(np.argmax(_weights(x, m)))],) for m in allowed)
-
-
 def _sos_point(w: FloatArray) -> int:
     """Where an SOS split of weights ``w`` (members in index order) cuts: at the weighted mean."""
     centre = float(np.dot(w, np.arange(len(w)))) / max(float(np.sum(w)), 1e-12)
@@ -1665,8 +1681,8 @@ def _sos_point(w: FloatArray) -> int:
 def _candidates(
     s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], tol: float
 ) -> list[int]:
-    """Groups with every member violated at ``x``, best branching candidate first (see
-    ``BRANCH_SELECT``)."""
+    """Groups with every member violated at ``x`` (beyond ``tol``), the one whose nearest member
+    is violated most first."""
     scored: list[tuple[float, int]] = []
     for g, mem in enumerate(allowed):
         if len(mem) < 2:
@@ -1674,29 +1690,18 @@ def _candidates(
         viol = _violations(s, x, g, mem)
         if float(np.min(viol)) <= tol:
             continue
-        if BRANCH_SELECT == "violation":
-            score = float(np.min(viol))
-        elif BRANCH_SELECT == "fractional":
-            score = 1.0 - float(np.max(_weights(x, mem)))
-        else:  # "first"
-            score = -g
-        scored.append((-score, g))
+        scored.append((-float(np.min(viol)), g))
     scored.sort()
     return [g for _, g in scored]
 
 
 def _split(
-    s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], g: int
+    x: FloatArray, allowed: tuple[tuple[int, ...], ...], g: int
 ) -> tuple[tuple[tuple[int, ...], ...], tuple[tuple[int, ...], ...]]:
-    """Split group ``g`` into two halves (see ``BRANCH_SPLIT``)."""
+    """Split group ``g`` into two halves at the weighted mean of its members (SOS1 branching)."""
     mem = allowed[g]
-    w = _weights(x, mem)
-    if BRANCH_SPLIT == "sos":
-        k = _sos_point(w)
-        one, other = mem[:k], mem[k:]
-    else:  # "nearest": the least violated member against the rest
-        z = mem[int(np.argmin(_violations(s, x, g, mem)))]
-        one, other = (z,), tuple(m for m in mem if m != z)
+    k = _sos_point(_weights(x, mem))
+    one, other = mem[:k], mem[k:]
     left = [*allowed]
     right = [*allowed]
     left[g] = one
@@ -1730,13 +1735,13 @@ def _propagate(
 def _branch(
     s: _Structure, x: FloatArray, allowed: tuple[tuple[int, ...], ...], tol: float
 ) -> tuple[tuple[tuple[int, ...], ...], ...] | None:
-    """Split the best violated group (see ``BRANCH_SELECT``) into two halves (``BRANCH_SPLIT``);
+    """Split the best violated group (see :func:`_candidates`) into two halves (:func:`_split`);
     with links, each child is reduced by :func:`_propagate` (a child left empty is dropped)."""
     cands = _candidates(s, x, allowed, tol)
     if not cands:
         return None
-    children = _split(s, x, allowed, cands[0])
-    if not (PROPAGATE and s.compat):
+    children = _split(x, allowed, cands[0])
+    if not s.compat:
         return children
     return tuple(c for c in (_propagate(s, a) for a in children) if c is not None)
 
@@ -1787,7 +1792,7 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
     """
     start = time.perf_counter()
     try:
-        structure = analyse(problem)
+        structure = analyse(problem, settings=options.bnb)
     except UnsupportedProblem as exc:
         from footfall.solvers import scip
 
@@ -1840,7 +1845,7 @@ def _dive(
         if res.bound >= cutoff:
             return None
         x = res.x
-        chosen = _choice(s, x, cur, ROW_TOL)
+        chosen = _choice(s, x, cur, relax.settings.row_tol)
         if chosen is not None:
             return chosen
     return None
@@ -1923,6 +1928,7 @@ class _Workers:
         import multiprocessing as mp
 
         ctx = mp.get_context("fork")
+        self.settings = relax.settings
         #: shared flag: 1 ends dives early (set by :meth:`close`)
         self.stop = ctx.Value("b", 0, lock=False)
         self.conns: list[Any] = []
@@ -2005,10 +2011,11 @@ class _Workers:
         return out
 
     def map(self, kind: str, tasks: list[Any], deadline: float = math.inf) -> list[Any]:
-        """Results of ``tasks`` in their order, solved in the workers (for synchronous batches);
-        None for the tasks not sent before ``deadline`` (``time.perf_counter`` seconds).
+        """Results of ``tasks`` in their order, solved in the workers (a synchronous batch:
+        probing, the local search); None for the tasks not sent before ``deadline``
+        (``time.perf_counter`` seconds).
 
-        At most ``MAP_DEPTH`` tasks per worker are in flight: a worker blocks sending its result
+        At most ``settings.map_depth`` tasks per worker are in flight: a worker blocks sending its result
         while its pipe is full, so sending it every task at once could deadlock both ends."""
         base = 1 << 40  # ids apart from the asynchronous tasks
         got: dict[int, Any] = {}
@@ -2017,7 +2024,7 @@ class _Workers:
         while len(got) < sent or sent < limit:
             if time.perf_counter() > deadline:
                 limit = sent  # send no more; wait for those in flight
-            while sent < limit and self.busy < MAP_DEPTH * len(self.conns):
+            while sent < limit and self.busy < self.settings.map_depth * len(self.conns):
                 self.submit(base + sent, kind, tasks[sent])
                 sent += 1
             if len(got) < sent:
@@ -2029,12 +2036,14 @@ class _Workers:
         while self.busy:
             self.wait(60.0)
 
-    def close(self, grace: float = DRAIN_TIMEOUT) -> None:
+    def close(self, grace: float | None = None) -> None:
         """Stop every worker and reap it: dives end early (shared flag), each worker finishes its
-        current solve and exits on ``None``; one still alive after ``grace`` seconds is
-        terminated, then killed. Unanswered results are dropped. Safe to call twice."""
+        current solve and exits on ``None``; one still alive after ``grace`` seconds (default
+        ``settings.drain_timeout``) is terminated, then killed. Unanswered results are dropped.
+        Safe to call twice."""
         if self.closed:
             return
+        grace = self.settings.drain_timeout if grace is None else grace
         self.closed = True
         self.stop.value = 1
         for conn in self.conns:
@@ -2086,11 +2095,12 @@ class _Search:
         self.s = structure
         self.problem = structure.problem
         self.options = options
+        self.settings = options.bnb
         self.start = start
         self.deadline = start + options.time_limit
         #: the search stops (as at the time limit) after this many nodes
         self.node_limit = math.inf
-        self.relax = HullRelaxation(structure) if relax is None else relax
+        self.relax = HullRelaxation(structure, settings=self.settings) if relax is None else relax
         self.incumbent: FloatArray | None = None
         self.inc_obj = math.inf
         self.tried: set[tuple[tuple[int, ...], ...]] = set()
@@ -2101,8 +2111,6 @@ class _Search:
         #: Clarabel status -> number of nodes left unsolved with it
         self.failures: dict[str, int] = {}
         self.lost_bound = math.inf
-        self.fixed_by_duals = 0
-        self.strong_solves = 0
         #: probing at the root: relaxations solved, members dropped
         self.probes = 0
         self.probe_dropped = 0
@@ -2110,7 +2118,7 @@ class _Search:
         #: the root node's allowed members and relaxation point (for probing)
         self.root: tuple[tuple[tuple[int, ...], ...], FloatArray] | None = None
         #: probing: due after this many nodes; its budget (relaxations per part, see
-        #: ``PROBE_BUDGET``); nodes solved when it ran (None: not yet) and the gap then; the
+        #: ``settings.probe_budget``); nodes solved when it ran (None: not yet) and the gap then; the
         #: members it killed, and the incumbent objective they were last updated for
         self.probe_at = math.inf
         self.probe_budget = math.inf
@@ -2137,7 +2145,7 @@ class _Search:
     # ----------------------------------------------------------------------------- incumbents
     def offer(self, cand: FloatArray) -> bool:
         """Take ``cand`` as incumbent if it is feasible and better; True if feasible."""
-        if self.problem.violation(cand) > FEAS_TOL:
+        if self.problem.violation(cand) > self.settings.feas_tol:
             return False
         obj = self.problem.objective(cand)
         if obj < self.inc_obj:
@@ -2199,7 +2207,7 @@ class _Search:
         bound = max(res.bound, parent_bound)
         if bound >= self.inc_obj:
             return None
-        chosen = _choice(self.s, res.x, allowed, ROW_TOL)
+        chosen = _choice(self.s, res.x, allowed, self.settings.row_tol)
         if chosen is not None:
             # The relaxation optimum satisfies one member of every group.
             if self.offer(_finish(self.s, res.x, chosen)):
@@ -2208,18 +2216,15 @@ class _Search:
                 return self.evaluate(allowed, bound, depth, True)
             self.solve_fixed(chosen)
             return None
-        heapq.heappush(
-            self.heap, _Node(bound, self.counter, allowed, res.x, depth, full, res.zdual)
-        )
+        heapq.heappush(self.heap, _Node(bound, self.counter, allowed, res.x, depth, full))
         self.counter += 1
-        if ROUNDING_EVERY and self.nodes % ROUNDING_EVERY == 0:
-            self.solve_fixed(_rounded(res.x, allowed))
         return res
 
     def run(self) -> SolverResult:
         """Best-first branch and bound; returns the best plan with an honest gap.
 
-        With probing (``PROBE_ROUNDS``), a search still open after ``PROBE_AFTER`` nodes per
+        With probing (``settings.probe_rounds``), a search still open after
+        ``settings.probe_after`` nodes per
         member of the root's undecided groups probes the root once (see :meth:`probe_now`): small
         searches never pay for probing, and a large one keeps the nodes it has."""
         root_allowed = _root_allowed(self.s)
@@ -2229,22 +2234,23 @@ class _Search:
             root = self.evaluate(root_allowed, -math.inf, 0, False)
         pool = None
         if self.heap and self.options.threads >= 2 and _Workers.available():
-            pool = _Workers(self.relax, self.options.threads - (1 if LOCAL_SOLVES else 0))
+            pool = _Workers(
+                self.relax, self.options.threads - (1 if self.settings.local_solves else 0)
+            )
         self.workers = 0 if pool is None else len(pool.procs)
         try:
             dive_from = None
             if root is not None and root.x is not None:
                 self.root = (root_allowed, root.x)
-                if PROBE_ROUNDS:
+                if self.settings.probe_rounds:
                     undecided = sum(len(m) for m in root_allowed if len(m) > 1)
-                    self.probe_at = PROBE_AFTER * undecided
-                if DIVE:
-                    if pool is not None and ASYNC:
-                        dive_from = (root.x, root_allowed)  # a worker dives, the others branch
-                    else:
-                        self.dive(root.x, root_allowed)
-            if pool is None or not ASYNC:
-                timed_out = self._loop(pool)
+                    self.probe_at = self.settings.probe_after * undecided
+                if pool is not None:
+                    dive_from = (root.x, root_allowed)  # a worker dives, the others branch
+                else:
+                    self.dive(root.x, root_allowed)
+            if pool is None:
+                timed_out = self._loop()
             else:
                 timed_out = self._loop_async(pool, dive_from)
         finally:
@@ -2258,27 +2264,28 @@ class _Search:
         return self.probed_at is None and self.nodes >= self.probe_at
 
     def probe_now(self, pool: _Workers | None) -> None:
-        """Probe the root (:meth:`probe`, ``PROBE_FIRST_ROUNDS`` rounds) with the incumbent, run
-        the primal heuristics (:meth:`restricted_search`, :meth:`local_search`), then probe on
-        (up to ``PROBE_ROUNDS`` rounds) with their incumbent. The members probing drops are dead for the rest of the search: an open node
+        """Probe the root (:meth:`probe`, ``settings.probe_first_rounds`` rounds) with the
+        incumbent, run the primal heuristics (:meth:`restricted_search`, :meth:`local_search`),
+        then probe on (up to ``settings.probe_rounds`` rounds) with their incumbent. The members
+        probing drops are dead for the rest of the search: an open node
         loses them when it is next taken from the queue (:meth:`narrowed`), and one that loses
         any is solved again before it is branched. Called with no node solve in flight."""
         self.probed_at = self.nodes
         if self.root is None:
             return
-        self.probe_budget = PROBE_BUDGET * self.nodes
+        self.probe_budget = self.settings.probe_budget * self.nodes
         self.probe_gap = self.gap_of(self.heap[0].bound) if self.heap else 0.0
         start, root_x = self.root
         # one round ranks the members for the heuristics; the rest use their incumbent
         t0 = time.perf_counter()
-        allowed = self.probe(start, root_x, pool, PROBE_FIRST_ROUNDS)
+        allowed = self.probe(start, root_x, pool, self.settings.probe_first_rounds)
         self.probe_time += time.perf_counter() - t0
         if all(allowed) and self.heap and self.gap_of(self.heap[0].bound) > self.options.gap:
             self.heur_from = self.inc_obj
             self.restricted_search(allowed, pool)
             self.local_search(allowed, pool)
         t0 = time.perf_counter()
-        allowed = self.probe(allowed, None, pool, PROBE_ROUNDS)
+        allowed = self.probe(allowed, None, pool, self.settings.probe_rounds)
         self.probe_time += time.perf_counter() - t0
         kept = {z for mem in allowed for z in mem}
         self.dead |= {z for mem in start for z in mem if z not in kept}
@@ -2324,7 +2331,7 @@ class _Search:
         for rnd in range(rounds):
             if not all(allowed) or time.perf_counter() > self.deadline:
                 break
-            if rnd and DIVE and not math.isfinite(self.inc_obj):
+            if rnd and not math.isfinite(self.inc_obj):
                 # no incumbent yet: the smaller root may lead the dive to a plan
                 if root_x is None:
                     top = self.relax.solve(allowed)
@@ -2350,7 +2357,7 @@ class _Search:
                 elif res.status == "infeasible":
                     self.probe_bound[z] = math.inf
                 if res.status == "solved" and res.x is not None:
-                    chosen = _choice(self.s, res.x, a, ROW_TOL)
+                    chosen = _choice(self.s, res.x, a, self.settings.row_tol)
                     if chosen is not None:
                         self.offer(_finish(self.s, res.x, chosen))
             # against the best incumbent now (a probe may have found a better one)
@@ -2358,7 +2365,7 @@ class _Search:
             root_x = None
             if drop:
                 allowed = self._narrow(allowed, drop)
-            few = len(drop) < PROBE_MIN_DROP * len(tasks)
+            few = len(drop) < self.settings.probe_min_drop * len(tasks)
             if not drop or (few and self.inc_obj >= before and math.isfinite(self.inc_obj)):
                 break
         return allowed
@@ -2392,21 +2399,22 @@ class _Search:
     def restricted_search(
         self, allowed: tuple[tuple[int, ...], ...], pool: _Workers | None
     ) -> None:
-        """Primal heuristic: branch and bound (at most ``HEUR_NODES`` nodes, cut off at the
-        incumbent) over ``allowed`` restricted to each group's ``HEUR_TOP`` members of the lowest
+        """Primal heuristic: branch and bound (at most ``settings.heur_nodes`` nodes, cut off at the
+        incumbent) over ``allowed`` restricted to each group's ``settings.heur_top`` members of the lowest
         probe bound; its best point is offered as incumbent. The restricted problem is small, and
         its optimum is often the full problem's (the probe bounds rank the members well)."""
-        if not (HEUR_TOP and HEUR_NODES):
+        top, nodes = self.settings.heur_top, self.settings.heur_nodes
+        if not (top and nodes):
             return
         rank = self.probe_bound
         small = tuple(
-            mem if len(mem) <= HEUR_TOP
-            else tuple(sorted(mem, key=lambda z: (rank.get(z, -math.inf), z))[:HEUR_TOP])
+            mem if len(mem) <= top
+            else tuple(sorted(mem, key=lambda z: (rank.get(z, -math.inf), z))[:top])
             for mem in allowed
         )  # fmt: skip
         if small == allowed:
             return  # the restricted problem is the search itself
-        limit = min(HEUR_NODES, self.probe_budget)
+        limit = min(nodes, self.probe_budget)
         sub = _Search(self.s, self.options, self.start, self.relax)
         sub.deadline = self.deadline
         sub.node_limit = limit
@@ -2414,8 +2422,8 @@ class _Search:
         sub.tried = self.tried
         sub.evaluate(small, -math.inf, 0, False)
         try:
-            if pool is None or not ASYNC:
-                sub._loop(pool)
+            if pool is None:
+                sub._loop()
             else:
                 sub._loop_async(pool, None)
         finally:
@@ -2428,12 +2436,12 @@ class _Search:
     def local_search(self, allowed: tuple[tuple[int, ...], ...], pool: _Workers | None) -> None:
         """Primal heuristic: from the incumbent's members, solve every assignment that moves one
         group to another allowed member (all groups fixed: one convex solve each) and take the
-        best improvement; repeat for at most ``LS_SWEEPS`` sweeps."""
-        if self.incumbent is None or not LS_SWEEPS:
+        best improvement; repeat for at most ``settings.ls_sweeps`` sweeps."""
+        if self.incumbent is None or not self.settings.ls_sweeps:
             return
         x = self.incumbent
         cur = [mem[int(np.argmax(x[list(mem)]))] for mem in _root_allowed(self.s)]
-        for _ in range(LS_SWEEPS):
+        for _ in range(self.settings.ls_sweeps):
             if time.perf_counter() > self.deadline:
                 return
             moves: list[tuple[tuple[int, ...], ...]] = []
@@ -2472,58 +2480,48 @@ class _Search:
             if self.inc_obj >= before:
                 return
 
-    def _loop(self, pool: _Workers | None) -> bool:
-        """The best-first loop; returns True when stopped by the time limit. With a ``pool``, the
-        children of the best ``threads`` open nodes are solved in parallel."""
-        batch = 1 if pool is None else self.options.threads
+    def _loop(self) -> bool:
+        """The serial best-first loop; returns True when stopped by the time limit."""
         while self.heap:
             top = self.heap[0].bound
-            if not self.trace or self.nodes >= self.trace[-1][0] + 25:
-                inc = self.inc_obj if math.isfinite(self.inc_obj) else None  # JSON-safe
-                self.trace.append((self.nodes, time.perf_counter() - self.start, inc, top))
+            self._record(top)
             if self.gap_of(top) <= self.options.gap:
                 break
             if time.perf_counter() > self.deadline or self.nodes >= self.node_limit:
                 return True
             if self.probe_due:
-                self.probe_now(pool)
+                self.probe_now(None)
                 continue
-            tasks: list[tuple[tuple[tuple[int, ...], ...], _Node]] = []
-            while self.heap and len(tasks) < 2 * batch:
-                node = heapq.heappop(self.heap)
-                if node.bound >= self.inc_obj:
-                    continue
-                assert node.x is not None
-                narrowed = self.narrowed(node.allowed)
-                if narrowed is None:
-                    continue
-                if narrowed != node.allowed:  # it lost dead members: solve it again first
-                    tasks.append((narrowed, node))
-                    continue
-                allowed = node.allowed
-                if REDUCED_COST_FIXING and node.zdual is not None and math.isfinite(self.inc_obj):
-                    allowed = _fix_by_duals(allowed, node.bound + node.zdual, self.inc_obj)
-                    if not all(allowed):
-                        continue  # every member of some group is worse than the incumbent
-                    self.fixed_by_duals += sum(map(len, node.allowed)) - sum(map(len, allowed))
-                if STRONG > 1:
-                    done = self.strong(node, allowed, pool)
-                    if done is not None:
-                        for child, res in done:
-                            self.evaluate(child, node.bound, node.depth + 1, node.full, res)
-                        continue
-                split = _branch(self.s, node.x, allowed, ROW_TOL)
-                if split is None:  # pragma: no cover - evaluate() resolved such nodes
-                    continue
-                tasks.extend((child, node) for child in split)
-            if pool is None:
-                for child, node in tasks:
-                    self.evaluate(child, node.bound, node.depth + 1, node.full)
-            else:
-                results = pool.map("node", [(child, node.full) for child, node in tasks])
-                for (child, node), res in zip(tasks, results, strict=True):
-                    self.evaluate(child, node.bound, node.depth + 1, node.full, res)
+            for child, node in self._take_two():
+                self.evaluate(child, node.bound, node.depth + 1, node.full)
         return False
+
+    def _record(self, top: float) -> None:
+        """Append ``(nodes, seconds, incumbent, bound)`` to the trace every 25 nodes."""
+        if not self.trace or self.nodes >= self.trace[-1][0] + 25:
+            inc = self.inc_obj if math.isfinite(self.inc_obj) else None  # JSON-safe
+            self.trace.append((self.nodes, time.perf_counter() - self.start, inc, top))
+
+    def _take_two(self) -> list[tuple[tuple[tuple[int, ...], ...], _Node]]:
+        """Up to two node problems to solve next, with their parents: the children of the best
+        open node, or an open node that lost dead members (solved again before it is branched)."""
+        tasks: list[tuple[tuple[tuple[int, ...], ...], _Node]] = []
+        while self.heap and len(tasks) < 2:
+            node = heapq.heappop(self.heap)
+            if node.bound >= self.inc_obj:
+                continue
+            assert node.x is not None
+            narrowed = self.narrowed(node.allowed)
+            if narrowed is None:
+                continue
+            if narrowed != node.allowed:  # it lost dead members: solve it again first
+                tasks.append((narrowed, node))
+                continue
+            split = _branch(self.s, node.x, node.allowed, self.settings.row_tol)
+            if split is None:  # pragma: no cover - evaluate() resolved such nodes
+                continue
+            tasks.extend((child, node) for child in split)
+        return tasks
 
     def _loop_async(
         self, pool: _Workers, dive_from: tuple[FloatArray, tuple[tuple[int, ...], ...]] | None
@@ -2533,18 +2531,19 @@ class _Search:
         loaded workers), so the workers never wait for a batch. A node's bound counts in the global
         bound until its children's results are in. ``dive_from`` (a relaxation point and its
         node) starts a dive in one worker. Returns True when stopped by the time limit."""
-        #: per task: (kind, assignment, parent node); kind "node", "fixed" or "dive"
+        #: per task: (kind, assignment, parent node); kind "node" or "dive"
         inflight: dict[int, tuple[str, tuple[tuple[int, ...], ...], _Node | None]] = {}
-        #: with LOCAL_SOLVES: the node tasks the search process solves itself
+        #: with ``settings.local_solves``: the node tasks the search process solves itself
         mine: list[tuple[int, Any]] = []
         next_id = 0
+        local = self.settings.local_solves
 
         def submit(kind: str, task: Any, allowed: Any, node: _Node | None) -> None:
             nonlocal next_id
             tid = next_id
             next_id += 1
             inflight[tid] = (kind, allowed, node)
-            if LOCAL_SOLVES and kind != "dive" and pool.busy >= 2 * len(pool.procs):
+            if local and kind != "dive" and pool.busy >= 2 * len(pool.procs):
                 mine.append((tid, task))
             else:
                 pool.submit(tid, "dive" if kind == "dive" else "node", task)
@@ -2566,49 +2565,22 @@ class _Search:
         inflight: dict[int, tuple[str, tuple[tuple[int, ...], ...], _Node | None]],
         mine: list[tuple[int, Any]],
     ) -> bool:
-        """The body of :meth:`_loop_async`."""
+        """The body of :meth:`_loop_async`: branch until the workers are busy, check the gap,
+        then take one answer. Returns True when stopped by the time limit or the node limit."""
         answered: list[tuple[int, Any]] = []
-        threads = self.options.threads
-        if LOCAL_SOLVES:  # every worker two deep, one for the search process
-            threads = 2 * len(pool.procs) + 1
-        branched = 0
+        # with local solves every worker is kept two deep, one more task for the search process
+        depth = 2 * len(pool.procs) + 1 if self.settings.local_solves else None
         while True:
-            # Branch until every worker has a task: counting the tasks in flight instead left a
-            # worker idle whenever both children of a node had gone to the other worker's queue.
             due = self.probe_due
-            while (
-                self.heap and not due and (len(inflight) < threads if LOCAL_SOLVES else pool.idle)
-            ):
-                node = heapq.heappop(self.heap)
-                if node.bound >= self.inc_obj:
-                    continue
-                assert node.x is not None
-                allowed = self.narrowed(node.allowed)
-                if allowed is None:
-                    continue
-                if allowed != node.allowed:  # it lost dead members: solve it again first
-                    submit("node", (allowed, node.full), allowed, node)
-                    continue
-                split = _branch(self.s, node.x, node.allowed, ROW_TOL)
-                if split is None:  # pragma: no cover - evaluate() resolved such nodes
-                    continue
-                for child in split:
-                    submit("node", (child, node.full), child, node)
-                branched += 1
-                if ROUNDING_EVERY and branched % ROUNDING_EVERY == 0:
-                    fixed = _rounded(node.x, node.allowed)
-                    if fixed not in self.tried:
-                        self.tried.add(fixed)
-                        submit("fixed", (fixed, False), fixed, None)
+            if not due:
+                self._branch_into(pool, submit, inflight, depth)
             open_nodes = [nd.bound for _, _, nd in inflight.values() if nd is not None]
             if self.heap:
                 open_nodes.append(self.heap[0].bound)
             if not open_nodes:
                 return False
             top = min(open_nodes)
-            if not self.trace or self.nodes >= self.trace[-1][0] + 25:
-                inc = self.inc_obj if math.isfinite(self.inc_obj) else None  # JSON-safe
-                self.trace.append((self.nodes, time.perf_counter() - self.start, inc, top))
+            self._record(top)
             if self.gap_of(top) <= self.options.gap:
                 return False
             if self.nodes >= self.node_limit:
@@ -2616,60 +2588,73 @@ class _Search:
             if due and not inflight:
                 self.probe_now(pool)
                 continue
-            if not answered and mine:
-                if time.perf_counter() > self.deadline:
-                    return True
-                tid, (allowed, full) = mine.pop(0)
-                answered = [(tid, self.relax.solve(allowed, full=full)), *pool.wait(0.0)]
-                answered.reverse()
             if not answered:
-                answered = pool.wait(self.deadline - time.perf_counter())
+                answered = self._answers(pool, mine)
                 if not answered:
                     return True
-                answered.reverse()  # popped from the end: oldest first
             tid, res = answered.pop()
-            kind, allowed, parent = inflight.pop(tid)
-            if kind == "dive":
-                allowed, res = res
-                if allowed is None or allowed in self.tried:
-                    continue
-                self.tried.add(allowed)
-            if parent is None:  # every group fixed: a rounding or the end of the dive
-                if res is not None and res.status == "solved" and res.x is not None:
-                    if not self.offer(_finish(self.s, res.x, allowed)):
-                        self.tried.discard(allowed)
-                        self.solve_fixed(allowed)  # the condensed point broke a dropped bound
-                continue
-            self.evaluate(allowed, parent.bound, parent.depth + 1, parent.full, res)
+            self._take_answer(inflight.pop(tid), res)
 
-    def strong(
-        self, node: _Node, allowed: tuple[tuple[int, ...], ...], pool: _Workers | None
-    ) -> list[tuple[tuple[tuple[int, ...], ...], _Relaxation]] | None:
-        """Strong branching over the ``STRONG`` best candidates: the children (with their solved
-        relaxations) of the split whose children bounds rise most (product score)."""
-        assert node.x is not None
-        cands = _candidates(self.s, node.x, allowed, ROW_TOL)[:STRONG]
-        if len(cands) < 2:
-            return None
-        splits = [_split(self.s, node.x, allowed, g) for g in cands]
-        flat = [child for sp_ in splits for child in sp_]
-        if pool is None:
-            results = [self.relax.solve(c, full=node.full) for c in flat]
+    def _branch_into(
+        self,
+        pool: _Workers,
+        submit: Any,
+        inflight: dict[int, tuple[str, tuple[tuple[int, ...], ...], _Node | None]],
+        depth: int | None,
+    ) -> None:
+        """Branch the best open nodes and submit their children until every worker has a task
+        (or, with ``depth``, until that many tasks are in flight). Counting the tasks in flight
+        instead left a worker idle whenever both children of a node had gone to the other
+        worker's queue."""
+        while self.heap and (pool.idle if depth is None else len(inflight) < depth):
+            node = heapq.heappop(self.heap)
+            if node.bound >= self.inc_obj:
+                continue
+            assert node.x is not None
+            allowed = self.narrowed(node.allowed)
+            if allowed is None:
+                continue
+            if allowed != node.allowed:  # it lost dead members: solve it again first
+                submit("node", (allowed, node.full), allowed, node)
+                continue
+            split = _branch(self.s, node.x, node.allowed, self.settings.row_tol)
+            if split is None:  # pragma: no cover - evaluate() resolved such nodes
+                continue
+            for child in split:
+                submit("node", (child, node.full), child, node)
+
+    def _answers(self, pool: _Workers, mine: list[tuple[int, Any]]) -> list[tuple[int, Any]]:
+        """The next answered tasks, oldest last (popped from the end): one of ``mine`` solved
+        here with whatever the workers answered meanwhile, else the workers' answers as they
+        come; [] at the time limit."""
+        if mine:
+            if time.perf_counter() > self.deadline:
+                return []
+            tid, (allowed, full) = mine.pop(0)
+            answered = [(tid, self.relax.solve(allowed, full=full)), *pool.wait(0.0)]
         else:
-            results = pool.map("node", [(c, node.full) for c in flat])
-        self.strong_solves += len(flat) - 2
-        best, best_i = -math.inf, 0
-        for i in range(len(splits)):
-            gains = []
-            for res in results[2 * i : 2 * i + 2]:
-                b = res.bound if res.status == "solved" else math.inf
-                if res.status == "failed":
-                    b = node.bound
-                gains.append(max(min(b, self.inc_obj) - node.bound, 1e-9))
-            score = gains[0] * gains[1]
-            if score > best:
-                best, best_i = score, i
-        return list(zip(splits[best_i], results[2 * best_i : 2 * best_i + 2], strict=True))
+            answered = pool.wait(self.deadline - time.perf_counter())
+        answered.reverse()
+        return answered
+
+    def _take_answer(
+        self, task: tuple[str, tuple[tuple[int, ...], ...], _Node | None], res: Any
+    ) -> None:
+        """Use the answer ``res`` of one task ``(kind, assignment, parent)``: a node's
+        relaxation is evaluated; the end of the dive, every group fixed, is offered."""
+        kind, allowed, parent = task
+        if kind == "dive":
+            allowed, res = res
+            if allowed is None or allowed in self.tried:
+                return
+            self.tried.add(allowed)
+        if parent is None:  # every group fixed: the end of the dive
+            if res is not None and res.status == "solved" and res.x is not None:
+                if not self.offer(_finish(self.s, res.x, allowed)):
+                    self.tried.discard(allowed)
+                    self.solve_fixed(allowed)  # the condensed point broke a dropped bound
+            return
+        self.evaluate(allowed, parent.bound, parent.depth + 1, parent.full, res)
 
     def result(self, timed_out: bool) -> SolverResult:
         """The :class:`SolverResult` of the search so far."""
@@ -2711,8 +2696,6 @@ class _Search:
                 "groups": len(self.s.groups),
                 "members": self.relax.n_members,
                 "condensed": self.relax.condensed is not None,
-                "fixed_by_duals": self.fixed_by_duals,
-                "strong_solves": self.strong_solves,
                 "probes": self.probes,
                 "probe_dropped": self.probe_dropped,
                 "probe_time_s": self.probe_time,
@@ -2723,5 +2706,6 @@ class _Search:
                 "incumbent_before_heuristics": self.heur_from,
                 "workers": self.workers,
                 "trace": self.trace,
+                "settings": dataclasses.asdict(self.settings),
             },
         )
