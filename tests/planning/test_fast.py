@@ -20,7 +20,9 @@ from footfall.planning.check import check_plan
 from footfall.planning.miqcqp import build_footstep_problem, plan_footsteps
 from footfall.planning.plan import PlannerOptions
 from footfall.solvers import ProblemBuilder, SolverOptions, SolveStatus, bnb, solve
-from footfall.solvers.bnb import BnbSettings
+from footfall.solvers.bnb import BnbSettings, branching, links, relaxation, workers
+from footfall.solvers.bnb import search as bnb_search
+from footfall.solvers.bnb import structure as bnb_structure
 from footfall.solvers.problem import MIQCQP, fix_variables
 from footfall.terrain.scene import random_stepping_stones
 
@@ -69,7 +71,7 @@ def test_fast_objective_equals_direct(regions: int, seed: int, n: int) -> None:
     assert fast.bound <= direct.objective * (1 + OBJ_RTOL)
     # and so is the root relaxation (hull, perspective, tightened member rows, condensed dynamics)
     structure = bnb.analyse(build_footstep_problem(scene, ROBOT, n, opts).problem)
-    root = bnb.HullRelaxation(structure).solve(bnb._root_allowed(structure))
+    root = bnb.HullRelaxation(structure).solve(branching._root_allowed(structure))
     assert root.status == "solved"
     assert root.bound <= direct.objective * (1 + BOUND_RTOL)
 
@@ -111,7 +113,7 @@ def test_relaxation_is_a_lower_bound_and_exact_when_fixed() -> None:
     assert res.status is SolveStatus.OPTIMAL and res.x is not None
     structure = bnb.analyse(fp.problem)
     relax = bnb.HullRelaxation(structure)
-    root = relax.solve(bnb._root_allowed(structure))
+    root = relax.solve(branching._root_allowed(structure))
     assert root.status == "solved"
     assert root.bound <= res.objective * (1 + BOUND_RTOL)
     # every group fixed to the optimal member: condensed and full relaxations give the optimum
@@ -129,8 +131,8 @@ def test_perspective_and_hull_relaxations_agree_on_the_optimum() -> None:
     assert not np.any(structure.assigned)
     with_p = bnb.analyse(fp.problem, perspective=True)
     assert np.any(with_p.assigned)  # the horizontal step terms sit in the heading-segment groups
-    plain = bnb.HullRelaxation(structure).solve(bnb._root_allowed(structure))
-    persp = bnb.HullRelaxation(with_p).solve(bnb._root_allowed(with_p))
+    plain = bnb.HullRelaxation(structure).solve(branching._root_allowed(structure))
+    persp = bnb.HullRelaxation(with_p).solve(branching._root_allowed(with_p))
     # the perspective relaxation is at least as tight
     assert persp.bound >= plain.bound * (1 - BOUND_RTOL)
 
@@ -211,10 +213,10 @@ def test_search_process_solving_beside_one_worker_finds_the_same_optimum() -> No
     assert local.stats["workers"] == 1
 
 
-class _Recorded(bnb._Workers):
+class _Recorded(workers._Workers):
     """The worker pool, remembering every instance (to check that its processes are reaped)."""
 
-    made: ClassVar[list[bnb._Workers]] = []
+    made: ClassVar[list[workers._Workers]] = []
 
     def __init__(self, relax, n: int) -> None:  # type: ignore[no-untyped-def]
         super().__init__(relax, n)
@@ -222,13 +224,13 @@ class _Recorded(bnb._Workers):
 
 
 @pytest.fixture
-def recorded(monkeypatch: pytest.MonkeyPatch) -> list[bnb._Workers]:
+def recorded(monkeypatch: pytest.MonkeyPatch) -> list[workers._Workers]:
     """Pools the searches of a test made; afterwards every worker must be reaped."""
     import multiprocessing as mp
     import os
 
     _Recorded.made = []
-    monkeypatch.setattr(bnb, "_Workers", _Recorded)
+    monkeypatch.setattr(bnb_search, "_Workers", _Recorded)
     yield _Recorded.made
     for pool in _Recorded.made:
         assert pool.closed
@@ -242,13 +244,13 @@ def _branching_problem() -> MIQCQP:
     return build_footstep_problem(random_stepping_stones(0, 8, robot=ROBOT), ROBOT, 8).problem
 
 
-def test_workers_are_reaped_after_a_solve(recorded: list[bnb._Workers]) -> None:
+def test_workers_are_reaped_after_a_solve(recorded: list[workers._Workers]) -> None:
     res = solve(_branching_problem(), "bnb", SolverOptions(gap=GAP, threads=2))
     assert res.status is SolveStatus.OPTIMAL
     assert len(recorded) == 1 and len(recorded[0].procs) == 2
 
 
-def test_workers_are_reaped_after_the_time_limit(recorded: list[bnb._Workers]) -> None:
+def test_workers_are_reaped_after_the_time_limit(recorded: list[workers._Workers]) -> None:
     fp = build_footstep_problem(random_stepping_stones(0, 8, robot=ROBOT), ROBOT, 10)
     res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.3, gap=0.0, threads=2))
     assert res.status in (SolveStatus.TIME_LIMIT, SolveStatus.OPTIMAL)
@@ -266,20 +268,20 @@ def _exit_in_worker(task):  # type: ignore[no-untyped-def]
 
 
 def test_a_failing_worker_stops_the_search_with_its_error(
-    recorded: list[bnb._Workers], monkeypatch: pytest.MonkeyPatch
+    recorded: list[workers._Workers], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setattr(bnb, "_work", _raise_in_worker)  # the forked workers inherit it
+    monkeypatch.setattr(workers, "_work", _raise_in_worker)  # the forked workers inherit it
     with pytest.raises(bnb.WorkerError, match="node solver exploded"):
         solve(_branching_problem(), "bnb", SolverOptions(gap=GAP, threads=2))
     assert len(recorded) == 1
 
 
 def test_a_dead_worker_is_an_error_not_a_hang(
-    recorded: list[bnb._Workers], monkeypatch: pytest.MonkeyPatch
+    recorded: list[workers._Workers], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     import time
 
-    monkeypatch.setattr(bnb, "_work", _exit_in_worker)
+    monkeypatch.setattr(workers, "_work", _exit_in_worker)
     start = time.perf_counter()
     with pytest.raises(bnb.WorkerError, match=r"died \(exit code 7\)"):
         solve(_branching_problem(), "bnb", SolverOptions(time_limit=60.0, gap=GAP, threads=2))
@@ -288,10 +290,10 @@ def test_a_dead_worker_is_an_error_not_a_hang(
 
 
 def test_an_error_in_the_search_process_reaps_the_workers(
-    recorded: list[bnb._Workers], monkeypatch: pytest.MonkeyPatch
+    recorded: list[workers._Workers], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     calls = {"n": 0}
-    evaluate = bnb._Search.evaluate
+    evaluate = bnb_search._Search.evaluate
 
     def failing(self, *args, **kwargs):  # type: ignore[no-untyped-def]
         calls["n"] += 1
@@ -299,7 +301,7 @@ def test_an_error_in_the_search_process_reaps_the_workers(
             raise KeyboardInterrupt
         return evaluate(self, *args, **kwargs)
 
-    monkeypatch.setattr(bnb._Search, "evaluate", failing)
+    monkeypatch.setattr(bnb_search._Search, "evaluate", failing)
     with pytest.raises(KeyboardInterrupt):
         solve(_branching_problem(), "bnb", SolverOptions(gap=GAP, threads=2))
     assert len(recorded) == 1
@@ -370,7 +372,7 @@ def test_dropping_redundant_member_rows_keeps_the_member_set() -> None:
     lb, ub = np.array([-1.0, -2.0]), np.array([1.0, 2.0])
     a_v = np.array([[1.0, 0.0], [2.0, 0.0], [-1.0, 0.0], [-0.5, 0.0], [0.1, 0.1], [1.0, 1.0]])
     beta = np.array([0.5, 3.0, 0.8, 0.2, 5.0, 1.0])
-    a_r, b_r = bnb._drop_redundant(a_v, beta, lb, ub, DEFAULTS.redundant_tol)
+    a_r, b_r = bnb_structure._drop_redundant(a_v, beta, lb, ub, DEFAULTS.redundant_tol)
     assert len(b_r) == 3  # x0 <= 0.5, x0 >= -0.4, x0 + x1 <= 1
     pts = rng.uniform(lb, ub, size=(2000, 2))
     inside = np.all(pts @ a_v.T <= beta, axis=1)
@@ -383,7 +385,7 @@ def test_member_violations_are_the_largest_row_violations() -> None:
     structure = bnb.analyse(fp.problem)
     x = np.random.default_rng(1).uniform(fp.problem.lb, fp.problem.ub)
     for g, grp in enumerate(structure.groups):
-        got = bnb._violations(structure, x, g, grp.members[::-1])
+        got = branching._violations(structure, x, g, grp.members[::-1])
         for k, z in enumerate(grp.members[::-1]):
             mb = structure.member[z]
             want = float(np.max(mb.a_v @ x[grp.variables] - mb.beta)) if len(mb.beta) else 0.0
@@ -392,7 +394,7 @@ def test_member_violations_are_the_largest_row_violations() -> None:
 
 def _link_structure(
     problem: MIQCQP, staircase: bool = True, min_drop: float = DEFAULTS.link_min_drop
-) -> bnb._Structure:
+) -> bnb_structure._Structure:
     settings = BnbSettings(links=True, staircase=staircase, link_min_drop=min_drop)
     return bnb.analyse(problem, settings=settings)
 
@@ -440,11 +442,11 @@ def test_linked_relaxation_is_tighter_and_below_the_optimum(seed: int) -> None:
     best = solve(fp.problem, "bnb", SolverOptions(gap=GAP))
     assert best.status is SolveStatus.OPTIMAL
     plain_s = bnb.analyse(fp.problem)
-    plain = bnb.HullRelaxation(plain_s).solve(bnb._root_allowed(plain_s))
+    plain = bnb.HullRelaxation(plain_s).solve(branching._root_allowed(plain_s))
     bounds = []
     for staircase in (True, False):  # prefix rows and pair weights: the same polytope
         linked_s = _link_structure(fp.problem, staircase)
-        linked = bnb.HullRelaxation(linked_s).solve(bnb._root_allowed(linked_s))
+        linked = bnb.HullRelaxation(linked_s).solve(branching._root_allowed(linked_s))
         assert linked.status == plain.status == "solved"
         assert linked.bound >= plain.bound * (1 - BOUND_RTOL)
         assert linked.bound <= best.objective * (1 + BOUND_RTOL)
@@ -468,12 +470,12 @@ def test_linked_search_finds_the_same_optimum(regions: int, seed: int, n: int) -
 def test_propagation_drops_only_members_without_a_compatible_partner() -> None:
     fp = build_footstep_problem(random_stepping_stones(0, 8, robot=ROBOT), ROBOT, 10)
     structure = _link_structure(fp.problem)
-    root = bnb._root_allowed(structure)
+    root = branching._root_allowed(structure)
     # pin footstep 5 to its first live segment
     z5 = int(fp.segments[5][fp.segments[5] >= 0][0])
     g5 = structure.group_of[z5]
     pinned = tuple((z5,) if g == g5 else mem for g, mem in enumerate(root))
-    out = bnb._propagate(structure, pinned)
+    out = links._propagate(structure, pinned)
     assert out is not None
     assert sum(map(len, out)) < sum(map(len, pinned))
     # partners of each member in the other group of each link, both directions
@@ -497,11 +499,11 @@ def test_propagation_drops_only_members_without_a_compatible_partner() -> None:
     clash = tuple((z6,) if g == g6 else mem for g, mem in enumerate(pinned))
     link56 = next(lk for lk in structure.compat if lk.groups == (g5, g6))
     assert (z5, z6) not in {(int(a), int(b)) for a, b in link56.pairs}
-    assert bnb._propagate(structure, clash) is None
+    assert links._propagate(structure, clash) is None
 
 
 def test_clarabel_gets_the_same_problem_from_lists() -> None:
-    """The node solver hands Clarabel its matrices as lists (:class:`bnb._CscLists`, cheaper to
+    """The node solver hands Clarabel its matrices as lists (:class:`relaxation._CscLists`, cheaper to
     convert): same solution as from the scipy matrices, also for a non-canonical input."""
     import clarabel
     import scipy.sparse as sp
@@ -526,7 +528,7 @@ def test_clarabel_gets_the_same_problem_from_lists() -> None:
     ref = clarabel.DefaultSolver(p_mat, q, a_mat, b, [clarabel.NonnegativeConeT(m)], settings)
     ref_sol = ref.solve()
     got = clarabel.DefaultSolver(
-        bnb._CscLists(p_mat), q.tolist(), bnb._CscLists(a_dup), b.tolist(),
+        relaxation._CscLists(p_mat), q.tolist(), relaxation._CscLists(a_dup), b.tolist(),
         [clarabel.NonnegativeConeT(m)], settings,
     ).solve()  # fmt: skip
     assert str(got.status) == str(ref_sol.status) == "Solved"
@@ -553,7 +555,7 @@ def test_compact_node_problems_are_the_same_relaxation() -> None:
         1 for grp in structure.groups if len(grp.cost_rows) and len(grp.members) > 1
     )
     rng = np.random.default_rng(3)
-    root = bnb._root_allowed(structure)
+    root = branching._root_allowed(structure)
     nodes = [root]
     for _ in range(12):  # random nodes: every group keeps a random non-empty subset
         nodes.append(
@@ -598,7 +600,7 @@ def test_probing_drops_only_members_no_better_plan_uses() -> None:
     that binary fixed to 1: infeasible, or no better than the plan the search returned."""
     fp = build_footstep_problem(_scene(5, 1), ROBOT, 5)
     options = SolverOptions(gap=GAP, bnb=PROBING)
-    search = bnb._Search(bnb.analyse(fp.problem), options, time.perf_counter())
+    search = bnb_search._Search(bnb.analyse(fp.problem), options, time.perf_counter())
     res = search.run()
     assert res.status is SolveStatus.OPTIMAL
     dead = sorted(search.dead)
@@ -618,8 +620,8 @@ def test_worker_map_keeps_many_tasks_flowing_and_stops_at_its_deadline() -> None
     # all tasks sent at once filled both pipes and deadlocked the search and its workers
     structure = bnb.analyse(_branching_problem())
     relax = bnb.HullRelaxation(structure)
-    root = bnb._root_allowed(structure)
-    pool = bnb._Workers(relax, 2)
+    root = branching._root_allowed(structure)
+    pool = workers._Workers(relax, 2)
     try:
         out = pool.map("node", [(root, False)] * 300)
         assert len(out) == 300 and all(r.status == "solved" for r in out)
