@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -19,9 +19,6 @@ from footfall._typing import FloatArray
 from footfall.solvers.bnb.links import _propagate
 from footfall.solvers.bnb.relaxation import HullRelaxation
 from footfall.solvers.bnb.structure import _Structure
-
-if TYPE_CHECKING:
-    pass
 
 
 @dataclass(order=True)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -27,10 +27,6 @@ from footfall.solvers.bnb.templates import (
     _templates,
     _with_prefix,
 )
-
-if TYPE_CHECKING:
-    pass
-
 
 #: Clarabel statuses that end a node solve (anything else is retried once, then "failed")
 _CLARABEL_DONE = ("Solved", "AlmostSolved", "PrimalInfeasible", "AlmostPrimalInfeasible")

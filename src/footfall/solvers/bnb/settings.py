@@ -10,13 +10,10 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from footfall._validate import non_negative
 from footfall.errors import InputError
-
-if TYPE_CHECKING:
-    pass
 
 
 def _pairs(name: str, value: object) -> tuple[tuple[str, bool | int | float], ...]:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -21,9 +21,7 @@ from numpy.typing import NDArray
 
 from footfall._typing import FloatArray, IntArray
 from footfall.solvers.bnb.structure import _Group, _Structure
-
-if TYPE_CHECKING:
-    pass
+from footfall.solvers.problem import MIQCQP
 
 
 class _Coo:
@@ -153,90 +151,28 @@ def _with_prefix(s: _Structure, base: _Base) -> _Base:
 
 def _condensed_base(s: _Structure) -> _Base | None:
     """Eliminate the variables ``y`` that appear only in equality rows, the objective, bounds and
-    cones (the ALIP states and torques of the planner): ``V(w) = min_y cost`` subject to the
-    equality rows is a convex quadratic of the remaining ``w``, computed once from the KKT system.
-    Dropping the bounds and cones of ``y`` gives a valid lower bound; a point whose recovered ``y``
-    satisfies them is exact. Returns None when nothing can be eliminated or the KKT system is
-    singular (e.g. a zero torque weight).
+    cones (the ALIP states and torques of the planner, eq. 5.12a-d): ``V(w) = min_y cost`` subject
+    to the equality rows is a convex quadratic of the remaining ``w``, computed once from the KKT
+    system. Dropping the bounds and cones of ``y`` gives a valid lower bound; a point whose
+    recovered ``y`` satisfies them is exact. Returns None when nothing can be eliminated or the
+    KKT system is singular (e.g. a zero torque weight).
     """
-    pr = s.problem
-    n = pr.n
-    keep = np.zeros(n, dtype=bool)
-    keep[pr.integer] = True
-    keep[s.plain_le.indices] = True
-    for grp in s.groups:
-        keep[grp.variables] = True
-        keep[grp.private] = True
-    # a variable in no equality row and no cost row has nothing to determine it: keep it
-    keep[np.asarray(abs(pr.a_eq).sum(axis=0) + abs(pr.cost_matrix).sum(axis=0)).ravel() == 0] = True
-    y_mask = ~keep
-    for idx, _ in pr.cones:
-        if np.any(keep[idx]):
-            return None
-    y_idx = np.flatnonzero(y_mask)
-    w_idx = np.flatnonzero(keep)
-    if len(y_idx) == 0:
+    split = _condensed_columns(s)
+    if split is None:
         return None
+    y_idx, w_idx = split
+    pr = s.problem
     a_eq = pr.a_eq.tocsr()
     touches_y = np.asarray(abs(a_eq[:, y_idx]).sum(axis=1) > 0).ravel()
-    e_y = a_eq[touches_y][:, y_idx]
-    e_w = a_eq[touches_y][:, w_idx]
-    e_rhs = pr.b_eq[touches_y]
     f_mat = pr.cost_matrix.tocsr()
     rows_y = np.asarray(abs(f_mat[:, y_idx]).sum(axis=1) > 0).ravel()
-    f_y = f_mat[rows_y][:, y_idx]
-    f_wy = f_mat[rows_y][:, w_idx]
-    t_y = pr.cost_target[rows_y]
-    wt_y = pr.cost_weight[rows_y]
-    # Parameters that move y: w columns of the y equality rows and of the y cost rows.
-    support = np.flatnonzero(
-        np.asarray(abs(e_w).sum(axis=0)).ravel() + np.asarray(abs(f_wy).sum(axis=0)).ravel()
-    )
-    h = 2.0 * (f_y.T @ sp.diags(wt_y) @ f_y)
-    m_y = e_y.shape[0]
-    kkt = sp.bmat([[h, e_y.T], [e_y, None]], format="csc")
-    ny = len(y_idx)
-    rhs_lin = np.vstack(
-        [
-            -2.0 * (f_y.T @ sp.diags(wt_y) @ f_wy[:, support]).toarray(),
-            -e_w[:, support].toarray(),
-        ]
-    )
-    rhs_off = np.concatenate([2.0 * (f_y.T @ (wt_y * t_y)), e_rhs])
-    try:
-        lu = sp.linalg.splu(kkt)
-        sol = lu.solve(np.column_stack([rhs_lin, rhs_off]))
-    except RuntimeError:
+    law = _optimal_y(pr, a_eq[touches_y], f_mat[rows_y], y_idx, w_idx, rows_y, touches_y)
+    if law is None:
         return None
-    kkt_res = kkt @ sol - np.column_stack([rhs_lin, rhs_off])
-    if not np.all(np.isfinite(sol)) or float(np.max(np.abs(kkt_res))) > 1e-6 * max(
-        1.0, float(np.max(np.abs(sol)))
-    ):
-        return None
-    y_lin, y_off = sol[:ny, :-1], sol[:ny, -1]
-    del m_y
-    # New cost rows over w: F_y (Y w_S + y0) + F_wy w - t.
-    w_pos = np.full(n, -1, dtype=np.int64)
-    w_pos[w_idx] = np.arange(len(w_idx))
-    f_eff = (f_y @ y_lin) + f_wy[:, support].toarray()
-    t_eff = t_y - f_y @ y_off
-    sq = np.sqrt(wt_y)
-    a_s = sq[:, None] * f_eff
-    t_s = sq * t_eff
-    # other cost rows (only w)
-    other = ~rows_y & ~s.assigned
+    support, y_lin, y_off = law
     if np.any(rows_y & s.assigned):  # pragma: no cover - assigned rows hold only group variables
         return None
-    f_o = f_mat[other][:, w_idx]
-    p_o, q_o, c_o = _cost_pq(f_o.tocsr(), pr.cost_target[other], pr.cost_weight[other])
-    nw = len(w_idx)
-    p_s = np.zeros((nw, nw))
-    p_s_sub = 2.0 * (a_s.T @ a_s)
-    p_s[np.ix_(support, support)] = p_s_sub
-    p_mat = sp.triu(p_o + sp.csc_matrix(np.triu(p_s)), format="csc")
-    q_vec = q_o.copy()
-    q_vec[support] += -2.0 * (a_s.T @ t_s)
-    const = c_o + float(t_s @ t_s)
+    p_mat, q_vec, const = _condensed_cost(s, f_mat, rows_y, y_idx, w_idx, support, y_lin, y_off)
     # rows over w: equality rows without y, plain le rows, bounds of w
     eq = _Coo()
     eq.add_csr(a_eq[~touches_y][:, w_idx].tocsr(), pr.b_eq[~touches_y])
@@ -247,8 +183,10 @@ def _condensed_base(s: _Structure) -> _Base | None:
     fin_l = cont[np.isfinite(pr.lb[w_idx][cont])]
     le.add(np.arange(len(fin_u)), fin_u, np.ones(len(fin_u)), pr.ub[w_idx][fin_u])
     le.add(np.arange(len(fin_l)), fin_l, -np.ones(len(fin_l)), -pr.lb[w_idx][fin_l])
+    w_pos = np.full(pr.n, -1, dtype=np.int64)
+    w_pos[w_idx] = np.arange(len(w_idx))
     return _Base(
-        nw,
+        len(w_idx),
         w_pos,
         eq,
         le,
@@ -262,6 +200,103 @@ def _condensed_base(s: _Structure) -> _Base | None:
         y_lin=y_lin,
         y_off=y_off,
     )
+
+
+def _condensed_columns(s: _Structure) -> tuple[IntArray, IntArray] | None:
+    """The variables to eliminate (``y``) and to keep (``w``); None when there is no ``y`` or a
+    cone mixes them."""
+    pr = s.problem
+    keep = np.zeros(pr.n, dtype=bool)
+    keep[pr.integer] = True
+    keep[s.plain_le.indices] = True
+    for grp in s.groups:
+        keep[grp.variables] = True
+        keep[grp.private] = True
+    # a variable in no equality row and no cost row has nothing to determine it: keep it
+    keep[np.asarray(abs(pr.a_eq).sum(axis=0) + abs(pr.cost_matrix).sum(axis=0)).ravel() == 0] = True
+    for idx, _ in pr.cones:
+        if np.any(keep[idx]):
+            return None
+    y_idx = np.flatnonzero(~keep)
+    if len(y_idx) == 0:
+        return None
+    return y_idx, np.flatnonzero(keep)
+
+
+def _optimal_y(
+    pr: MIQCQP,
+    e_rows: sp.csr_matrix,
+    f_rows: sp.csr_matrix,
+    y_idx: IntArray,
+    w_idx: IntArray,
+    rows_y: NDArray[np.bool_],
+    touches_y: NDArray[np.bool_],
+) -> tuple[IntArray, FloatArray, FloatArray] | None:
+    """The minimiser ``y = Y w_S + y0`` of the ``y`` cost rows ``f_rows`` subject to the ``y``
+    equality rows ``e_rows`` (one KKT solve), with ``S`` the ``w`` columns that move it; returns
+    ``(S, Y, y0)``, or None when the KKT system is singular."""
+    e_y, e_w = e_rows[:, y_idx], e_rows[:, w_idx]
+    f_y, f_wy = f_rows[:, y_idx], f_rows[:, w_idx]
+    t_y, wt_y = pr.cost_target[rows_y], pr.cost_weight[rows_y]
+    # Parameters that move y: w columns of the y equality rows and of the y cost rows.
+    support = np.flatnonzero(
+        np.asarray(abs(e_w).sum(axis=0)).ravel() + np.asarray(abs(f_wy).sum(axis=0)).ravel()
+    )
+    h = 2.0 * (f_y.T @ sp.diags(wt_y) @ f_y)
+    kkt = sp.bmat([[h, e_y.T], [e_y, None]], format="csc")
+    rhs_lin = np.vstack(
+        [
+            -2.0 * (f_y.T @ sp.diags(wt_y) @ f_wy[:, support]).toarray(),
+            -e_w[:, support].toarray(),
+        ]
+    )
+    rhs_off = np.concatenate([2.0 * (f_y.T @ (wt_y * t_y)), pr.b_eq[touches_y]])
+    try:
+        lu = sp.linalg.splu(kkt)
+        sol = lu.solve(np.column_stack([rhs_lin, rhs_off]))
+    except RuntimeError:
+        return None
+    kkt_res = kkt @ sol - np.column_stack([rhs_lin, rhs_off])
+    if not np.all(np.isfinite(sol)) or float(np.max(np.abs(kkt_res))) > 1e-6 * max(
+        1.0, float(np.max(np.abs(sol)))
+    ):
+        return None
+    ny = len(y_idx)
+    return support, sol[:ny, :-1], sol[:ny, -1]
+
+
+def _condensed_cost(
+    s: _Structure,
+    f_mat: sp.csr_matrix,
+    rows_y: NDArray[np.bool_],
+    y_idx: IntArray,
+    w_idx: IntArray,
+    support: IntArray,
+    y_lin: FloatArray,
+    y_off: FloatArray,
+) -> tuple[sp.csc_matrix, FloatArray, float]:
+    """The objective over ``w`` with ``y`` at its minimiser: ``(P, q, const)``, ``P`` upper
+    triangular. The ``y`` cost rows become ``F_y (Y w_S + y0) + F_wy w - t``; the rows the groups
+    charge in perspective form are left out."""
+    pr = s.problem
+    f_y, f_wy = f_mat[rows_y][:, y_idx], f_mat[rows_y][:, w_idx]
+    t_y, wt_y = pr.cost_target[rows_y], pr.cost_weight[rows_y]
+    f_eff = (f_y @ y_lin) + f_wy[:, support].toarray()
+    t_eff = t_y - f_y @ y_off
+    sq = np.sqrt(wt_y)
+    a_s = sq[:, None] * f_eff
+    t_s = sq * t_eff
+    # other cost rows (only w)
+    other = ~rows_y & ~s.assigned
+    f_o = f_mat[other][:, w_idx]
+    p_o, q_o, c_o = _cost_pq(f_o.tocsr(), pr.cost_target[other], pr.cost_weight[other])
+    nw = len(w_idx)
+    p_s = np.zeros((nw, nw))
+    p_s[np.ix_(support, support)] = 2.0 * (a_s.T @ a_s)
+    p_mat = sp.triu(p_o + sp.csc_matrix(np.triu(p_s)), format="csc")
+    q_vec = q_o.copy()
+    q_vec[support] += -2.0 * (a_s.T @ t_s)
+    return p_mat, q_vec, c_o + float(t_s @ t_s)
 
 
 def _cat(parts: list[Any], dtype: Any) -> Any:

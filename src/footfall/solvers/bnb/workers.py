@@ -9,15 +9,11 @@ from __future__ import annotations
 
 import math
 import time
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from footfall._typing import FloatArray
 from footfall.solvers.bnb.branching import _dive
 from footfall.solvers.bnb.relaxation import HullRelaxation, _Relaxation
-
-if TYPE_CHECKING:
-    pass
-
 
 _WORKER: HullRelaxation | None = None
 
