@@ -20,7 +20,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from footfall._typing import FloatArray, IntArray
-from footfall.solvers.bnb.structure import _Group, _Structure
+from footfall.solvers.bnb.structure import _Group, _Member, _Structure
 from footfall.solvers.problem import MIQCQP
 
 
@@ -491,117 +491,211 @@ def _separable_forms(
     return np.flatnonzero(~sep), sepf, lo[:, sepf], hi[:, sepf], rows
 
 
+@dataclass
+class _Parts:
+    """The pieces :func:`_templates` collects, as lists of per-group and per-member arrays (each
+    tuple: the fields of one block of :class:`_Templates`, in its order)."""
+
+    groups: list[int] = field(default_factory=list)
+    zcol: list[int] = field(default_factory=list)
+    kk: list[int] = field(default_factory=list)
+    nrows: list[int] = field(default_factory=list)
+    has_cost: list[bool] = field(default_factory=list)
+    cdim: list[int] = field(default_factory=list)
+    #: hull rows: member, row, kind, location, value
+    h: tuple[list[Any], ...] = field(default_factory=lambda: ([], [], [], [], []))
+    #: perspective cones: member, row, kind, location, value
+    c: tuple[list[Any], ...] = field(default_factory=lambda: ([], [], [], [], []))
+    #: direct rows: member, row, column, value, row count, rhs, rhs member
+    d: tuple[list[Any], ...] = field(default_factory=lambda: ([], [], [], [], [], [], []))
+    #: direct cost: quadratic (member, i, j, value), linear (member, i, value), constants
+    dp: tuple[list[Any], ...] = field(default_factory=lambda: ([], [], [], []))
+    dq: tuple[list[Any], ...] = field(default_factory=lambda: ([], [], []))
+    dconst: list[float] = field(default_factory=list)
+    #: linking rows B x_V = sum_z f^z: group, row, column, value
+    link: tuple[list[Any], ...] = field(default_factory=lambda: ([], [], [], []))
+    #: separable-form rows: group, row, kind, column, member, value; rows per group
+    sep: tuple[list[Any], ...] = field(default_factory=lambda: ([], [], [], [], [], []))
+    sep_rows: list[int] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class _GroupCost:
+    """A group's perspective cost rows over its kept forms, and their direct (one-member) form."""
+
+    sw: FloatArray  # 2 sqrt(w)
+    cf: FloatArray  # 2 sqrt(w) C over the kept forms
+    cr: IntArray
+    cc: IntArray
+    pg: FloatArray  # upper triangle of the quadratic over V
+    pi: IntArray
+    pj: IntArray
+    qg: FloatArray  # linear term over V
+
+
 def _templates(s: _Structure, base: _Base, compact: bool) -> _Templates:
+    """The node relaxation's pieces over ``base``, for every member of every group (see the
+    module docstring); with ``compact``, separable forms lose their copies and free columns are
+    left out (:func:`_dropped_columns`)."""
     col = base.col
-    groups: list[int] = []
-    zcol: list[int] = []
-    kk: list[int] = []
-    nrows: list[int] = []
-    has_cost: list[bool] = []
-    cdim: list[int] = []
-    h: tuple[list[Any], ...] = ([], [], [], [], [], [])
-    c: tuple[list[Any], ...] = ([], [], [], [], [], [])
-    d: tuple[list[Any], ...] = ([], [], [], [], [], [], [])
-    dp: tuple[list[Any], ...] = ([], [], [], [])
-    dq: tuple[list[Any], ...] = ([], [], [])
-    dconst: list[float] = []
-    link: tuple[list[Any], ...] = ([], [], [], [])
-    sep: tuple[list[Any], ...] = ([], [], [], [], [], [])
-    sep_rows: list[int] = []
+    parts = _Parts()
     mi = 0
     for g, grp in enumerate(s.groups):
         vcols = col[grp.variables]
         keepf, sepf, s_lo, s_hi, is_sep_row = _separable_forms(s, grp, compact)
-        basis = grp.basis[keepf]
-        k = len(keepf)
-        br, bc = np.nonzero(basis)
-        link[0].append(np.full(len(br), g))
-        link[1].append(br)
-        link[2].append(vcols[bc])
-        link[3].append(basis[br, bc])
-        # separable forms: sum_z lo_z z <= B_j x_V <= sum_z hi_z z (the copies projected out)
-        n_sep = 0
-        for i, j in enumerate(sepf):
-            bj = np.flatnonzero(grp.basis[j])
-            for sign, bnd in ((1.0, s_hi[:, i]), (-1.0, s_lo[:, i])):
-                if not np.all(np.isfinite(bnd)):
-                    continue  # no member bounds this side (see _separable_forms)
-                m_idx = mi + np.arange(len(grp.members))
-                sep[0].append(np.full(len(bj) + len(m_idx), g))
-                sep[1].append(np.full(len(bj) + len(m_idx), n_sep))
-                sep[2].append(np.r_[np.zeros(len(bj)), np.ones(len(m_idx))].astype(np.int64))
-                sep[3].append(np.r_[vcols[bj], np.zeros(len(m_idx), dtype=np.int64)])
-                sep[4].append(np.r_[np.full(len(bj), -1), m_idx].astype(np.int64))
-                sep[5].append(np.r_[sign * grp.basis[j, bj], -sign * bnd])
-                n_sep += 1
-        sep_rows.append(n_sep)
-        n_cost = len(grp.cost_rows)
-        if n_cost:
-            sw = 2.0 * np.sqrt(grp.cost_w)
-            cf = sw[:, None] * grp.cost_f[:, keepf]
-            cr, cc = np.nonzero(cf)
-            wv = grp.cost_w[:, None] * grp.cost_v
-            pg = np.triu(2.0 * grp.cost_v.T @ wv)
-            pi, pj = np.nonzero(pg)
-            qg = -2.0 * wv.T @ grp.cost_t
+        _group_rows(parts, g, grp, vcols, keepf, sepf, s_lo, s_hi, mi)
+        cost = _group_cost(grp, keepf) if len(grp.cost_rows) else None
         for z in grp.members:
-            mb = s.member[z]
-            groups.append(g)
-            zcol.append(col[z])
-            kk.append(k)
-            a_f = mb.a_f[~is_sep_row[z]][:, keepf]
-            beta = mb.beta[~is_sep_row[z]]
-            nb = len(beta)
-            nrows.append(nb)
-            has_cost.append(n_cost > 0)
-            cdim.append(n_cost + 2 if n_cost else 0)
-            # hull rows: a_f f - beta z <= 0 (the copies are bounded through the member rows)
-            rr, cc2 = np.nonzero(a_f)
-            rows = np.r_[rr, np.arange(nb)]
-            kind = np.r_[np.zeros(len(rr)), np.ones(nb)].astype(np.int64)
-            loc = np.r_[cc2, np.zeros(nb)].astype(np.int64)
-            val = np.r_[a_f[rr, cc2], -beta]
-            h[0].append(np.full(len(rows), mi))
-            h[1].append(rows)
-            h[2].append(kind)
-            h[3].append(loc)
-            h[4].append(val)
-            if n_cost:
-                # perspective: ||(2 sqrt(w) (C f^z - t z), t_z - z)|| <= t_z + z
-                rows = np.r_[0, 0, 1, 1, cr + 2, np.arange(n_cost) + 2]
-                kind = np.r_[2, 1, 2, 1, np.zeros(len(cr)), np.ones(n_cost)].astype(np.int64)
-                loc = np.r_[0, 0, 0, 0, cc, np.zeros(n_cost)].astype(np.int64)
-                val = np.r_[-1.0, -1.0, -1.0, 1.0, -cf[cr, cc], sw * grp.cost_t]
-                c[0].append(np.full(len(rows), mi))
-                c[1].append(rows)
-                c[2].append(kind)
-                c[3].append(loc)
-                c[4].append(val)
-            # direct rows
-            rr, cc2 = np.nonzero(mb.a_v)
-            d[0].append(np.full(len(rr), mi))
-            d[1].append(rr)
-            d[2].append(vcols[cc2])
-            d[3].append(mb.a_v[rr, cc2])
-            d[4].append(len(mb.beta))
-            d[5].append(mb.beta)
-            d[6].append(np.full(len(mb.beta), mi))
-            if n_cost:
-                lo = np.minimum(vcols[pi], vcols[pj])
-                hi = np.maximum(vcols[pi], vcols[pj])
-                dp[0].append(np.full(len(pi), mi))
-                dp[1].append(lo)
-                dp[2].append(hi)
-                dp[3].append(pg[pi, pj])
-                dq[0].append(np.full(len(vcols), mi))
-                dq[1].append(vcols)
-                dq[2].append(qg)
-                dconst.append(float(np.sum(grp.cost_w * grp.cost_t**2)))
-            else:
-                dconst.append(0.0)
+            parts.groups.append(g)
+            parts.zcol.append(col[z])
+            parts.kk.append(len(keepf))
+            _member_rows(parts, grp, s.member[z], mi, vcols, keepf, is_sep_row[z], cost)
             mi += 1
+    out = _pack(base, parts)
+    is_bin = np.zeros(base.n_cols, dtype=bool)
+    is_bin[out.zcol] = True
+    nonbin = np.bincount(out.le_r, weights=~is_bin[out.le_c], minlength=out.m_le)
+    out = dataclasses.replace(out, le_bin_rows=np.flatnonzero(nonbin == 0))
+    return _dropped_columns(s, out) if compact else out
+
+
+def _group_rows(
+    parts: _Parts,
+    g: int,
+    grp: _Group,
+    vcols: IntArray,
+    keepf: IntArray,
+    sepf: IntArray,
+    s_lo: FloatArray,
+    s_hi: FloatArray,
+    mi: int,
+) -> None:
+    """Group ``g``'s linking rows ``B x_V = sum_z f^z`` (kept forms) and the rows of its
+    separable forms, ``sum_z lo_z z <= B_j x_V <= sum_z hi_z z`` (the copies projected out);
+    ``mi``: the index of its first member."""
+    basis = grp.basis[keepf]
+    br, bc = np.nonzero(basis)
+    parts.link[0].append(np.full(len(br), g))
+    parts.link[1].append(br)
+    parts.link[2].append(vcols[bc])
+    parts.link[3].append(basis[br, bc])
+    sep = parts.sep
+    n_sep = 0
+    for i, j in enumerate(sepf):
+        bj = np.flatnonzero(grp.basis[j])
+        for sign, bnd in ((1.0, s_hi[:, i]), (-1.0, s_lo[:, i])):
+            if not np.all(np.isfinite(bnd)):
+                continue  # no member bounds this side (see _separable_forms)
+            m_idx = mi + np.arange(len(grp.members))
+            sep[0].append(np.full(len(bj) + len(m_idx), g))
+            sep[1].append(np.full(len(bj) + len(m_idx), n_sep))
+            sep[2].append(np.r_[np.zeros(len(bj)), np.ones(len(m_idx))].astype(np.int64))
+            sep[3].append(np.r_[vcols[bj], np.zeros(len(m_idx), dtype=np.int64)])
+            sep[4].append(np.r_[np.full(len(bj), -1), m_idx].astype(np.int64))
+            sep[5].append(np.r_[sign * grp.basis[j, bj], -sign * bnd])
+            n_sep += 1
+    parts.sep_rows.append(n_sep)
+
+
+def _group_cost(grp: _Group, keepf: IntArray) -> _GroupCost:
+    """The group's cost rows ``w (C f - t)^2`` (eq. 5.11's horizontal step terms) prepared for
+    the perspective cones and for the direct form of a lone member."""
+    sw = 2.0 * np.sqrt(grp.cost_w)
+    cf = sw[:, None] * grp.cost_f[:, keepf]
+    cr, cc = np.nonzero(cf)
+    wv = grp.cost_w[:, None] * grp.cost_v
+    pg = np.triu(2.0 * grp.cost_v.T @ wv)
+    pi, pj = np.nonzero(pg)
+    return _GroupCost(sw, cf, cr, cc, pg, pi, pj, -2.0 * wv.T @ grp.cost_t)
+
+
+def _member_rows(
+    parts: _Parts,
+    grp: _Group,
+    mb: _Member,
+    mi: int,
+    vcols: IntArray,
+    keepf: IntArray,
+    is_sep_row: NDArray[np.bool_],
+    cost: _GroupCost | None,
+) -> None:
+    """Member ``mi``'s hull rows, perspective cone (with a cost), and direct rows and cost (used
+    when it is its group's only allowed member)."""
+    a_f = mb.a_f[~is_sep_row][:, keepf]
+    beta = mb.beta[~is_sep_row]
+    nb = len(beta)
+    n_cost = len(grp.cost_rows)
+    parts.nrows.append(nb)
+    parts.has_cost.append(n_cost > 0)
+    parts.cdim.append(n_cost + 2 if n_cost else 0)
+    # hull rows: a_f f - beta z <= 0 (the copies are bounded through the member rows)
+    rr, cc2 = np.nonzero(a_f)
+    for lst, arr in zip(
+        parts.h,
+        (
+            np.full(len(rr) + nb, mi),
+            np.r_[rr, np.arange(nb)],
+            np.r_[np.zeros(len(rr)), np.ones(nb)].astype(np.int64),
+            np.r_[cc2, np.zeros(nb)].astype(np.int64),
+            np.r_[a_f[rr, cc2], -beta],
+        ),
+        strict=True,
+    ):
+        lst.append(arr)
+    if cost is not None:
+        # perspective: ||(2 sqrt(w) (C f^z - t z), t_z - z)|| <= t_z + z
+        cr, cc = cost.cr, cost.cc
+        rows = np.r_[0, 0, 1, 1, cr + 2, np.arange(n_cost) + 2]
+        for lst, arr in zip(
+            parts.c,
+            (
+                np.full(len(rows), mi),
+                rows,
+                np.r_[2, 1, 2, 1, np.zeros(len(cr)), np.ones(n_cost)].astype(np.int64),
+                np.r_[0, 0, 0, 0, cc, np.zeros(n_cost)].astype(np.int64),
+                np.r_[-1.0, -1.0, -1.0, 1.0, -cost.cf[cr, cc], cost.sw * grp.cost_t],
+            ),
+            strict=True,
+        ):
+            lst.append(arr)
+    # direct rows
+    rr, cc2 = np.nonzero(mb.a_v)
+    d = parts.d
+    d[0].append(np.full(len(rr), mi))
+    d[1].append(rr)
+    d[2].append(vcols[cc2])
+    d[3].append(mb.a_v[rr, cc2])
+    d[4].append(len(mb.beta))
+    d[5].append(mb.beta)
+    d[6].append(np.full(len(mb.beta), mi))
+    if cost is None:
+        parts.dconst.append(0.0)
+        return
+    pi, pj = cost.pi, cost.pj
+    parts.dp[0].append(np.full(len(pi), mi))
+    parts.dp[1].append(np.minimum(vcols[pi], vcols[pj]))
+    parts.dp[2].append(np.maximum(vcols[pi], vcols[pj]))
+    parts.dp[3].append(cost.pg[pi, pj])
+    parts.dq[0].append(np.full(len(vcols), mi))
+    parts.dq[1].append(vcols)
+    parts.dq[2].append(cost.qg)
+    parts.dconst.append(float(np.sum(grp.cost_w * grp.cost_t**2)))
+
+
+def _pack(base: _Base, parts: _Parts) -> _Templates:
+    """The collected pieces as the flat arrays of :class:`_Templates` (``le_bin_rows`` empty)."""
     i64, f64 = np.int64, float
-    out = _Templates(
+    h, c, d, dp, dq, link, sep = (
+        parts.h,
+        parts.c,
+        parts.d,
+        parts.dp,
+        parts.dq,
+        parts.link,
+        parts.sep,
+    )
+    pm = base.p_mat.tocoo()
+    return _Templates(
         base=base,
         eq_r=_cat(base.eq.r, i64),
         eq_c=_cat(base.eq.c, i64),
@@ -613,12 +707,12 @@ def _templates(s: _Structure, base: _Base, compact: bool) -> _Templates:
         le_b=_cat(base.le.b, f64),
         m_eq=base.eq.m,
         m_le=base.le.m,
-        group=np.array(groups, dtype=i64),
-        zcol=np.array(zcol, dtype=i64),
-        k=np.array(kk, dtype=i64),
-        n_rows=np.array(nrows, dtype=i64),
-        has_cost=np.array(has_cost, dtype=bool),
-        cost_dim=np.array(cdim, dtype=i64),
+        group=np.array(parts.groups, dtype=i64),
+        zcol=np.array(parts.zcol, dtype=i64),
+        k=np.array(parts.kk, dtype=i64),
+        n_rows=np.array(parts.nrows, dtype=i64),
+        has_cost=np.array(parts.has_cost, dtype=bool),
+        cost_dim=np.array(parts.cdim, dtype=i64),
         h_mem=_cat(h[0], i64),
         h_row=_cat(h[1], i64),
         h_kind=_cat(h[2], i64),
@@ -643,7 +737,7 @@ def _templates(s: _Structure, base: _Base, compact: bool) -> _Templates:
         dq_mem=_cat(dq[0], i64),
         dq_i=_cat(dq[1], i64),
         dq_v=_cat(dq[2], f64),
-        d_const=np.array(dconst, dtype=f64),
+        d_const=np.array(parts.dconst, dtype=f64),
         l_grp=_cat(link[0], i64),
         l_row=_cat(link[1], i64),
         l_col=_cat(link[2], i64),
@@ -654,14 +748,8 @@ def _templates(s: _Structure, base: _Base, compact: bool) -> _Templates:
         s_col=_cat(sep[3], i64),
         s_mem=_cat(sep[4], i64),
         s_val=_cat(sep[5], f64),
-        s_nrows=np.array(sep_rows, dtype=i64),
+        s_nrows=np.array(parts.sep_rows, dtype=i64),
+        p_i=pm.row.astype(i64),
+        p_j=pm.col.astype(i64),
+        p_v=pm.data.astype(f64),
     )
-    pm = base.p_mat.tocoo()
-    out = dataclasses.replace(
-        out, p_i=pm.row.astype(i64), p_j=pm.col.astype(i64), p_v=pm.data.astype(f64)
-    )
-    is_bin = np.zeros(base.n_cols, dtype=bool)
-    is_bin[out.zcol] = True
-    nonbin = np.bincount(out.le_r, weights=~is_bin[out.le_c], minlength=out.m_le)
-    out = dataclasses.replace(out, le_bin_rows=np.flatnonzero(nonbin == 0))
-    return _dropped_columns(s, out) if compact else out
