@@ -12,7 +12,7 @@ from footfall._typing import FloatArray
 from footfall._validate import non_negative, positive
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
-from footfall.solvers import KNOWN_BACKENDS
+from footfall.solvers import DEFAULT_SOLVER, KNOWN_BACKENDS
 from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
 from footfall.solvers.bnb import BnbSettings
 
@@ -95,7 +95,7 @@ class PlannerOptions:
 
     weights: PlannerWeights = field(default_factory=PlannerWeights)
     heading_segments: int = 16
-    solver: str = "bnb"
+    solver: str = DEFAULT_SOLVER
     time_limit: float = 60.0
     gap: float = 1e-4
     threads: int = 1

@@ -58,9 +58,9 @@ class _Relaxation:
 class _CscLists:
     """A CSC matrix with its arrays as Python lists, to hand to ``clarabel.DefaultSolver``.
 
-    Clarabel's Python wrapper (0.11) reads ``data``, ``indices`` and ``indptr`` element by element;
-    from numpy arrays that costs about 0.65 ms of a 9 ms node solve at N = 15, from lists (built by
-    ``tolist``) about a third of it. It reads only these attributes and ``shape`` and
+    Clarabel's Python wrapper (0.11) reads ``data``, ``indices`` and ``indptr`` element by element,
+    which is much cheaper from lists (built by ``tolist``) than from numpy arrays (see
+    ``benchmarks/RESULTS.md``). It reads only these attributes and ``shape`` and
     ``has_canonical_format``; the matrices given are canonical (sorted, no duplicates).
     """
 

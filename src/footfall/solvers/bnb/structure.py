@@ -19,12 +19,13 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from footfall._typing import FloatArray, IntArray
+from footfall.errors import SolverError
 from footfall.solvers.bnb.links import _Link, _links, _staircase
 from footfall.solvers.bnb.settings import BnbSettings
 from footfall.solvers.problem import MIQCQP
 
 
-class UnsupportedProblem(ValueError):
+class UnsupportedProblem(SolverError, ValueError):
     """The problem does not have the choice-group / big-M shape this backend handles."""
 
 

@@ -12,6 +12,7 @@ import time
 from typing import Any
 
 from footfall._typing import FloatArray
+from footfall.errors import SolverError
 from footfall.solvers.bnb.branching import _dive
 from footfall.solvers.bnb.relaxation import HullRelaxation, _Relaxation
 
@@ -22,7 +23,7 @@ _WORKER: HullRelaxation | None = None
 _STOP: Any = None
 
 
-class WorkerError(RuntimeError):
+class WorkerError(SolverError, RuntimeError):
     """A worker process of the search died or failed; the message says which and how."""
 
 
