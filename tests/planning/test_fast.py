@@ -657,3 +657,31 @@ def test_probing_stays_within_its_budget() -> None:
         assert res.stats[key] <= settings.probe_budget * at, key
     assert res.stats["settings"] == dataclasses.asdict(settings)
     assert res.stats["probes"] > 0
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [("probe_rounds", -1), ("heur_nodes", 1.5), ("compact", 1), ("feas_tol", -1e-6),
+     ("probe_budget", "inf"), ("clarabel", (("max_iter", "many"),)), ("map_depth", 0)],
+)  # fmt: skip
+def test_bad_bnb_settings_are_input_errors(field: str, value: object) -> None:
+    from footfall.errors import InputError
+
+    with pytest.raises(InputError, match=f"bnb.{field}"):
+        BnbSettings(**{field: value})  # type: ignore[arg-type]
+
+
+def test_bnb_settings_travel_with_the_options_and_serialise() -> None:
+    import json
+
+    from footfall.errors import InputError
+
+    settings = BnbSettings(probe_budget=math.inf, clarabel={"max_iter": 50})
+    assert settings.clarabel == (("max_iter", 50),)
+    assert PlannerOptions(bnb=settings).solver_options().bnb is settings
+    assert json.loads(json.dumps(dataclasses.asdict(settings)))["clarabel"] == [["max_iter", 50]]
+    for bad in ({"probe_rounds": 0}, None):
+        with pytest.raises(InputError, match="bnb"):
+            SolverOptions(bnb=bad)  # type: ignore[arg-type]
+        with pytest.raises(InputError, match="bnb"):
+            PlannerOptions(bnb=bad)  # type: ignore[arg-type]

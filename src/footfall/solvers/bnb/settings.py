@@ -22,9 +22,9 @@ def _pairs(name: str, value: object) -> tuple[tuple[str, bool | int | float], ..
     try:
         out = tuple((str(k), v) for k, v in items)
     except (TypeError, ValueError):
-        raise InputError(name, value, "(name, value) pairs of Clarabel settings") from None
+        raise InputError(f"bnb.{name}", value, "(name, value) pairs of Clarabel settings") from None
     if any(not isinstance(v, bool | int | float) for _, v in out):
-        raise InputError(name, value, "Clarabel settings with bool, int or float values")
+        raise InputError(f"bnb.{name}", value, "Clarabel settings with bool, int or float values")
     return out
 
 
@@ -114,20 +114,20 @@ class BnbSettings:
     def __post_init__(self) -> None:
         for name in ("feas_tol", "redundant_tol", "row_tol", "rank_tol", "probe_min_drop",
                      "drain_timeout", "link_min_drop"):  # fmt: skip
-            object.__setattr__(self, name, non_negative(name, getattr(self, name)))
+            object.__setattr__(self, name, non_negative(f"bnb.{name}", getattr(self, name)))
         for name in ("probe_after", "probe_budget"):  # inf: never / no budget
             value = getattr(self, name)
             if value != math.inf:
-                object.__setattr__(self, name, non_negative(name, value))
+                object.__setattr__(self, name, non_negative(f"bnb.{name}", value))
         for name in ("max_fm_rows", "probe_rounds", "probe_first_rounds", "heur_top",
                      "heur_nodes", "ls_sweeps", "map_depth"):  # fmt: skip
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-                raise InputError(name, value, "an integer >= 0")
+                raise InputError(f"bnb.{name}", value, "an integer >= 0")
         for name in ("compact", "links", "staircase", "local_solves"):
             if not isinstance(getattr(self, name), bool):
-                raise InputError(name, getattr(self, name), "True or False")
+                raise InputError(f"bnb.{name}", getattr(self, name), "True or False")
         if self.map_depth < 1:
-            raise InputError("map_depth", self.map_depth, "an integer >= 1")
+            raise InputError("bnb.map_depth", self.map_depth, "an integer >= 1")
         for name in ("clarabel", "clarabel_retry"):
             object.__setattr__(self, name, _pairs(name, getattr(self, name)))
