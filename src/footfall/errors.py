@@ -57,5 +57,9 @@ class InfeasibleError(FootfallError):
     """An optimisation problem has no solution; the message says what is known about why."""
 
 
+class SolverError(FootfallError):
+    """A solver backend cannot take a problem or failed while solving it."""
+
+
 class SolverUnavailableError(FootfallError):
     """A requested solver backend is not installed; the message says what to install."""

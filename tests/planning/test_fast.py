@@ -1,4 +1,4 @@
-"""The fast planner (``bnb`` backend) solves exactly the direct model's problem.
+"""The ``bnb`` backend (the planner's default) solves exactly the direct model's problem.
 
 Objective equality against the direct SCIP model on small seeded instances (N = 4..6, K = 3), the
 independent checker on every plan, infeasibility detected by both, and unit checks of the
@@ -7,6 +7,7 @@ relaxation (a valid lower bound, exact at a fixed assignment) and of the fallbac
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import ClassVar
@@ -16,10 +17,12 @@ import pytest
 
 from footfall.models.biped import BipedParams
 from footfall.planning.check import check_plan
-from footfall.planning.fast import FAST_SOLVER, plan_footsteps_fast
 from footfall.planning.miqcqp import build_footstep_problem, plan_footsteps
 from footfall.planning.plan import PlannerOptions
 from footfall.solvers import ProblemBuilder, SolverOptions, SolveStatus, bnb, solve
+from footfall.solvers.bnb import BnbSettings, branching, links, relaxation, workers
+from footfall.solvers.bnb import search as bnb_search
+from footfall.solvers.bnb import structure as bnb_structure
 from footfall.solvers.problem import MIQCQP, fix_variables
 from footfall.terrain.scene import random_stepping_stones
 
@@ -31,15 +34,15 @@ OBJ_RTOL = 3 * GAP
 BOUND_RTOL = 1e-7
 
 ROBOT = BipedParams(n_nodes=3)
+#: the default settings of the search (tolerances, drain timeout)
+DEFAULTS = BnbSettings()
+#: probing at the root of every search (small searches never reach it), without a budget
+PROBING = BnbSettings(probe_after=0, probe_budget=math.inf)
+#: no probing
+NO_PROBING = BnbSettings(probe_rounds=0)
 
 # (regions, seed, steps): feasible small instances where SCIP finishes in seconds
 CASES = [(4, 0, 4), (4, 1, 4), (5, 0, 5), (5, 1, 5), (5, 2, 6), (5, 3, 6), (6, 0, 6)]
-
-
-def _force_probing(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Probe at the root of every search (small searches never reach it), without a budget."""
-    monkeypatch.setattr(bnb, "PROBE_AFTER", 0)
-    monkeypatch.setattr(bnb, "PROBE_BUDGET", math.inf)
 
 
 def _scene(regions: int, seed: int):  # type: ignore[no-untyped-def]
@@ -47,21 +50,19 @@ def _scene(regions: int, seed: int):  # type: ignore[no-untyped-def]
 
 
 @pytest.mark.parametrize(("regions", "seed", "n"), CASES)
-def test_fast_objective_equals_direct(
-    regions: int, seed: int, n: int, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_fast_objective_equals_direct(regions: int, seed: int, n: int) -> None:
     scene = _scene(regions, seed)
     opts = PlannerOptions(gap=GAP, time_limit=60.0)
-    direct = plan_footsteps(scene, ROBOT, n, opts)
-    fast = plan_footsteps_fast(scene, ROBOT, n, opts)
+    direct = plan_footsteps(scene, ROBOT, n, dataclasses.replace(opts, solver="scip"))
+    assert direct.solver == "scip"
+    fast = plan_footsteps(scene, ROBOT, n, dataclasses.replace(opts, solver="bnb"))
     # these searches are too small to reach probing: force it at the root (and its heuristics)
-    _force_probing(monkeypatch)
-    probed = plan_footsteps_fast(scene, ROBOT, n, opts)
+    probed = plan_footsteps(scene, ROBOT, n, dataclasses.replace(opts, solver="bnb", bnb=PROBING))
     assert probed.stats["probes"] > 0
     assert direct.status is SolveStatus.OPTIMAL, direct.message
     for plan in (fast, probed):
         assert plan.status is SolveStatus.OPTIMAL, plan.message
-        assert plan.solver == FAST_SOLVER
+        assert plan.solver == "bnb"
         assert plan.objective == pytest.approx(direct.objective, rel=OBJ_RTOL)
     for plan in (direct, fast, probed):
         report = check_plan(plan, scene)
@@ -70,7 +71,7 @@ def test_fast_objective_equals_direct(
     assert fast.bound <= direct.objective * (1 + OBJ_RTOL)
     # and so is the root relaxation (hull, perspective, tightened member rows, condensed dynamics)
     structure = bnb.analyse(build_footstep_problem(scene, ROBOT, n, opts).problem)
-    root = bnb.HullRelaxation(structure).solve(bnb._root_allowed(structure))
+    root = bnb.HullRelaxation(structure).solve(branching._root_allowed(structure))
     assert root.status == "solved"
     assert root.bound <= direct.objective * (1 + BOUND_RTOL)
 
@@ -85,21 +86,20 @@ def test_infeasible_detected_by_both() -> None:
     res_direct = solve(fp.problem, "scip", SolverOptions(time_limit=60.0))
     assert res_fast.status is SolveStatus.INFEASIBLE
     assert res_direct.status is SolveStatus.INFEASIBLE
-    plan = plan_footsteps_fast(scene, ROBOT, 5)
+    plan = plan_footsteps(scene, ROBOT, 5, PlannerOptions(solver="bnb"))
     assert plan.status is SolveStatus.INFEASIBLE
     assert plan.message.startswith("infeasible")
     assert not check_plan(plan, scene).ok
 
 
-def test_unsolvable_node_relaxations_are_an_error_that_says_so(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_unsolvable_node_relaxations_are_an_error_that_says_so() -> None:
     """Clarabel stopping early on every node (one iteration allowed, also in the retry) must
     not read as infeasible: the plan says how many nodes failed and with which status."""
-    monkeypatch.setattr(bnb, "CLARABEL_SETTINGS", {**bnb.CLARABEL_SETTINGS, "max_iter": 1})
-    monkeypatch.setattr(bnb, "CLARABEL_RETRY_SETTINGS", {"max_iter": 1})
+    one_step = BnbSettings(
+        clarabel=(*DEFAULTS.clarabel, ("max_iter", 1)), clarabel_retry=(("max_iter", 1),)
+    )
     scene = _scene(4, 0)
-    plan = plan_footsteps_fast(scene, ROBOT, 4, PlannerOptions(time_limit=30.0))
+    plan = plan_footsteps(scene, ROBOT, 4, PlannerOptions(time_limit=30.0, bnb=one_step))
     assert plan.status is SolveStatus.ERROR
     assert plan.stats["failed_nodes"] == {"MaxIterations": plan.stats["nodes"]}
     assert "infeasibility not proven" in plan.message
@@ -113,7 +113,7 @@ def test_relaxation_is_a_lower_bound_and_exact_when_fixed() -> None:
     assert res.status is SolveStatus.OPTIMAL and res.x is not None
     structure = bnb.analyse(fp.problem)
     relax = bnb.HullRelaxation(structure)
-    root = relax.solve(bnb._root_allowed(structure))
+    root = relax.solve(branching._root_allowed(structure))
     assert root.status == "solved"
     assert root.bound <= res.objective * (1 + BOUND_RTOL)
     # every group fixed to the optimal member: condensed and full relaxations give the optimum
@@ -131,8 +131,8 @@ def test_perspective_and_hull_relaxations_agree_on_the_optimum() -> None:
     assert not np.any(structure.assigned)
     with_p = bnb.analyse(fp.problem, perspective=True)
     assert np.any(with_p.assigned)  # the horizontal step terms sit in the heading-segment groups
-    plain = bnb.HullRelaxation(structure).solve(bnb._root_allowed(structure))
-    persp = bnb.HullRelaxation(with_p).solve(bnb._root_allowed(with_p))
+    plain = bnb.HullRelaxation(structure).solve(branching._root_allowed(structure))
+    persp = bnb.HullRelaxation(with_p).solve(branching._root_allowed(with_p))
     # the perspective relaxation is at least as tight
     assert persp.bound >= plain.bound * (1 - BOUND_RTOL)
 
@@ -154,17 +154,14 @@ def test_fixed_binaries_are_respected() -> None:
 
 
 @pytest.mark.parametrize("probe_at_root", [False, True])
-def test_time_limit_returns_an_honest_gap(
-    probe_at_root: bool, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    if probe_at_root:
-        _force_probing(monkeypatch)
+def test_time_limit_returns_an_honest_gap(probe_at_root: bool) -> None:
+    settings = PROBING if probe_at_root else DEFAULTS
     scene = random_stepping_stones(0, 8, robot=ROBOT)
     fp = build_footstep_problem(scene, ROBOT, 10)
-    res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.3, gap=0.0))
+    res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.3, gap=0.0, bnb=settings))
     assert res.status in (SolveStatus.TIME_LIMIT, SolveStatus.OPTIMAL)
     if res.x is not None:
-        assert fp.problem.violation(res.x) <= bnb.FEAS_TOL
+        assert fp.problem.violation(res.x) <= DEFAULTS.feas_tol
         assert res.objective == pytest.approx(fp.problem.objective(res.x))
         assert res.bound <= res.objective * (1 + BOUND_RTOL)
         expected = (res.objective - res.bound) / min(abs(res.objective), abs(res.bound))
@@ -200,27 +197,26 @@ def test_parallel_workers_find_the_same_optimum(seed: int, n: int) -> None:
         return
     assert serial.status is SolveStatus.OPTIMAL
     assert parallel.objective == pytest.approx(serial.objective, rel=OBJ_RTOL)
-    assert fp.problem.violation(parallel.x) <= bnb.FEAS_TOL
+    assert fp.problem.violation(parallel.x) <= DEFAULTS.feas_tol
     if parallel.stats["nodes"] > 1:  # the search branched, so the workers were used
         assert parallel.stats["workers"] == 2
 
 
-def test_search_process_solving_beside_one_worker_finds_the_same_optimum(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_search_process_solving_beside_one_worker_finds_the_same_optimum() -> None:
     fp = build_footstep_problem(random_stepping_stones(1, 8, robot=ROBOT), ROBOT, 8)
     serial = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=1))
-    monkeypatch.setattr(bnb, "LOCAL_SOLVES", True)
-    local = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=2))
+    local = solve(
+        fp.problem, "bnb", SolverOptions(gap=GAP, threads=2, bnb=BnbSettings(local_solves=True))
+    )
     assert local.status is serial.status is SolveStatus.OPTIMAL
     assert local.objective == pytest.approx(serial.objective, rel=OBJ_RTOL)
     assert local.stats["workers"] == 1
 
 
-class _Recorded(bnb._Workers):
+class _Recorded(workers._Workers):
     """The worker pool, remembering every instance (to check that its processes are reaped)."""
 
-    made: ClassVar[list[bnb._Workers]] = []
+    made: ClassVar[list[workers._Workers]] = []
 
     def __init__(self, relax, n: int) -> None:  # type: ignore[no-untyped-def]
         super().__init__(relax, n)
@@ -228,13 +224,13 @@ class _Recorded(bnb._Workers):
 
 
 @pytest.fixture
-def recorded(monkeypatch: pytest.MonkeyPatch) -> list[bnb._Workers]:
+def recorded(monkeypatch: pytest.MonkeyPatch) -> list[workers._Workers]:
     """Pools the searches of a test made; afterwards every worker must be reaped."""
     import multiprocessing as mp
     import os
 
     _Recorded.made = []
-    monkeypatch.setattr(bnb, "_Workers", _Recorded)
+    monkeypatch.setattr(bnb_search, "_Workers", _Recorded)
     yield _Recorded.made
     for pool in _Recorded.made:
         assert pool.closed
@@ -248,13 +244,13 @@ def _branching_problem() -> MIQCQP:
     return build_footstep_problem(random_stepping_stones(0, 8, robot=ROBOT), ROBOT, 8).problem
 
 
-def test_workers_are_reaped_after_a_solve(recorded: list[bnb._Workers]) -> None:
+def test_workers_are_reaped_after_a_solve(recorded: list[workers._Workers]) -> None:
     res = solve(_branching_problem(), "bnb", SolverOptions(gap=GAP, threads=2))
     assert res.status is SolveStatus.OPTIMAL
     assert len(recorded) == 1 and len(recorded[0].procs) == 2
 
 
-def test_workers_are_reaped_after_the_time_limit(recorded: list[bnb._Workers]) -> None:
+def test_workers_are_reaped_after_the_time_limit(recorded: list[workers._Workers]) -> None:
     fp = build_footstep_problem(random_stepping_stones(0, 8, robot=ROBOT), ROBOT, 10)
     res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.3, gap=0.0, threads=2))
     assert res.status in (SolveStatus.TIME_LIMIT, SolveStatus.OPTIMAL)
@@ -272,20 +268,20 @@ def _exit_in_worker(task):  # type: ignore[no-untyped-def]
 
 
 def test_a_failing_worker_stops_the_search_with_its_error(
-    recorded: list[bnb._Workers], monkeypatch: pytest.MonkeyPatch
+    recorded: list[workers._Workers], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setattr(bnb, "_work", _raise_in_worker)  # the forked workers inherit it
+    monkeypatch.setattr(workers, "_work", _raise_in_worker)  # the forked workers inherit it
     with pytest.raises(bnb.WorkerError, match="node solver exploded"):
         solve(_branching_problem(), "bnb", SolverOptions(gap=GAP, threads=2))
     assert len(recorded) == 1
 
 
 def test_a_dead_worker_is_an_error_not_a_hang(
-    recorded: list[bnb._Workers], monkeypatch: pytest.MonkeyPatch
+    recorded: list[workers._Workers], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     import time
 
-    monkeypatch.setattr(bnb, "_work", _exit_in_worker)
+    monkeypatch.setattr(workers, "_work", _exit_in_worker)
     start = time.perf_counter()
     with pytest.raises(bnb.WorkerError, match=r"died \(exit code 7\)"):
         solve(_branching_problem(), "bnb", SolverOptions(time_limit=60.0, gap=GAP, threads=2))
@@ -294,10 +290,10 @@ def test_a_dead_worker_is_an_error_not_a_hang(
 
 
 def test_an_error_in_the_search_process_reaps_the_workers(
-    recorded: list[bnb._Workers], monkeypatch: pytest.MonkeyPatch
+    recorded: list[workers._Workers], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     calls = {"n": 0}
-    evaluate = bnb._Search.evaluate
+    evaluate = bnb_search._Search.evaluate
 
     def failing(self, *args, **kwargs):  # type: ignore[no-untyped-def]
         calls["n"] += 1
@@ -305,7 +301,7 @@ def test_an_error_in_the_search_process_reaps_the_workers(
             raise KeyboardInterrupt
         return evaluate(self, *args, **kwargs)
 
-    monkeypatch.setattr(bnb._Search, "evaluate", failing)
+    monkeypatch.setattr(bnb_search._Search, "evaluate", failing)
     with pytest.raises(KeyboardInterrupt):
         solve(_branching_problem(), "bnb", SolverOptions(gap=GAP, threads=2))
     assert len(recorded) == 1
@@ -355,20 +351,17 @@ def test_bench_plan_cli_writes_the_table(tmp_path) -> None:  # type: ignore[no-u
 
 
 @pytest.mark.parametrize("probe_at_root", [False, True])
-def test_parallel_time_limit_returns_an_honest_gap(
-    probe_at_root: bool, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_parallel_time_limit_returns_an_honest_gap(probe_at_root: bool) -> None:
     # the asynchronous search stops with solves (and possibly the dive) in flight; with probing
     # at the root, the time limit falls in probing or its heuristics
-    if probe_at_root:
-        _force_probing(monkeypatch)
+    settings = PROBING if probe_at_root else DEFAULTS
     scene = random_stepping_stones(0, 8, robot=ROBOT)
     fp = build_footstep_problem(scene, ROBOT, 10)
-    res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.5, gap=0.0, threads=2))
+    res = solve(fp.problem, "bnb", SolverOptions(time_limit=0.5, gap=0.0, threads=2, bnb=settings))
     assert res.status in (SolveStatus.TIME_LIMIT, SolveStatus.OPTIMAL)
-    assert res.solve_time < 0.5 + bnb.DRAIN_TIMEOUT
+    assert res.solve_time < 0.5 + settings.drain_timeout
     if res.x is not None:
-        assert fp.problem.violation(res.x) <= bnb.FEAS_TOL
+        assert fp.problem.violation(res.x) <= settings.feas_tol
         assert res.bound <= res.objective * (1 + BOUND_RTOL)
 
 
@@ -379,7 +372,7 @@ def test_dropping_redundant_member_rows_keeps_the_member_set() -> None:
     lb, ub = np.array([-1.0, -2.0]), np.array([1.0, 2.0])
     a_v = np.array([[1.0, 0.0], [2.0, 0.0], [-1.0, 0.0], [-0.5, 0.0], [0.1, 0.1], [1.0, 1.0]])
     beta = np.array([0.5, 3.0, 0.8, 0.2, 5.0, 1.0])
-    a_r, b_r = bnb._drop_redundant(a_v, beta, lb, ub)
+    a_r, b_r = bnb_structure._drop_redundant(a_v, beta, lb, ub, DEFAULTS.redundant_tol)
     assert len(b_r) == 3  # x0 <= 0.5, x0 >= -0.4, x0 + x1 <= 1
     pts = rng.uniform(lb, ub, size=(2000, 2))
     inside = np.all(pts @ a_v.T <= beta, axis=1)
@@ -392,7 +385,7 @@ def test_member_violations_are_the_largest_row_violations() -> None:
     structure = bnb.analyse(fp.problem)
     x = np.random.default_rng(1).uniform(fp.problem.lb, fp.problem.ub)
     for g, grp in enumerate(structure.groups):
-        got = bnb._violations(structure, x, g, grp.members[::-1])
+        got = branching._violations(structure, x, g, grp.members[::-1])
         for k, z in enumerate(grp.members[::-1]):
             mb = structure.member[z]
             want = float(np.max(mb.a_v @ x[grp.variables] - mb.beta)) if len(mb.beta) else 0.0
@@ -400,20 +393,16 @@ def test_member_violations_are_the_largest_row_violations() -> None:
 
 
 def _link_structure(
-    monkeypatch: pytest.MonkeyPatch, problem: MIQCQP, staircase: bool = True
-) -> bnb._Structure:
-    monkeypatch.setattr(bnb, "LINKS", True)
-    monkeypatch.setattr(bnb, "STAIRCASE", staircase)
-    return bnb.analyse(problem)
+    problem: MIQCQP, staircase: bool = True, min_drop: float = DEFAULTS.link_min_drop
+) -> bnb_structure._Structure:
+    settings = BnbSettings(links=True, staircase=staircase, link_min_drop=min_drop)
+    return bnb.analyse(problem, settings=settings)
 
 
-def test_link_pairs_are_exactly_the_rate_feasible_segment_pairs(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_link_pairs_are_exactly_the_rate_feasible_segment_pairs() -> None:
     scene = random_stepping_stones(0, 8, robot=ROBOT)
     fp = build_footstep_problem(scene, ROBOT, 8)
-    monkeypatch.setattr(bnb, "LINK_MIN_DROP", 0.0)
-    structure = _link_structure(monkeypatch, fp.problem)
+    structure = _link_structure(fp.problem, min_drop=0.0)
     pr, br, tmax = fp.problem, fp.breakpoints, ROBOT.theta_max
     by_groups = {link.groups: link for link in structure.compat}
     checked = 0
@@ -447,19 +436,17 @@ def test_link_pairs_are_exactly_the_rate_feasible_segment_pairs(
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2, 3])
-def test_linked_relaxation_is_tighter_and_below_the_optimum(
-    monkeypatch: pytest.MonkeyPatch, seed: int
-) -> None:
+def test_linked_relaxation_is_tighter_and_below_the_optimum(seed: int) -> None:
     scene = random_stepping_stones(seed, 8, robot=ROBOT)
     fp = build_footstep_problem(scene, ROBOT, 8)
     best = solve(fp.problem, "bnb", SolverOptions(gap=GAP))
     assert best.status is SolveStatus.OPTIMAL
     plain_s = bnb.analyse(fp.problem)
-    plain = bnb.HullRelaxation(plain_s).solve(bnb._root_allowed(plain_s))
+    plain = bnb.HullRelaxation(plain_s).solve(branching._root_allowed(plain_s))
     bounds = []
     for staircase in (True, False):  # prefix rows and pair weights: the same polytope
-        linked_s = _link_structure(monkeypatch, fp.problem, staircase)
-        linked = bnb.HullRelaxation(linked_s).solve(bnb._root_allowed(linked_s))
+        linked_s = _link_structure(fp.problem, staircase)
+        linked = bnb.HullRelaxation(linked_s).solve(branching._root_allowed(linked_s))
         assert linked.status == plain.status == "solved"
         assert linked.bound >= plain.bound * (1 - BOUND_RTOL)
         assert linked.bound <= best.objective * (1 + BOUND_RTOL)
@@ -472,28 +459,23 @@ def test_linked_relaxation_is_tighter_and_below_the_optimum(
 
 
 @pytest.mark.parametrize(("regions", "seed", "n"), CASES[:4])
-def test_linked_search_finds_the_same_optimum(
-    monkeypatch: pytest.MonkeyPatch, regions: int, seed: int, n: int
-) -> None:
+def test_linked_search_finds_the_same_optimum(regions: int, seed: int, n: int) -> None:
     fp = build_footstep_problem(_scene(regions, seed), ROBOT, n)
     plain = solve(fp.problem, "bnb", SolverOptions(gap=GAP))
-    monkeypatch.setattr(bnb, "LINKS", True)
-    linked = solve(fp.problem, "bnb", SolverOptions(gap=GAP))
+    linked = solve(fp.problem, "bnb", SolverOptions(gap=GAP, bnb=BnbSettings(links=True)))
     assert plain.status is linked.status is SolveStatus.OPTIMAL
     assert linked.objective == pytest.approx(plain.objective, rel=OBJ_RTOL)
 
 
-def test_propagation_drops_only_members_without_a_compatible_partner(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_propagation_drops_only_members_without_a_compatible_partner() -> None:
     fp = build_footstep_problem(random_stepping_stones(0, 8, robot=ROBOT), ROBOT, 10)
-    structure = _link_structure(monkeypatch, fp.problem)
-    root = bnb._root_allowed(structure)
+    structure = _link_structure(fp.problem)
+    root = branching._root_allowed(structure)
     # pin footstep 5 to its first live segment
     z5 = int(fp.segments[5][fp.segments[5] >= 0][0])
     g5 = structure.group_of[z5]
     pinned = tuple((z5,) if g == g5 else mem for g, mem in enumerate(root))
-    out = bnb._propagate(structure, pinned)
+    out = links._propagate(structure, pinned)
     assert out is not None
     assert sum(map(len, out)) < sum(map(len, pinned))
     # partners of each member in the other group of each link, both directions
@@ -517,11 +499,11 @@ def test_propagation_drops_only_members_without_a_compatible_partner(
     clash = tuple((z6,) if g == g6 else mem for g, mem in enumerate(pinned))
     link56 = next(lk for lk in structure.compat if lk.groups == (g5, g6))
     assert (z5, z6) not in {(int(a), int(b)) for a, b in link56.pairs}
-    assert bnb._propagate(structure, clash) is None
+    assert links._propagate(structure, clash) is None
 
 
 def test_clarabel_gets_the_same_problem_from_lists() -> None:
-    """The node solver hands Clarabel its matrices as lists (:class:`bnb._CscLists`, cheaper to
+    """The node solver hands Clarabel its matrices as lists (:class:`relaxation._CscLists`, cheaper to
     convert): same solution as from the scipy matrices, also for a non-canonical input."""
     import clarabel
     import scipy.sparse as sp
@@ -546,7 +528,7 @@ def test_clarabel_gets_the_same_problem_from_lists() -> None:
     ref = clarabel.DefaultSolver(p_mat, q, a_mat, b, [clarabel.NonnegativeConeT(m)], settings)
     ref_sol = ref.solve()
     got = clarabel.DefaultSolver(
-        bnb._CscLists(p_mat), q.tolist(), bnb._CscLists(a_dup), b.tolist(),
+        relaxation._CscLists(p_mat), q.tolist(), relaxation._CscLists(a_dup), b.tolist(),
         [clarabel.NonnegativeConeT(m)], settings,
     ).solve()  # fmt: skip
     assert str(got.status) == str(ref_sol.status) == "Solved"
@@ -554,16 +536,14 @@ def test_clarabel_gets_the_same_problem_from_lists() -> None:
     assert got.obj_val == pytest.approx(ref_sol.obj_val, abs=1e-12)
 
 
-def test_compact_node_problems_are_the_same_relaxation(monkeypatch: pytest.MonkeyPatch) -> None:
-    """``bnb.COMPACT`` leaves out free columns, excluded binaries and implied ``z >= 0`` rows and
+def test_compact_node_problems_are_the_same_relaxation() -> None:
+    """``BnbSettings.compact`` leaves out free columns, excluded binaries and implied ``z >= 0`` rows and
     projects the separable forms' copies out: the node bounds (condensed and full) and statuses
     stay those of the plain node problems."""
     fp = build_footstep_problem(_scene(5, 0), ROBOT, 5)
     structure = bnb.analyse(fp.problem)
-    monkeypatch.setattr(bnb, "COMPACT", False)
-    plain = bnb.HullRelaxation(structure)
-    monkeypatch.setattr(bnb, "COMPACT", True)
-    compact = bnb.HullRelaxation(structure)
+    plain = bnb.HullRelaxation(structure, settings=BnbSettings(compact=False))
+    compact = bnb.HullRelaxation(structure, settings=BnbSettings(compact=True))
     assert compact.condensed is not None
     dropped = compact._tpl[id(compact.condensed)].drop_col
     # the private sin/cos of the heading segments (and footstep 0's, fixed by their bounds)
@@ -575,7 +555,7 @@ def test_compact_node_problems_are_the_same_relaxation(monkeypatch: pytest.Monke
         1 for grp in structure.groups if len(grp.cost_rows) and len(grp.members) > 1
     )
     rng = np.random.default_rng(3)
-    root = bnb._root_allowed(structure)
+    root = branching._root_allowed(structure)
     nodes = [root]
     for _ in range(12):  # random nodes: every group keeps a random non-empty subset
         nodes.append(
@@ -587,9 +567,7 @@ def test_compact_node_problems_are_the_same_relaxation(monkeypatch: pytest.Monke
     statuses = set()
     for allowed in nodes:
         for full in (False, True):
-            monkeypatch.setattr(bnb, "COMPACT", False)
             ref = plain.solve(allowed, full=full)
-            monkeypatch.setattr(bnb, "COMPACT", True)
             got = compact.solve(allowed, full=full)
             assert got.status == ref.status
             statuses.add(ref.status)
@@ -604,30 +582,25 @@ def test_compact_node_problems_are_the_same_relaxation(monkeypatch: pytest.Monke
 
 @pytest.mark.parametrize("threads", [1, 2])
 @pytest.mark.parametrize(("seed", "n"), [(1, 8), (3, 8)])
-def test_probing_and_heuristics_keep_the_optimum(
-    seed: int, n: int, threads: int, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_probing_and_heuristics_keep_the_optimum(seed: int, n: int, threads: int) -> None:
     fp = build_footstep_problem(random_stepping_stones(seed, 8, robot=ROBOT), ROBOT, n)
-    monkeypatch.setattr(bnb, "PROBE_ROUNDS", 0)
-    plain = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads))
-    monkeypatch.setattr(bnb, "PROBE_ROUNDS", 8)
-    _force_probing(monkeypatch)
-    probed = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads))
+    plain = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads, bnb=NO_PROBING))
+    probed = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads, bnb=PROBING))
     assert plain.status is probed.status is SolveStatus.OPTIMAL
     assert plain.stats["probes"] == 0
     assert probed.stats["probes"] > 0 and probed.stats["probe_dropped"] > 0
     assert probed.stats["heuristic_nodes"] + probed.stats["local_search_solves"] > 0
     assert probed.objective == pytest.approx(plain.objective, rel=OBJ_RTOL)
-    assert probed.x is not None and fp.problem.violation(probed.x) <= bnb.FEAS_TOL
+    assert probed.x is not None and fp.problem.violation(probed.x) <= DEFAULTS.feas_tol
     assert probed.bound <= probed.objective * (1 + BOUND_RTOL)
 
 
-def test_probing_drops_only_members_no_better_plan_uses(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_probing_drops_only_members_no_better_plan_uses() -> None:
     """Every member probing kills is checked by SCIP (an independent solver) on the problem with
     that binary fixed to 1: infeasible, or no better than the plan the search returned."""
     fp = build_footstep_problem(_scene(5, 1), ROBOT, 5)
-    _force_probing(monkeypatch)
-    search = bnb._Search(bnb.analyse(fp.problem), SolverOptions(gap=GAP), time.perf_counter())
+    options = SolverOptions(gap=GAP, bnb=PROBING)
+    search = bnb_search._Search(bnb.analyse(fp.problem), options, time.perf_counter())
     res = search.run()
     assert res.status is SolveStatus.OPTIMAL
     dead = sorted(search.dead)
@@ -647,8 +620,8 @@ def test_worker_map_keeps_many_tasks_flowing_and_stops_at_its_deadline() -> None
     # all tasks sent at once filled both pipes and deadlocked the search and its workers
     structure = bnb.analyse(_branching_problem())
     relax = bnb.HullRelaxation(structure)
-    root = bnb._root_allowed(structure)
-    pool = bnb._Workers(relax, 2)
+    root = branching._root_allowed(structure)
+    pool = workers._Workers(relax, 2)
     try:
         out = pool.map("node", [(root, False)] * 300)
         assert len(out) == 300 and all(r.status == "solved" for r in out)
@@ -660,31 +633,55 @@ def test_worker_map_keeps_many_tasks_flowing_and_stops_at_its_deadline() -> None
 
 
 @pytest.mark.parametrize("threads", [1, 2])
-def test_probing_in_the_middle_of_a_search_keeps_the_optimum(
-    threads: int, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_probing_in_the_middle_of_a_search_keeps_the_optimum(threads: int) -> None:
     # probing after some nodes: the open nodes lose the killed members and are solved again
     fp = build_footstep_problem(random_stepping_stones(1, 8, robot=ROBOT), ROBOT, 8)
-    monkeypatch.setattr(bnb, "PROBE_ROUNDS", 0)
-    plain = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads))
-    monkeypatch.setattr(bnb, "PROBE_ROUNDS", 8)
-    monkeypatch.setattr(bnb, "PROBE_AFTER", 0.2)
-    monkeypatch.setattr(bnb, "PROBE_BUDGET", math.inf)
-    probed = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads))
+    plain = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads, bnb=NO_PROBING))
+    middle = BnbSettings(probe_after=0.2, probe_budget=math.inf)
+    probed = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads, bnb=middle))
     assert plain.status is probed.status is SolveStatus.OPTIMAL
     assert probed.stats["probed_at_node"] > 1 and probed.stats["probes"] > 0
     assert probed.stats["probe_dropped"] > 0
     assert probed.objective == pytest.approx(plain.objective, rel=OBJ_RTOL)
-    assert probed.x is not None and fp.problem.violation(probed.x) <= bnb.FEAS_TOL
+    assert probed.x is not None and fp.problem.violation(probed.x) <= DEFAULTS.feas_tol
 
 
-def test_probing_stays_within_its_budget(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_probing_stays_within_its_budget() -> None:
     fp = build_footstep_problem(random_stepping_stones(1, 8, robot=ROBOT), ROBOT, 8)
-    monkeypatch.setattr(bnb, "PROBE_AFTER", 1.0)
-    res = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=1))
+    settings = BnbSettings(probe_after=1.0)
+    res = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=1, bnb=settings))
     assert res.status is SolveStatus.OPTIMAL
     at = res.stats["probed_at_node"]
     assert at is not None, "the search ended before probing: the test checks nothing"
     for key in ("probes", "local_search_solves", "heuristic_nodes"):
-        assert res.stats[key] <= bnb.PROBE_BUDGET * at, key
+        assert res.stats[key] <= settings.probe_budget * at, key
+    assert res.stats["settings"] == dataclasses.asdict(settings)
     assert res.stats["probes"] > 0
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [("probe_rounds", -1), ("heur_nodes", 1.5), ("compact", 1), ("feas_tol", -1e-6),
+     ("probe_budget", "inf"), ("clarabel", (("max_iter", "many"),)), ("map_depth", 0)],
+)  # fmt: skip
+def test_bad_bnb_settings_are_input_errors(field: str, value: object) -> None:
+    from footfall.errors import InputError
+
+    with pytest.raises(InputError, match=f"bnb.{field}"):
+        BnbSettings(**{field: value})  # type: ignore[arg-type]
+
+
+def test_bnb_settings_travel_with_the_options_and_serialise() -> None:
+    import json
+
+    from footfall.errors import InputError
+
+    settings = BnbSettings(probe_budget=math.inf, clarabel={"max_iter": 50})
+    assert settings.clarabel == (("max_iter", 50),)
+    assert PlannerOptions(bnb=settings).solver_options().bnb is settings
+    assert json.loads(json.dumps(dataclasses.asdict(settings)))["clarabel"] == [["max_iter", 50]]
+    for bad in ({"probe_rounds": 0}, None):
+        with pytest.raises(InputError, match="bnb"):
+            SolverOptions(bnb=bad)  # type: ignore[arg-type]
+        with pytest.raises(InputError, match="bnb"):
+            PlannerOptions(bnb=bad)  # type: ignore[arg-type]

@@ -33,11 +33,13 @@ def small_problem() -> MIQCQP:
 OPTIMUM = 0.49 + (4 - np.sqrt(8)) ** 2
 
 
-@pytest.mark.parametrize("backend", ["scip", "gurobi"])
+@pytest.mark.parametrize("backend", ["bnb", "scip", "gurobi"])
 def test_backend_finds_the_hand_computed_optimum(backend: str) -> None:
     # gurobipy is in the [dev] extra: its size-limited pip licence covers this small problem
     prob = small_problem()
     res = solve(prob, backend, SolverOptions(gap=1e-9))
+    assert res.solver == backend
+    assert "fallback" not in res.stats  # bnb takes this problem's shape itself
     assert res.status is SolveStatus.OPTIMAL
     assert res.x is not None
     assert res.objective == pytest.approx(OPTIMUM, abs=1e-6)
@@ -70,8 +72,26 @@ def test_unbounded_variable_in_big_m_row_is_refused() -> None:
     b = ProblemBuilder()
     x = b.add_vars("x", (1,))
     z = b.add_binaries("z", ())
-    with pytest.raises(ValueError, match="unbounded"):
+    with pytest.raises(InputError, match=r"big-M row 'row': got \['x\[0\]'\].*unbounded"):
         b.add_le_big_m({int(x[0]): 1.0}, 0.0, int(z), "row")
+
+
+def test_negative_cost_weight_is_an_input_error() -> None:
+    b = ProblemBuilder()
+    x = b.add_vars("x", (1,))
+    with pytest.raises(InputError, match="weight of cost term 'a'"):
+        b.add_square({int(x[0]): 1.0}, 0.0, -1.0, "a")
+
+
+def test_solver_errors_derive_from_the_footfall_root() -> None:
+    from footfall.errors import FootfallError, SolverError
+    from footfall.solvers.bnb import UnsupportedProblem, WorkerError
+
+    assert issubclass(UnsupportedProblem, SolverError) and issubclass(
+        UnsupportedProblem, ValueError
+    )
+    assert issubclass(WorkerError, SolverError) and issubclass(WorkerError, RuntimeError)
+    assert issubclass(SolverError, FootfallError)
 
 
 def test_fixing_variables_changes_only_their_bounds() -> None:

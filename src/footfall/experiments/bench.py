@@ -2,7 +2,7 @@
 ``footfall bench sim``: the reduced-order simulation's python and compiled engines, same walk, one run.
 
 Both solve the same MIQCQP (:func:`footfall.planning.miqcqp.build_footstep_problem`, document 000
-eq. 5.11-5.18); only the backend differs (``scip`` vs ``bnb``, see :mod:`footfall.planning.fast`).
+eq. 5.11-5.18); only the backend differs (``scip`` vs ``bnb``, see :mod:`footfall.solvers.bnb`).
 Instances are seeded random stepping-stone scenes (:func:`random_stepping_stones`) and optionally
 built-in scenes, for every requested number of steps N and ALIP nodes K. The machine may be shared,
 so the table reports the speed-up as a ratio of times measured in the same run; when the direct

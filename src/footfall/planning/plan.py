@@ -13,8 +13,9 @@ from footfall._typing import FloatArray
 from footfall._validate import non_negative, positive
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
-from footfall.solvers import KNOWN_BACKENDS
+from footfall.solvers import DEFAULT_SOLVER, KNOWN_BACKENDS
 from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
+from footfall.solvers.bnb import BnbSettings
 
 PLANNERS = ("miqcqp", "kinematic", "reactive")
 
@@ -104,11 +105,13 @@ class PlannerOptions:
             reach; a legged robot's swing, which must move the foot that far in T_ss + T_ds
             while the stance leg carries the body, may not allow that. Imposed as the inscribed
             regular ``SWING_SIDES``-gon (linear rows, never longer than L_swing).
+        bnb: settings of the ``bnb`` backend (:class:`footfall.solvers.bnb.BnbSettings`; part of
+            the plan cache key).
     """
 
     weights: PlannerWeights = field(default_factory=PlannerWeights)
     heading_segments: int = 16
-    solver: str = "bnb"
+    solver: str = DEFAULT_SOLVER
     time_limit: float = 60.0
     gap: float = 1e-4
     threads: int = 1
@@ -117,6 +120,7 @@ class PlannerOptions:
     region_margin: float = 0.0
     reach_both_frames: bool = False
     swing_max: float | None = None
+    bnb: BnbSettings = field(default_factory=BnbSettings)
 
     def __post_init__(self) -> None:
         segments = self.heading_segments
@@ -144,11 +148,17 @@ class PlannerOptions:
             raise InputError("reach_both_frames", self.reach_both_frames, "True or False")
         if self.swing_max is not None:
             object.__setattr__(self, "swing_max", positive("swing_max", self.swing_max))
+        if not isinstance(self.bnb, BnbSettings):
+            raise InputError("bnb", self.bnb, "a footfall.solvers.bnb.BnbSettings")
 
     def solver_options(self) -> SolverOptions:
         """The backend options these planner options imply."""
         return SolverOptions(
-            time_limit=self.time_limit, gap=self.gap, threads=self.threads, verbose=self.verbose
+            time_limit=self.time_limit,
+            gap=self.gap,
+            threads=self.threads,
+            verbose=self.verbose,
+            bnb=self.bnb,
         )
 
 

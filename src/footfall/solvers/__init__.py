@@ -1,10 +1,10 @@
 """Optimisation backends behind one interface: build a :class:`MIQCQP`, then :func:`solve` it.
 
-Backends register themselves when their Python package imports: ``scip`` (PySCIPOpt, the default,
-installed with footfall), ``bnb`` (footfall's own branch and bound on convex-hull relaxations with
-Clarabel node solves, installed with footfall; fast on the footstep planner's problems, see
-:mod:`footfall.solvers.bnb`) and ``gurobi`` (optional: ``pip install "footfall[gurobi]"`` and a
-licence).
+Backends register themselves when their Python package imports: ``bnb`` (the default, installed
+with footfall: footfall's own branch and bound on convex-hull relaxations with Clarabel node
+solves, exact and fast on the footstep planner's problems, handing any other problem shape to
+SCIP; see :mod:`footfall.solvers.bnb`), ``scip`` (PySCIPOpt, installed with footfall: the direct
+model) and ``gurobi`` (optional: ``pip install "footfall[gurobi]"`` and a licence).
 """
 
 from __future__ import annotations
@@ -22,7 +22,8 @@ KNOWN_BACKENDS = {
     "gurobi": ("gurobipy", 'pip install "footfall[gurobi]" and a Gurobi licence'),
     "bnb": ("clarabel", "pip install clarabel (installed with footfall by default)"),
 }
-DEFAULT_SOLVER = "scip"
+#: the backend :func:`solve` and the planners use unless told otherwise
+DEFAULT_SOLVER = "bnb"
 
 
 def available_solvers() -> list[str]:

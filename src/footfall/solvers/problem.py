@@ -21,6 +21,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from footfall._typing import FloatArray, IntArray
+from footfall.errors import InputError
 
 
 @dataclass(frozen=True)
@@ -196,7 +197,14 @@ class ProblemBuilder:
             top += c * (hi if c > 0 else lo)
         m = top - rhs
         if not np.isfinite(m):
-            raise ValueError(f"big-M row {label!r} has an unbounded variable")
+            unbounded = [
+                self.names[i] for i in coeffs if not np.isfinite(self._ub[i] - self._lb[i])
+            ]
+            raise InputError(
+                f"big-M row {label!r}",
+                unbounded,
+                "finite bounds on every variable of an indicator row (these are unbounded)",
+            )
         if m <= slack:
             return
         row = dict(coeffs)
@@ -212,7 +220,7 @@ class ProblemBuilder:
     ) -> None:
         """Add the cost term ``weight * (sum coeffs x - target)^2``."""
         if weight < 0:
-            raise ValueError("cost weights must be >= 0")
+            raise InputError(f"weight of cost term {label!r}", weight, "a cost weight >= 0")
         if weight == 0.0:
             return
         self._cost.add(coeffs, target, label)

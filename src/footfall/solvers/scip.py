@@ -1,4 +1,4 @@
-"""SCIP backend through PySCIPOpt: the open-source default (pip-installable, exact on MIQCQPs)."""
+"""SCIP backend through PySCIPOpt: the direct model (pip-installable, exact on MIQCQPs)."""
 
 from __future__ import annotations
 
@@ -15,7 +15,16 @@ NAME = "scip"
 
 
 def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
-    """Solve ``problem`` with SCIP.
+    """Solve ``problem`` with SCIP (the model of :func:`build_model`)."""
+    start = time.perf_counter()
+    m, x = build_model(problem, options)
+    build_time = time.perf_counter() - start
+    m.optimize()
+    return _result(problem, m, x, start, build_time)
+
+
+def build_model(problem: MIQCQP, options: SolverOptions) -> tuple[Any, list[Any]]:
+    """The SCIP model of ``problem`` and its variables, one per problem variable.
 
     The least-squares objective becomes one epigraph variable per cost label,
     ``t_g >= sum_j w_j (F_j x - f_j)^2`` (a convex quadratic constraint), and the objective is
@@ -23,7 +32,6 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
     """
     import pyscipopt as scip
 
-    start = time.perf_counter()
     m = scip.Model("footfall")
     if not options.verbose:
         m.hideOutput()
@@ -42,24 +50,39 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
             vtype = "B" if lb == 0.0 and ub == 1.0 else "I"
         x.append(m.addVar(name=name, vtype=vtype, lb=lb, ub=ub))
 
-    def rows(mat: Any, rhs: Any, labels: list[str], sense: str) -> None:
-        for r in range(mat.shape[0]):
-            lo, hi = mat.indptr[r], mat.indptr[r + 1]
-            expr = scip.quicksum(
-                float(v) * x[int(c)]
-                for c, v in zip(mat.indices[lo:hi], mat.data[lo:hi], strict=True)
-            )
-            if sense == "eq":
-                m.addCons(expr == float(rhs[r]), name=labels[r][:200])
-            else:
-                m.addCons(expr <= float(rhs[r]), name=labels[r][:200])
-
-    rows(problem.a_eq, problem.b_eq, problem.eq_labels, "eq")
-    rows(problem.a_le, problem.b_le, problem.le_labels, "le")
+    _add_rows(m, x, problem.a_eq, problem.b_eq, problem.eq_labels, equal=True)
+    _add_rows(m, x, problem.a_le, problem.b_le, problem.le_labels, equal=False)
     for k, (idx, radius) in enumerate(problem.cones):
         m.addCons(
             scip.quicksum(x[int(i)] * x[int(i)] for i in idx) <= radius * radius, name=f"cone{k}"
         )
+    _add_objective(m, x, problem)
+    if options.initial_solution is not None:
+        sol = m.createSol()
+        for i, v in enumerate(options.initial_solution):
+            m.setSolVal(sol, x[i], float(v))
+        m.addSol(sol, free=True)
+    return m, x
+
+
+def _add_rows(m: Any, x: list[Any], mat: Any, rhs: Any, labels: list[str], equal: bool) -> None:
+    """Add the rows ``mat x = rhs`` (``equal``) or ``mat x <= rhs``, named by their labels."""
+    import pyscipopt as scip
+
+    for r in range(mat.shape[0]):
+        lo, hi = mat.indptr[r], mat.indptr[r + 1]
+        expr = scip.quicksum(
+            float(v) * x[int(c)] for c, v in zip(mat.indices[lo:hi], mat.data[lo:hi], strict=True)
+        )
+        if equal:
+            m.addCons(expr == float(rhs[r]), name=labels[r][:200])
+        else:
+            m.addCons(expr <= float(rhs[r]), name=labels[r][:200])
+
+
+def _add_objective(m: Any, x: list[Any], problem: MIQCQP) -> None:
+    """Minimise ``sum_g t_g`` with ``t_g >= sum_{j in g} w_j (F_j x - f_j)^2`` per cost label."""
+    import pyscipopt as scip
 
     groups: dict[str, list[int]] = {}
     for r, g in enumerate(problem.cost_group):
@@ -79,14 +102,22 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
         m.addCons(scip.quicksum(terms) <= t, name=f"cost[{g}]")
     m.setObjective(scip.quicksum(epi), "minimize")
 
-    if options.initial_solution is not None:
-        sol = m.createSol()
-        for i, v in enumerate(options.initial_solution):
-            m.setSolVal(sol, x[i], float(v))
-        m.addSol(sol, free=True)
 
-    build_time = time.perf_counter() - start
-    m.optimize()
+def _status(raw: str, n_sols: int) -> SolveStatus:
+    """The :class:`SolveStatus` of SCIP's status ``raw`` with ``n_sols`` solutions found."""
+    if raw in ("optimal", "gaplimit"):
+        return SolveStatus.OPTIMAL
+    if raw == "infeasible":
+        return SolveStatus.INFEASIBLE
+    if raw == "timelimit":
+        return SolveStatus.TIME_LIMIT
+    if raw in ("unbounded", "inforunbd"):
+        return SolveStatus.ERROR
+    return SolveStatus.FEASIBLE if n_sols > 0 else SolveStatus.ERROR
+
+
+def _result(problem: MIQCQP, m: Any, x: list[Any], start: float, build_time: float) -> SolverResult:
+    """The :class:`SolverResult` of the solved model ``m``."""
     raw = m.getStatus()
     n_sols = m.getNSols()
     xs = None
@@ -95,18 +126,6 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
         best = m.getBestSol()
         xs = np.array([m.getSolVal(best, v) for v in x])
         objective = problem.objective(xs)
-    bound = float(m.getDualbound()) if raw != "infeasible" else math.nan
-    gap = float(m.getGap()) if n_sols > 0 else math.inf
-    if raw in ("optimal", "gaplimit"):
-        status = SolveStatus.OPTIMAL
-    elif raw == "infeasible":
-        status = SolveStatus.INFEASIBLE
-    elif raw == "timelimit":
-        status = SolveStatus.TIME_LIMIT
-    elif raw in ("unbounded", "inforunbd"):
-        status = SolveStatus.ERROR
-    else:
-        status = SolveStatus.FEASIBLE if n_sols > 0 else SolveStatus.ERROR
     stats = {
         "raw_status": raw,
         "nodes": int(m.getNNodes()),
@@ -117,11 +136,11 @@ def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
         "integer_variables": problem.n_integer,
     }
     return SolverResult(
-        status=status,
+        status=_status(raw, n_sols),
         x=xs,
         objective=objective,
-        bound=bound,
-        gap=gap,
+        bound=float(m.getDualbound()) if raw != "infeasible" else math.nan,
+        gap=float(m.getGap()) if n_sols > 0 else math.inf,
         solve_time=time.perf_counter() - start,
         solver=NAME,
         stats=stats,
