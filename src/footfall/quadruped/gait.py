@@ -334,48 +334,87 @@ def _plan(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
     t = 0.0
     for cycle in range(params.cycles):
         for group in swing_groups(params.strategy):
-            tri_feet = feet.copy()
-            triangles = []
-            for leg in group:
-                stance = [i for i in range(4) if i != leg.idx]
-                triangles.append(support_polygon(tri_feet[stance]))
-                tri_feet[leg.idx] = tri_feet[leg.idx] + u * params.step
-            target, margin = zmp_target(triangles)
-            new_body = _body_for_com(robot, post, target, feet, params.step)
-            phases.append(
-                GaitPhase(
-                    PhaseKind.SHIFT,
-                    t,
-                    params.shift_period,
-                    body,
-                    new_body,
-                    feet.copy(),
-                    zmp_target=target,
-                    target_margin=margin,
-                    cycle=cycle,
-                )
+            body, t = _shift_and_swing(robot, post, params, group, cycle, feet, body, t, phases)
+    _centre_and_hold(robot, post, params, feet, body, t, phases)
+    plan = GaitPlan(robot, params, post, tuple(phases))
+    _check_plan_reach(plan)
+    return plan
+
+
+def _shift_and_swing(
+    robot: QuadrupedRobot,
+    post: SlopePosture,
+    params: GaitParams,
+    group: tuple[Leg, ...],
+    cycle: int,
+    feet: FloatArray,
+    body: FloatArray,
+    t: float,
+    phases: list[GaitPhase],
+) -> tuple[FloatArray, float]:
+    """Append one body shift to the ZMP target of the support triangles of ``group`` (sec. 3),
+    then the swing of each leg of the group (one step along the slope) to ``phases``.
+
+    ``feet`` (4, 3) [m] is updated to the landed feet. Returns the body position [m] after the
+    shift and the time [s] after the last swing.
+    """
+    u = post.slope_direction
+    tri_feet = feet.copy()
+    triangles = []
+    for leg in group:
+        stance = [i for i in range(4) if i != leg.idx]
+        triangles.append(support_polygon(tri_feet[stance]))
+        tri_feet[leg.idx] = tri_feet[leg.idx] + u * params.step
+    target, margin = zmp_target(triangles)
+    new_body = _body_for_com(robot, post, target, feet, params.step)
+    phases.append(
+        GaitPhase(
+            PhaseKind.SHIFT,
+            t,
+            params.shift_period,
+            body,
+            new_body,
+            feet.copy(),
+            zmp_target=target,
+            target_margin=margin,
+            cycle=cycle,
+        )
+    )
+    t += params.shift_period
+    body = new_body
+    for leg in group:
+        land = feet[leg.idx] + u * params.step
+        phases.append(
+            GaitPhase(
+                PhaseKind.SWING,
+                t,
+                params.swing_period,
+                body,
+                body,
+                feet.copy(),
+                leg=leg,
+                foot_end=land,
+                zmp_target=target,
+                target_margin=margin,
+                cycle=cycle,
             )
-            t += params.shift_period
-            body = new_body
-            for leg in group:
-                land = feet[leg.idx] + u * params.step
-                phases.append(
-                    GaitPhase(
-                        PhaseKind.SWING,
-                        t,
-                        params.swing_period,
-                        body,
-                        body,
-                        feet.copy(),
-                        leg=leg,
-                        foot_end=land,
-                        zmp_target=target,
-                        target_margin=margin,
-                        cycle=cycle,
-                    )
-                )
-                t += params.swing_period
-                feet[leg.idx] = land
+        )
+        t += params.swing_period
+        feet[leg.idx] = land
+    return body, t
+
+
+def _centre_and_hold(
+    robot: QuadrupedRobot,
+    post: SlopePosture,
+    params: GaitParams,
+    feet: FloatArray,
+    body: FloatArray,
+    t: float,
+    phases: list[GaitPhase],
+) -> None:
+    """Append the final shift of the CoM over the centre of the four feet, and the standing hold
+    (when ``params.hold_time`` > 0), to ``phases``."""
     centre = feet[:, :2].mean(axis=0)
     final = _body_for_com(robot, post, centre, feet, params.step)
     phases.append(
@@ -403,9 +442,6 @@ def _plan(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
                 cycle=params.cycles - 1,
             )
         )
-    plan = GaitPlan(robot, params, post, tuple(phases))
-    _check_plan_reach(plan)
-    return plan
 
 
 def _check_plan_reach(plan: GaitPlan) -> None:
