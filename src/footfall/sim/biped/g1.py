@@ -229,6 +229,111 @@ def _prepared_urdf(path: Path) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
+#: colours of the stick figure, the feet and the trunk boxes (RGBA)
+_GREY, _DARK, _BLUE = [0.7, 0.7, 0.72, 1.0], [0.15, 0.15, 0.15, 1.0], [0.25, 0.35, 0.6, 1.0]
+
+
+def _robot_col() -> dict[str, int]:
+    """Contact bits of the robot's collision geoms (they touch the ground, not each other)."""
+    return {"contype": nm.ROBOT_CONTYPE, "conaffinity": nm.ROBOT_CONAFFINITY}
+
+
+def _visual() -> dict[str, int]:
+    """Attributes of geoms that are drawn and never collide."""
+    return {"contype": 0, "conaffinity": 0, "group": nm.ROBOT_GROUP}
+
+
+def _add_trunk(spec: Any, mujoco: Any) -> None:
+    """Free joint and tracking camera on the pelvis; the torso renamed; the trunk boxes."""
+    pelvis = spec.body(nm.PELVIS_BODY)
+    pelvis.add_freejoint(name=nm.ROOT_JOINT)
+    cam = pelvis.add_camera(
+        name=nm.TRACK_CAMERA, mode=mujoco.mjtCamLight.mjCAMLIGHT_TRACKCOM, pos=[0.3, -2.6, 0.6]
+    )
+    cam.alt.type = mujoco.mjtOrientation.mjORIENTATION_XYAXES
+    cam.alt.xyaxes = [1.0, 0.0, 0.0, 0.0, 0.2, 1.0]
+    torso = spec.body(G1_TORSO_LINK)
+    torso.name = nm.TORSO_BODY
+    for body, geom, (centre, half) in (
+        (pelvis, nm.PELVIS_GEOM, PELVIS_BOX),
+        (torso, nm.TORSO_GEOM, TORSO_BOX),
+    ):
+        body.add_geom(
+            name=geom,
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            pos=list(centre),
+            size=list(half),
+            rgba=_BLUE,
+            group=nm.ROBOT_GROUP,
+            **_robot_col(),
+        )
+
+
+def _add_leg(spec: Any, mujoco: Any, p: G1Model, side: Side, efforts: dict[str, float]) -> None:
+    """One leg: joints and bodies renamed, position servos saturating at the URDF effort, the
+    sole's corner spheres, the sole site and the drawn foot plate."""
+    for name in nm.LEG_JOINTS:
+        j = spec.joint(urdf_joint(side, name))
+        effort = efforts[urdf_joint(side, name)]
+        j.name = nm.joint(side, name)
+        j.armature = p.armature
+        j.damping[0] = p.joint_damping  # MuJoCo 4: (linear, quadratic, cubic) coefficients
+        body = j.parent
+        body.name = nm.link_body(side, name)
+        kp = effort / p.servo_saturation
+        act = spec.add_actuator(
+            name=nm.actuator(side, name),
+            target=nm.joint(side, name),
+            trntype=mujoco.mjtTrn.mjTRN_JOINT,
+        )
+        act.set_to_position(kp=kp, kv=kp * p.servo_damping_time)
+        act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        act.forcerange = [-effort, effort]
+    foot = spec.body(nm.foot_body(side))
+    r = G1_SPHERE_RADIUS
+    for k, pos in enumerate(_sole_corners()):
+        foot.add_geom(
+            name=nm.corner_geom(side, k),
+            type=mujoco.mjtGeom.mjGEOM_SPHERE,
+            size=[r, 0, 0],
+            pos=list(pos),
+            rgba=_DARK,
+            friction=[p.friction, 0.02, 0.002],
+            solref=[0.004, 1.0],
+            group=nm.ROBOT_GROUP,
+            **_robot_col(),
+        )
+    sole_z = G1_SPHERE_Z - r
+    dx, _ = p.ankle_offset
+    foot.add_site(name=nm.sole_site(side), pos=[dx, 0.0, sole_z], size=[0.01, 0, 0])
+    foot.add_geom(
+        name=nm.foot_geom(side),
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        pos=[dx, 0.0, sole_z + 0.01],
+        size=[p.foot_length / 2, G1_TOE_HALF_WIDTH + r, 0.01],
+        rgba=_DARK,
+        **_visual(),
+    )
+
+
+def _add_stick_figure(spec: Any, mujoco: Any) -> None:
+    """A stick figure for videos: a capsule from each body to each of its children."""
+    for body in spec.bodies:
+        if body.name in ("world", nm.PELVIS_BODY) or body.parent is None:
+            continue
+        for child in body.bodies:
+            d = np.asarray(child.pos, dtype=float)
+            if float(np.linalg.norm(d)) < 2.0 * LINK_RADIUS:
+                continue
+            body.add_geom(
+                type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+                fromto=[0.0, 0.0, 0.0, *d.tolist()],
+                size=[LINK_RADIUS, 0, 0],
+                rgba=_GREY,
+                **_visual(),
+            )
+
+
 def g1_spec(params: G1Model | None = None) -> Any:
     """The G1 as a ``mujoco.MjSpec`` named as :mod:`biped_names` (see the module docstring)."""
     mujoco = require_mujoco()
@@ -248,91 +353,10 @@ def g1_spec(params: G1Model | None = None) -> Any:
     spec.visual.global_.offwidth = 1280
     spec.visual.global_.offheight = 720
 
-    robot_col = {"contype": nm.ROBOT_CONTYPE, "conaffinity": nm.ROBOT_CONAFFINITY}
-    visual = {"contype": 0, "conaffinity": 0, "group": nm.ROBOT_GROUP}
-    grey, dark, blue = [0.7, 0.7, 0.72, 1.0], [0.15, 0.15, 0.15, 1.0], [0.25, 0.35, 0.6, 1.0]
-
-    pelvis = spec.body(nm.PELVIS_BODY)
-    pelvis.add_freejoint(name=nm.ROOT_JOINT)
-    cam = pelvis.add_camera(
-        name=nm.TRACK_CAMERA, mode=mujoco.mjtCamLight.mjCAMLIGHT_TRACKCOM, pos=[0.3, -2.6, 0.6]
-    )
-    cam.alt.type = mujoco.mjtOrientation.mjORIENTATION_XYAXES
-    cam.alt.xyaxes = [1.0, 0.0, 0.0, 0.0, 0.2, 1.0]
-    torso = spec.body(G1_TORSO_LINK)
-    torso.name = nm.TORSO_BODY
-    for body, geom, (centre, half) in (
-        (pelvis, nm.PELVIS_GEOM, PELVIS_BOX),
-        (torso, nm.TORSO_GEOM, TORSO_BOX),
-    ):
-        body.add_geom(
-            name=geom,
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            pos=list(centre),
-            size=list(half),
-            rgba=blue,
-            group=nm.ROBOT_GROUP,
-            **robot_col,
-        )
-
+    _add_trunk(spec, mujoco)
     for side in (Side.LEFT, Side.RIGHT):
-        for name in nm.LEG_JOINTS:
-            j = spec.joint(urdf_joint(side, name))
-            effort = efforts[urdf_joint(side, name)]
-            j.name = nm.joint(side, name)
-            j.armature = p.armature
-            j.damping[0] = p.joint_damping  # MuJoCo 4: (linear, quadratic, cubic) coefficients
-            body = j.parent
-            body.name = nm.link_body(side, name)
-            kp = effort / p.servo_saturation
-            act = spec.add_actuator(
-                name=nm.actuator(side, name),
-                target=nm.joint(side, name),
-                trntype=mujoco.mjtTrn.mjTRN_JOINT,
-            )
-            act.set_to_position(kp=kp, kv=kp * p.servo_damping_time)
-            act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
-            act.forcerange = [-effort, effort]
-        foot = spec.body(nm.foot_body(side))
-        r = G1_SPHERE_RADIUS
-        for k, pos in enumerate(_sole_corners()):
-            foot.add_geom(
-                name=nm.corner_geom(side, k),
-                type=mujoco.mjtGeom.mjGEOM_SPHERE,
-                size=[r, 0, 0],
-                pos=list(pos),
-                rgba=dark,
-                friction=[p.friction, 0.02, 0.002],
-                solref=[0.004, 1.0],
-                group=nm.ROBOT_GROUP,
-                **robot_col,
-            )
-        sole_z = G1_SPHERE_Z - r
-        dx, _ = p.ankle_offset
-        foot.add_site(name=nm.sole_site(side), pos=[dx, 0.0, sole_z], size=[0.01, 0, 0])
-        foot.add_geom(
-            name=nm.foot_geom(side),
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            pos=[dx, 0.0, sole_z + 0.01],
-            size=[p.foot_length / 2, G1_TOE_HALF_WIDTH + r, 0.01],
-            rgba=dark,
-            **visual,
-        )
-    # a stick figure for videos: a capsule from each body to each of its children
-    for body in spec.bodies:
-        if body.name in ("world", nm.PELVIS_BODY) or body.parent is None:
-            continue
-        for child in body.bodies:
-            d = np.asarray(child.pos, dtype=float)
-            if float(np.linalg.norm(d)) < 2.0 * LINK_RADIUS:
-                continue
-            body.add_geom(
-                type=mujoco.mjtGeom.mjGEOM_CAPSULE,
-                fromto=[0.0, 0.0, 0.0, *d.tolist()],
-                size=[LINK_RADIUS, 0, 0],
-                rgba=grey,
-                **visual,
-            )
+        _add_leg(spec, mujoco, p, side, efforts)
+    _add_stick_figure(spec, mujoco)
     return spec
 
 
