@@ -97,9 +97,9 @@ class SimOptions:
         mpc_nodes: torque blocks + 1 of the MPC (default: the plan robot's K).
         solver: MPC backend, ``newton`` or ``clarabel``.
         engine: how the loop runs: ``python`` (the numpy reference), ``compiled`` (the same loop
-            compiled with numba, newton solver only; same trajectories up to rounding, about
-            20x faster: ``footfall bench sim``) or ``auto`` (compiled when numba is installed and the solver is
-            ``newton``).
+            compiled with numba, newton solver only; same trajectories up to rounding; its speed
+            is measured by ``footfall bench sim``) or ``auto`` (compiled when numba is installed
+            and the solver is ``newton``).
     """
 
     control_rate: float = 500.0
