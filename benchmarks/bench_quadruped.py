@@ -15,7 +15,7 @@ import os
 for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(var, "1")
 
-from footfall.sim.quadruped.sim import benchmark_quadruped  # noqa: E402
+from footfall.experiments.bench import benchmark_quadruped  # noqa: E402
 
 
 def main() -> None:

@@ -391,9 +391,10 @@ def quadruped_cmd(
     if video:
         # must be chosen before MuJoCo is imported; EGL works headless here
         os.environ.setdefault("MUJOCO_GL", "egl")
-    from footfall.quadruped import GaitParams, QuadrupedRobot, ZmpStrategy, plan_gait
+    from footfall.experiments.slope_walk import compare_strategies, plan_strategies
+    from footfall.quadruped import GaitParams, QuadrupedRobot, ZmpStrategy
     from footfall.sim.quadruped.sim import simulate
-    from footfall.viz import quadruped_plots as qp
+    from footfall.viz.quadruped_plots import save_walk_figures
 
     if not math.isfinite(slope_deg) or not 0.0 <= slope_deg <= 60.0:
         raise InputError("--slope-deg", slope_deg, "a slope in [0, 60] deg")
@@ -405,80 +406,35 @@ def quadruped_cmd(
         strat = ZmpStrategy(strategy)
     except ValueError:
         raise InputError("--strategy", strategy, "one of osp, incentre, transverse") from None
-    robot = QuadrupedRobot()
-
-    def params(s: ZmpStrategy) -> GaitParams:
-        return GaitParams(
-            slope=math.radians(slope_deg),
-            body_pitch=math.radians(body_deg),
-            step=step,
-            swing_height=height,
-            swing_period=swing_period,
-            shift_period=shift_period,
-            cycles=cycles,
-            strategy=s,
-        )
-
-    # every plan is built (and validated) before any simulation starts
-    plans = {strat: plan_gait(robot, params(strat))}
-    comparison_errors: dict[str, str] = {}
-    if compare:
-        for other in ZmpStrategy:
-            if other is not strat:
-                try:
-                    plans[other] = plan_gait(robot, params(other))
-                except InputError as exc:
-                    comparison_errors[other.value] = str(exc)
-    out.mkdir(parents=True, exist_ok=True)
+    params = GaitParams(
+        slope=math.radians(slope_deg),
+        body_pitch=math.radians(body_deg),
+        step=step,
+        swing_height=height,
+        swing_period=swing_period,
+        shift_period=shift_period,
+        cycles=cycles,
+        strategy=strat,
+    )
+    output_folder(out)
+    plans, infeasible = plan_strategies(QuadrupedRobot(), params, compare)
     plan = plans[strat]
     console.print(f"simulating {cycles} cycles on {slope_deg:g} deg ({plan.duration:.1f} s)...")
     res = simulate(plan, video_path=out / "quadruped.mp4" if video else None)
     if video and res.video is None:
-        console.print(f"[yellow]{res.video_note}[/]")
-    payload: dict[str, Any] = dict(res.metrics)
+        console.print(res.video_note)
+    payload = res.metrics.to_dict()
     if compare:
-        table = {}
-        for s, p in plans.items():
-            r = res if s is strat else simulate(p)
-            table[s.value] = {
-                "shifts_per_cycle": r.metrics["body_sway_planned"]["shifts_per_cycle"],
-                "planned_path_per_cycle_m": r.metrics["body_sway_planned"]["path_per_cycle_m"],
-                "measured_path_per_cycle_m": r.metrics["body_sway_measured"]["path_per_cycle_m"],
-                "measured_lateral_path_per_cycle_m": r.metrics["body_sway_measured"][
-                    "lateral_path_per_cycle_m"
-                ],
-                "measured_excess_path_per_cycle_m": r.metrics["body_sway_measured"][
-                    "excess_path_per_cycle_m"
-                ],
-                "stability_margin_min_m": r.metrics["stability_margin_min_m"],
-                "mean_speed_m_s": r.metrics["mean_speed_m_s"],
-                "fell": r.metrics["fell"],
-            }
-        payload["strategy_comparison"] = table
-        payload["strategy_comparison_infeasible"] = comparison_errors
-    figs = [
-        qp.plot_swing_frames(plan, out / "fig8_swing_frames.png"),
-        qp.plot_foot_path(plan, res, out / "fig10_lf_foot_path.png"),
-        qp.plot_body_height(
-            [
-                (
-                    f"{slope_deg:g}°/{body_deg:g}°",
-                    res.t,
-                    res.trunk_pos[:, 2],
-                    res.planned.body_pos[:, 2],
-                )
-            ],
-            out / "fig11_body_z.png",
-        ),
-        qp.plot_stability(plan, res, out / "stability.png"),
-    ]
+        payload["strategy_comparison"] = compare_strategies(plans, res)
+        payload["strategy_comparison_infeasible"] = infeasible
+    figs = save_walk_figures(plan, res, out, f"{slope_deg:g}°/{body_deg:g}°")
     payload["figures"] = [str(f) for f in figs]
     write_json(out / "quadruped.json", payload)
     m = res.metrics
     console.print(
-        f"distance {m['distance_up_slope_m']:.2f} m, speed {m['mean_speed_m_s']:.3f} m/s, "
-        f"fell {m['fell']}, margin min {m['stability_margin_min_m']:.3f} m "
-        f"mean {m['stability_margin_mean_m']:.3f} m, {m['realtime_factor']:.0f}x real time"
+        f"distance {m.distance_up_slope_m:.2f} m, speed {m.mean_speed_m_s:.3f} m/s, "
+        f"fell {m.fell}, margin min {m.stability_margin_min_m:.3f} m "
+        f"mean {m.stability_margin_mean_m:.3f} m, {m.realtime_factor:.0f}x real time"
     )
     console.print(f"wrote {out / 'quadruped.json'}")
 
@@ -961,7 +917,7 @@ def bench_quadruped_cmd(
     out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_quadruped.json."),
 ) -> None:
     """Quadruped slope walk: simulated s per wall s vs bare mj_step, and gait-plan time."""
-    from footfall.sim.quadruped.sim import benchmark_quadruped
+    from footfall.experiments.bench import benchmark_quadruped
 
     result = benchmark_quadruped(slope_deg=slope_deg, body_deg=body_deg)
     write_json(out / "bench_quadruped.json", result)

@@ -78,3 +78,10 @@ def test_a_plan_with_a_nan_footstep_is_refused_at_construction() -> None:
         replace(plan, footsteps=feet)
     with pytest.raises(InputError, match=r"plan\.headings"):
         replace(plan, headings=plan.headings[:-1])
+
+
+def test_quadruped_cycles_are_bounded() -> None:
+    from footfall.quadruped.gait import MAX_CYCLES, GaitParams
+
+    with pytest.raises(InputError, match="cycles"):
+        GaitParams(slope=0.2, body_pitch=0.1, cycles=MAX_CYCLES + 1)

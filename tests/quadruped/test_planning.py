@@ -272,6 +272,6 @@ def test_osp_sways_less_than_per_triangle_incentre() -> None:
         )
         tr = plan.sample(0.02, with_zmp=False)
         out[strat] = body_sway(plan, tr.t, tr.body_pos)
-    assert out[ZmpStrategy.OSP]["shifts_per_cycle"] == 2
-    assert out[ZmpStrategy.INCENTRE]["shifts_per_cycle"] == 4
-    assert out[ZmpStrategy.OSP]["path_per_cycle_m"] < out[ZmpStrategy.INCENTRE]["path_per_cycle_m"]
+    assert out[ZmpStrategy.OSP].shifts_per_cycle == 2
+    assert out[ZmpStrategy.INCENTRE].shifts_per_cycle == 4
+    assert out[ZmpStrategy.OSP].path_per_cycle_m < out[ZmpStrategy.INCENTRE].path_per_cycle_m

@@ -364,14 +364,8 @@ def build_mpc(
     ar, br = alip.reset_map(robot.t_ds)
     q, r, w, qf = weights.matrices(robot)
     edges = np.round(np.linspace(0, m, k_nodes)).astype(np.int64)
-    powers = np.empty((m + 1, 4, 4))
-    sums = np.empty((m + 1, 4, 2))
-    powers[0], sums[0] = np.eye(4), 0.0
-    for n in range(1, m + 1):
-        powers[n] = ad @ powers[n - 1]
-        sums[n] = sums[n - 1] + powers[n - 1] @ bd
-    u_lim = _torque_limits(robot, torque_limits)
-
+    powers, sums = _powers_and_sums(ad, bd, m)
+    first, ticks = _blocks_by_tick(edges, m)
     proto = CondensedMPC(
         robot=robot,
         weights=weights,
@@ -387,17 +381,37 @@ def build_mpc(
         R=r,
         W=w,
         Qf=qf,
-        first_block=(),
-        block_ticks=(),
+        first_block=tuple(first),
+        block_ticks=tuple(ticks),
         a_end=(),
         b_end=(),
         H=(),
         F=(),
         c=(),
-        u_limits=u_lim,
+        u_limits=_torque_limits(robot, torque_limits),
         _powers=powers,
         _sums=sums,
     )
+    per_tick = [_condense_tick(proto, k_s) for k_s in range(m)]
+    names = ("a_end", "b_end", "H", "F", "c", "_p_scaled", "_q_map", "_gain", "_d_theta", "_d_u")
+    for name, val in zip(names, zip(*per_tick, strict=True), strict=True):
+        object.__setattr__(proto, name, tuple(val))
+    return proto
+
+
+def _powers_and_sums(ad: FloatArray, bd: FloatArray, m: int) -> tuple[FloatArray, FloatArray]:
+    """``A_d^n`` (m + 1, 4, 4) and ``sum_{j<n} A_d^j B_d`` (m + 1, 4, 2): n ticks of (5.19b)."""
+    powers = np.empty((m + 1, 4, 4))
+    sums = np.empty((m + 1, 4, 2))
+    powers[0], sums[0] = np.eye(4), 0.0
+    for n in range(1, m + 1):
+        powers[n] = ad @ powers[n - 1]
+        sums[n] = sums[n - 1] + powers[n - 1] @ bd
+    return powers, sums
+
+
+def _blocks_by_tick(edges: NDArray[np.int64], m: int) -> tuple[list[int], list[NDArray[np.int64]]]:
+    """For every tick ``k_s``: the block it lies in, and the ticks each remaining block lasts."""
     first: list[int] = []
     ticks: list[NDArray[np.int64]] = []
     for k_s in range(m):
@@ -405,64 +419,56 @@ def build_mpc(
         first.append(j0)
         t = edges[j0 + 1 :] - np.maximum(edges[j0:-1], k_s)
         ticks.append(t.astype(np.int64))
-    object.__setattr__(proto, "first_block", tuple(first))
-    object.__setattr__(proto, "block_ticks", tuple(ticks))
+    return first, ticks
 
-    a_end, b_end, hs, fs, cs = [], [], [], [], []
-    p_sc, q_map, gains, d_th, d_u = [], [], [], [], []
-    br2 = br[:, :2]
-    for k_s in range(m):
-        phi, gamma = proto.stacked(k_s)
-        n_u = gamma.shape[2]
-        n_z = n_u + 2
-        a_end.append(phi[-1])
-        b_end.append(gamma[-1])
-        h = np.zeros((n_z, n_z))
-        # Stage terms (5.19a), summed over ticks and scaled by dt (weights per second).
-        h[:n_u, :n_u] = 2.0 * dt * np.einsum("kai,ab,kbj->ij", gamma, q, gamma)
-        h[:n_u, :n_u] += np.kron(np.diag(2.0 * dt * ticks[k_s]), r)
-        # Footstep and next-step terms: residuals r_w = S_d z + D theta, r_f = C_z z + C_th theta.
-        s_d = np.zeros((2, n_z))
-        s_d[:, n_u:] = np.eye(2)
-        d_map = np.zeros((2, N_THETA))
-        d_map[:, THETA_D] = -np.eye(2)
-        c_z = np.hstack([ar @ gamma[-1], br2])  # (5.19c) with x_M from (5.19b)
-        c_th = np.zeros((4, N_THETA))
-        c_th[:, THETA_X] = ar @ phi[-1]
-        c_th[:, THETA_XREF] = -np.eye(4)
-        h += 2.0 * (s_d.T @ w @ s_d + c_z.T @ qf @ c_z)
-        f = 2.0 * (s_d.T @ w @ d_map + c_z.T @ qf @ c_th)
-        c = d_map.T @ w @ d_map + c_th.T @ qf @ c_th
-        hs.append(h)
-        fs.append(f)
-        cs.append(c)
-        # Eliminate d (unconstrained): d = -H_dd^-1 (F_d theta + H_du u).
-        h_uu, h_ud, h_dd = h[:n_u, :n_u], h[:n_u, n_u:], h[n_u:, n_u:]
-        h_dd_inv = np.linalg.inv(h_dd)
-        p_red = h_uu - h_ud @ h_dd_inv @ h_ud.T
-        p_red = 0.5 * (p_red + p_red.T)
-        f_red = f[:n_u] - h_ud @ h_dd_inv @ f[n_u:]
-        # Scaled torques v = S^-1 u put the balls at radius 1 (better-conditioned multipliers).
-        scale = np.tile(u_lim, n_u // 2)
-        p_sc.append(scale[:, None] * p_red * scale[None, :])
-        q_map.append(scale[:, None] * f_red)
-        gains.append(-np.linalg.solve(p_red, f_red))
-        d_th.append(-h_dd_inv @ f[n_u:])
-        d_u.append(-h_dd_inv @ h_ud.T)
-    for name, val in (
-        ("a_end", a_end),
-        ("b_end", b_end),
-        ("H", hs),
-        ("F", fs),
-        ("c", cs),
-        ("_p_scaled", p_sc),
-        ("_q_map", q_map),
-        ("_gain", gains),
-        ("_d_theta", d_th),
-        ("_d_u", d_u),
-    ):
-        object.__setattr__(proto, name, tuple(val))
-    return proto
+
+def _condense_tick(mdl: CondensedMPC, k_s: int) -> tuple[NDArray[Any], ...]:
+    """The condensed cost of eq. (5.19) at tick ``k_s`` and its reduction to the torques.
+
+    Returns:
+        ``(a_end, b_end, H, F, c, P_scaled, q_map, gain, d_theta, d_u)`` of that tick (see
+        :class:`CondensedMPC` and :class:`PaddedMPC`).
+    """
+    dt, ar, q, r, w, qf = mdl.control_dt, mdl.ar, mdl.Q, mdl.R, mdl.W, mdl.Qf
+    phi, gamma = mdl.stacked(k_s)
+    n_u = gamma.shape[2]
+    n_z = n_u + 2
+    h = np.zeros((n_z, n_z))
+    # Stage terms (5.19a), summed over ticks and scaled by dt (weights per second).
+    h[:n_u, :n_u] = 2.0 * dt * np.einsum("kai,ab,kbj->ij", gamma, q, gamma)
+    h[:n_u, :n_u] += np.kron(np.diag(2.0 * dt * mdl.block_ticks[k_s]), r)
+    # Footstep and next-step terms: residuals r_w = S_d z + D theta, r_f = C_z z + C_th theta.
+    s_d = np.zeros((2, n_z))
+    s_d[:, n_u:] = np.eye(2)
+    d_map = np.zeros((2, N_THETA))
+    d_map[:, THETA_D] = -np.eye(2)
+    c_z = np.hstack([ar @ gamma[-1], mdl.br[:, :2]])  # (5.19c) with x_M from (5.19b)
+    c_th = np.zeros((4, N_THETA))
+    c_th[:, THETA_X] = ar @ phi[-1]
+    c_th[:, THETA_XREF] = -np.eye(4)
+    h += 2.0 * (s_d.T @ w @ s_d + c_z.T @ qf @ c_z)
+    f = 2.0 * (s_d.T @ w @ d_map + c_z.T @ qf @ c_th)
+    c = d_map.T @ w @ d_map + c_th.T @ qf @ c_th
+    # Eliminate d (unconstrained): d = -H_dd^-1 (F_d theta + H_du u).
+    h_uu, h_ud, h_dd = h[:n_u, :n_u], h[:n_u, n_u:], h[n_u:, n_u:]
+    h_dd_inv = np.linalg.inv(h_dd)
+    p_red = h_uu - h_ud @ h_dd_inv @ h_ud.T
+    p_red = 0.5 * (p_red + p_red.T)
+    f_red = f[:n_u] - h_ud @ h_dd_inv @ f[n_u:]
+    # Scaled torques v = S^-1 u put the balls at radius 1 (better-conditioned multipliers).
+    scale = np.tile(mdl.u_limits, n_u // 2)
+    return (
+        phi[-1],
+        gamma[-1],
+        h,
+        f,
+        c,
+        scale[:, None] * p_red * scale[None, :],
+        scale[:, None] * f_red,
+        -np.linalg.solve(p_red, f_red),
+        -h_dd_inv @ f[n_u:],
+        -h_dd_inv @ h_ud.T,
+    )
 
 
 def _torque_limits(robot: BipedParams, torque_limits: ArrayLike | None) -> FloatArray:
@@ -535,33 +541,11 @@ def solve_ball_qp(
     """
     n = q.shape[0]
     n_b = n // 2
-    diag = np.arange(n)
     if lam0 is None:
-        # Cold start from the exact multiplier of each block alone with P ~ P_jj I:
-        # ||q_j|| / (P_jj + lambda_j) = 1 at the unconstrained norm ||v_j|| = ||q_j|| / P_jj.
-        pjj = 0.5 * (p[diag[::2], diag[::2]] + p[diag[1::2], diag[1::2]])
-        v_unc = np.linalg.solve(p, -q).reshape(n_b, 2)
-        lam = pjj * np.maximum(np.linalg.norm(v_unc, axis=1) - 1.0, 0.0)
+        lam = _cold_start(p, q)
     else:
         lam = np.maximum(np.asarray(lam0, dtype=float), 0.0)
-
-    def evaluate(lam: FloatArray) -> tuple[FloatArray, FloatArray, float]:
-        mat = p.copy()
-        mat[diag, diag] += np.repeat(lam, 2)
-        # S = (P + Lambda)^-1 = L^-T L^-1 from the Cholesky factor (LAPACK directly: the numpy
-        # wrappers cost more than the arithmetic at this size).
-        chol, info = dpotrf(mat, lower=1, clean=1)
-        if info != 0:
-            raise np.linalg.LinAlgError(f"P + Lambda not positive definite (info {info})")
-        linv, info = dtrtri(chol, lower=1)
-        if info != 0:
-            raise np.linalg.LinAlgError(f"singular Cholesky factor (info {info})")
-        s = linv.T @ linv
-        v = -(s @ q)
-        # dual objective to minimise: phi = -g = 1/2 q^T S q + 1/2 sum(lambda)
-        return s, v, float(-0.5 * (q @ v) + 0.5 * lam.sum())
-
-    s, v, phi = evaluate(lam)
+    s, v, phi = _ball_dual(p, q, lam)
     converged = False
     it = 0
     for it in range(max_iter + 1):
@@ -573,29 +557,11 @@ def solve_ball_qp(
             break
         if it == max_iter:
             break
-        # Multipliers at (or within eps of) zero whose gradient pushes them down stay at zero.
-        eps = min(1e-3, float(np.sqrt(np.sum((lam - np.maximum(lam - grad, 0.0)) ** 2))))
-        bound = (lam <= eps) & (grad > 0.0)
-        free = ~bound
-        step = -grad
-        if free.any():
-            hess = np.einsum("ja,jalb,lb->jl", vb, s.reshape(n_b, 2, n_b, 2), vb)
-            hf = hess[free][:, free] if bound.any() else hess
-            hf.flat[:: hf.shape[0] + 1] += 1e-12 * (1.0 + np.trace(hf))
-            # Secular (More-Sorensen) Newton step: Newton on 1/||v_j|| - 1, which is close to
-            # linear in lambda (exactly so for P = p I), i.e. the dual Hessian system with the
-            # gradient rescaled per block by 2 ||v_j||^2 / (1 + ||v_j||). Far fewer iterations than
-            # Newton on the dual gradient; kept only while it is a descent direction of the dual.
-            nrm = np.sqrt(1.0 - 2.0 * grad[free])
-            rhs = np.stack([grad[free], grad[free] * 2.0 * nrm**2 / (1.0 + nrm)], axis=1)
-            _, sol, info = dposv(hf, rhs)
-            if info != 0:
-                raise np.linalg.LinAlgError(f"singular dual Hessian (info {info})")
-            step[free] = -sol[:, 1] if grad[free] @ sol[:, 1] > 0.0 else -sol[:, 0]
+        step = _newton_step(lam, grad, vb, s)
         alpha = 1.0
         while True:
             lam_new = np.maximum(lam + alpha * step, 0.0)
-            s_new, v_new, phi_new = evaluate(lam_new)
+            s_new, v_new, phi_new = _ball_dual(p, q, lam_new)
             decrease = float(grad @ (lam_new - lam))
             # Accept on sufficient decrease, or when the predicted decrease is below the rounding
             # error of phi (then only the gradient test above is meaningful).
@@ -609,6 +575,117 @@ def solve_ball_qp(
     norms = np.sqrt(np.einsum("ij,ij->i", vb, vb))
     vb = vb / np.maximum(norms, 1.0)[:, None]
     return vb.ravel(), lam, it, converged
+
+
+def _cold_start(p: FloatArray, q: FloatArray) -> FloatArray:
+    """Multipliers (n / 2,) of the cold start of :func:`solve_ball_qp`.
+
+    The exact multiplier of each block alone with ``P ~ P_jj I``: ``||q_j|| / (P_jj + lambda_j) = 1``
+    at the unconstrained norm ``||v_j|| = ||q_j|| / P_jj``.
+    """
+    n = q.shape[0]
+    diag = np.arange(n)
+    pjj = 0.5 * (p[diag[::2], diag[::2]] + p[diag[1::2], diag[1::2]])
+    v_unc = np.linalg.solve(p, -q).reshape(n // 2, 2)
+    return np.asarray(pjj * np.maximum(np.linalg.norm(v_unc, axis=1) - 1.0, 0.0))
+
+
+def _ball_dual(
+    p: FloatArray, q: FloatArray, lam: FloatArray
+) -> tuple[FloatArray, FloatArray, float]:
+    """Dual of :func:`solve_ball_qp` at ``lam``: ``(S = (P + Lambda)^-1, v = -S q, phi)`` with
+    ``phi = 1/2 q^T S q + 1/2 sum(lambda)`` the dual objective to minimise.
+
+    Raises:
+        numpy.linalg.LinAlgError: ``P + Lambda`` is not positive definite.
+    """
+    diag = np.arange(q.shape[0])
+    mat = p.copy()
+    mat[diag, diag] += np.repeat(lam, 2)
+    # S = (P + Lambda)^-1 = L^-T L^-1 from the Cholesky factor (LAPACK directly: the numpy
+    # wrappers cost more than the arithmetic at this size).
+    chol, info = dpotrf(mat, lower=1, clean=1)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"P + Lambda not positive definite (info {info})")
+    linv, info = dtrtri(chol, lower=1)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"singular Cholesky factor (info {info})")
+    s = linv.T @ linv
+    v = -(s @ q)
+    return s, v, float(-0.5 * (q @ v) + 0.5 * lam.sum())
+
+
+def _newton_step(lam: FloatArray, grad: FloatArray, vb: FloatArray, s: FloatArray) -> FloatArray:
+    """Projected Newton direction on the dual multipliers (n_b,) of :func:`solve_ball_qp`.
+
+    Multipliers at (or within eps of) zero whose gradient pushes them down stay at zero (their
+    step is the negative gradient); the free ones take the secular Newton step.
+    """
+    n_b = lam.shape[0]
+    eps = min(1e-3, float(np.sqrt(np.sum((lam - np.maximum(lam - grad, 0.0)) ** 2))))
+    bound = (lam <= eps) & (grad > 0.0)
+    free = ~bound
+    step = -grad
+    if free.any():
+        hess = np.einsum("ja,jalb,lb->jl", vb, s.reshape(n_b, 2, n_b, 2), vb)
+        hf = hess[free][:, free] if bound.any() else hess
+        hf.flat[:: hf.shape[0] + 1] += 1e-12 * (1.0 + np.trace(hf))
+        # Secular (More-Sorensen) Newton step: Newton on 1/||v_j|| - 1, which is close to
+        # linear in lambda (exactly so for P = p I), i.e. the dual Hessian system with the
+        # gradient rescaled per block by 2 ||v_j||^2 / (1 + ||v_j||). Far fewer iterations than
+        # Newton on the dual gradient; kept only while it is a descent direction of the dual.
+        nrm = np.sqrt(1.0 - 2.0 * grad[free])
+        rhs = np.stack([grad[free], grad[free] * 2.0 * nrm**2 / (1.0 + nrm)], axis=1)
+        _, sol, info = dposv(hf, rhs)
+        if info != 0:
+            raise np.linalg.LinAlgError(f"singular dual Hessian (info {info})")
+        step[free] = -sol[:, 1] if grad[free] @ sol[:, 1] > 0.0 else -sol[:, 0]
+    return np.asarray(step)
+
+
+def _check_polygon(a: ArrayLike, b: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """The footstep polygon ``a p[:2] <= b`` of :meth:`MPC.solve_in_polygon` as checked arrays."""
+    aa = np.asarray(a, dtype=float)
+    bb = np.asarray(b, dtype=float)
+    if aa.ndim != 2 or aa.shape[1] != 2 or aa.shape[0] < 1 or not np.all(np.isfinite(aa)):
+        raise InputError("a", aa.tolist(), "finite edge normals of shape (E, 2), E >= 1")
+    if bb.shape != (aa.shape[0],) or not np.all(np.isfinite(bb)):
+        raise InputError("b", bb.tolist(), f"finite offsets of shape ({aa.shape[0]},)")
+    return aa, bb
+
+
+def _clarabel_in_polygon(
+    p: FloatArray, q: FloatArray, a: FloatArray, b: FloatArray, n_u: int
+) -> Any:
+    """Clarabel's solution of ``min 1/2 z^T P z + q^T z`` over ``z = [v (n_u); d (2)]`` with
+    ``a d <= b`` and ``||v_j|| <= 1`` per 2-D block (eq. 5.19e in the scaled torques)."""
+    import clarabel
+    from scipy import sparse
+
+    n = n_u + 2
+    rows = [np.hstack([np.zeros((a.shape[0], n_u)), a])]
+    rhs = [b]
+    for j in range(n_u // 2):  # (1, v_j) in the second-order cone
+        blk = np.zeros((3, n))
+        blk[1, 2 * j] = blk[2, 2 * j + 1] = -1.0
+        rows.append(blk)
+        rhs.append(np.array([1.0, 0.0, 0.0]))
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    # the torques are nearly free along some directions (R is small): solve to the
+    # accuracy of the Newton backend, not Clarabel's default 1e-8 relative gap
+    settings.tol_gap_abs = settings.tol_gap_rel = POLYGON_GAP_TOL
+    settings.tol_feas = POLYGON_GAP_TOL
+    cones = [clarabel.NonnegativeConeT(a.shape[0])]
+    cones += [clarabel.SecondOrderConeT(3)] * (n_u // 2)
+    return clarabel.DefaultSolver(
+        sparse.triu(sparse.csc_matrix(p), format="csc"),
+        q,
+        sparse.csc_matrix(np.vstack(rows)),
+        np.concatenate(rhs),
+        cones,
+        settings,
+    ).solve()
 
 
 class MPC:
@@ -713,12 +790,7 @@ class MPC:
             The :class:`MPCSolution`. If the constrained solve fails (e.g. an empty polygon), the
             unconstrained solution with a ``message`` saying why.
         """
-        aa = np.asarray(a, dtype=float)
-        bb = np.asarray(b, dtype=float)
-        if aa.ndim != 2 or aa.shape[1] != 2 or aa.shape[0] < 1 or not np.all(np.isfinite(aa)):
-            raise InputError("a", aa.tolist(), "finite edge normals of shape (E, 2), E >= 1")
-        if bb.shape != (aa.shape[0],) or not np.all(np.isfinite(bb)):
-            raise InputError("b", bb.tolist(), f"finite offsets of shape ({aa.shape[0]},)")
+        aa, bb = _check_polygon(a, b)
         sol = self.solve(k_s, x_measured, p_stance, p_next_ref, x_next_ref)
         if sol.fallback or np.all(aa @ sol.next_footstep[:2] <= bb + POLYGON_TOL):
             return sol
@@ -736,33 +808,7 @@ class MPC:
         p = scale[:, None] * mdl.H[k_s] * scale[None, :]
         q = scale * (mdl.F[k_s] @ theta)
         try:
-            import clarabel
-            from scipy import sparse
-
-            n = n_u + 2
-            rows = [np.hstack([np.zeros((aa.shape[0], n_u)), aa])]  # a d <= b - a p_i
-            rhs = [bb - aa @ ps[:2]]
-            for j in range(n_u // 2):  # (1, v_j) in the second-order cone
-                blk = np.zeros((3, n))
-                blk[1, 2 * j] = blk[2, 2 * j + 1] = -1.0
-                rows.append(blk)
-                rhs.append(np.array([1.0, 0.0, 0.0]))
-            settings = clarabel.DefaultSettings()
-            settings.verbose = False
-            # the torques are nearly free along some directions (R is small): solve to the
-            # accuracy of the Newton backend, not Clarabel's default 1e-8 relative gap
-            settings.tol_gap_abs = settings.tol_gap_rel = POLYGON_GAP_TOL
-            settings.tol_feas = POLYGON_GAP_TOL
-            cones = [clarabel.NonnegativeConeT(aa.shape[0])]
-            cones += [clarabel.SecondOrderConeT(3)] * (n_u // 2)
-            res = clarabel.DefaultSolver(
-                sparse.triu(sparse.csc_matrix(p), format="csc"),
-                q,
-                sparse.csc_matrix(np.vstack(rows)),
-                np.concatenate(rhs),
-                cones,
-                settings,
-            ).solve()
+            res = _clarabel_in_polygon(p, q, aa, bb - aa @ ps[:2], n_u)
         except (ValueError, RuntimeError) as exc:  # pragma: no cover - solver internals
             return replace(sol, message=f"footstep polygon solve failed: {exc}")
         if str(res.status) not in ("Solved", "AlmostSolved"):

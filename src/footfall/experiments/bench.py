@@ -7,6 +7,9 @@ Instances are seeded random stepping-stone scenes (:func:`random_stepping_stones
 built-in scenes, for every requested number of steps N and ALIP nodes K. The machine may be shared,
 so the table reports the speed-up as a ratio of times measured in the same run; when the direct
 model hits its time limit the ratio is a lower bound (printed ``>=``).
+
+``footfall bench quadruped``: the document-001 slope walk's closed loop against bare ``mj_step``,
+and the gait plan's time (:func:`benchmark_quadruped`).
 """
 
 from __future__ import annotations
@@ -18,6 +21,8 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from footfall.models.biped import BipedParams
 from footfall.planning.check import check_plan
@@ -401,7 +406,6 @@ def bench_sim(
     Returns:
         One :class:`SimSpeed` per (K, engine), engines in :data:`SIM_ENGINES` order.
     """
-    import numpy as np
 
     from footfall.errors import InputError
     from footfall.sim import simulate
@@ -480,3 +484,79 @@ def sim_speed_to_dict(rows: Sequence[SimSpeed]) -> list[dict[str, Any]]:
         {**dataclasses.asdict(r), "realtime": r.realtime, "realtime_best": r.realtime_best}
         for r in rows
     ]
+
+
+def benchmark_quadruped(
+    slope_deg: float = 15.0,
+    body_deg: float = 10.0,
+    sim_cycles: int = 6,
+    plan_cycles: int = 10,
+    plan_repeats: int = 20,
+) -> dict[str, Any]:
+    """Speed of the slope walk (issue goals: >= 5x real time; 10-cycle plan < 50 ms).
+
+    Measures, in one run on the current core:
+
+    * the closed-loop simulation (control, contact forces, CoP, margins, slip; no video) as
+      simulated seconds per wall second, against a baseline of bare ``mj_step`` calls on the same
+      model for the same simulated time (so ``overhead_ratio`` is what footfall's loop costs on
+      top of the physics);
+    * the gait plan of ``plan_cycles`` cycles (``plan_gait``) and its dense sampling at 100 Hz
+      with joint angles and eq.-(5) ZMP (``GaitPlan.sample``), median of ``plan_repeats``.
+
+    Returns:
+        A JSON-ready dict of timings and ratios.
+    """
+    import mujoco
+
+    from footfall.quadruped import GaitParams, QuadrupedRobot, plan_gait
+    from footfall.sim.quadruped.sim import QuadrupedSim, simulate
+
+    robot = QuadrupedRobot()
+    slope, pitch = math.radians(slope_deg), math.radians(body_deg)
+    plan = plan_gait(robot, GaitParams(slope, pitch, cycles=sim_cycles))
+    res = simulate(plan)
+    loop_rtf = res.sim_time / res.wall_time
+
+    base = QuadrupedSim(robot, slope)
+    ref = plan.sample(0.01, with_zmp=False)
+    base.set_pose(ref.body_pos[0], ref.body_pitch, ref.joints[0])
+    steps = round(res.sim_time / base.model.opt.timestep)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        mujoco.mj_step(base.model, base.data)
+    base_wall = time.perf_counter() - t0
+    base_rtf = res.sim_time / base_wall
+
+    params = GaitParams(slope, pitch, cycles=plan_cycles)
+    plan_gait(robot, params).sample(0.01)  # warm-up (imports, caches)
+    plan_times, sample_times = [], []
+    for _ in range(plan_repeats):
+        t0 = time.perf_counter()
+        p = plan_gait(robot, params)
+        t1 = time.perf_counter()
+        p.sample(0.01)
+        plan_times.append(t1 - t0)
+        sample_times.append(time.perf_counter() - t1)
+    plan_ms = 1e3 * float(np.median(plan_times))
+    sample_ms = 1e3 * float(np.median(sample_times))
+    return {
+        "slope_deg": slope_deg,
+        "body_deg": body_deg,
+        "sim_cycles": sim_cycles,
+        "simulated_s": res.sim_time,
+        "loop_wall_s": res.wall_time,
+        "loop_realtime_factor": loop_rtf,
+        "baseline_mj_step_realtime_factor": base_rtf,
+        "overhead_ratio": base_rtf / loop_rtf,
+        "realtime_goal": 5.0,
+        "realtime_vs_goal": loop_rtf / 5.0,
+        "fell": res.metrics.fell,
+        "plan_cycles": plan_cycles,
+        "plan_ms_median": plan_ms,
+        "sample_100hz_ms_median": sample_ms,
+        "plan_plus_sample_ms_median": plan_ms + sample_ms,
+        "plan_goal_ms": 50.0,
+        "plan_goal_over_plan_ms": 50.0 / plan_ms,
+        "plan_goal_over_plan_plus_sample_ms": 50.0 / (plan_ms + sample_ms),
+    }

@@ -116,14 +116,14 @@ def _quadruped(out: Path, lines: list[str]) -> dict[str, Any]:
     folder.mkdir(parents=True, exist_ok=True)
     qp.plot_stability(plan, res, folder / "stability.png")
     qp.plot_foot_path(plan, res, folder / "fig10_lf_foot_path.png")
-    write_json(folder / "quadruped.json", dict(res.metrics))
+    write_json(folder / "quadruped.json", res.metrics.to_dict())
     m = res.metrics
     lines.append(
-        f"quadruped 15 deg slope, 2 cycles: fell {m['fell']}, "
-        f"min stability margin {m['stability_margin_min_m']:.3f} m, "
-        f"{m['distance_up_slope_m']:.2f} m up the slope"
+        f"quadruped 15 deg slope, 2 cycles: fell {m.fell}, "
+        f"min stability margin {m.stability_margin_min_m:.3f} m, "
+        f"{m.distance_up_slope_m:.2f} m up the slope"
     )
-    return dict(m)
+    return m.to_dict()
 
 
 def run_demo(out: Path, progress: Callable[[str], None] | None = None) -> dict[str, Any]:

@@ -394,35 +394,60 @@ def _num(v: float) -> float | None:
     return float(v) if math.isfinite(v) else None
 
 
-def _plan_from_dict(data: object, robot: BipedParams, source: str) -> FootstepPlan:
-    """See :meth:`FootstepPlan.from_dict`."""
+class _Reader:
+    """Typed reads from a plan dict; errors name the field under ``source``."""
 
-    def bad(fld: str, value: object, expected: str) -> InputError:
-        return InputError(f"{source}.{fld}", value, expected)
+    def __init__(self, source: str) -> None:
+        self.source = source
 
-    def get(d: object, key: str, where: str) -> Any:
+    def bad(self, fld: str, value: object, expected: str) -> InputError:
+        return InputError(f"{self.source}.{fld}", value, expected)
+
+    def get(self, d: object, key: str, where: str) -> Any:
         if not isinstance(d, dict) or key not in d:
-            raise bad(where, d if not isinstance(d, dict) else sorted(d), f"an object with {key!r}")
+            raise self.bad(
+                where, d if not isinstance(d, dict) else sorted(d), f"an object with {key!r}"
+            )
         return d[key]
 
-    def array(value: object, fld: str, shape: tuple[int, ...], nan_ok: bool = False) -> FloatArray:
+    def array(
+        self, value: object, fld: str, shape: tuple[int, ...], nan_ok: bool = False
+    ) -> FloatArray:
         try:
             arr = np.array(value, dtype=float)
         except (TypeError, ValueError):
-            raise bad(fld, value, f"numbers of shape {shape}") from None
+            raise self.bad(fld, value, f"numbers of shape {shape}") from None
         if arr.shape != shape:
-            raise bad(fld, value, f"numbers of shape {shape}, got {arr.shape}")
+            raise self.bad(fld, value, f"numbers of shape {shape}, got {arr.shape}")
         if not nan_ok and not np.all(np.isfinite(arr)):
-            raise bad(fld, value, "finite numbers")
+            raise self.bad(fld, value, "finite numbers")
         return arr
 
-    def number(value: object, fld: str, default: float) -> float:
+    def number(self, value: object, fld: str, default: float) -> float:
         if value is None:
             return default
         if isinstance(value, bool) or not isinstance(value, int | float):
-            raise bad(fld, value, "a number or null")
+            raise self.bad(fld, value, "a number or null")
         return float(value)
 
+    def sides(self, steps: list[Any]) -> list[Side]:
+        """The side of every footstep, checking that each also names its region."""
+        sides = []
+        for i, st in enumerate(steps):
+            try:
+                sides.append(Side(self.get(st, "side", f"footsteps[{i}]")))
+            except ValueError:
+                raise self.bad(f"footsteps[{i}].side", st["side"], "'left' or 'right'") from None
+            region = self.get(st, "region", f"footsteps[{i}]")
+            if not isinstance(region, str):
+                raise self.bad(f"footsteps[{i}].region", region, "a region name")
+        return sides
+
+
+def _plan_from_dict(data: object, robot: BipedParams, source: str) -> FootstepPlan:
+    """See :meth:`FootstepPlan.from_dict`."""
+    r = _Reader(source)
+    bad, get, array, number = r.bad, r.get, r.array, r.number
     try:
         status = SolveStatus(get(data, "status", "status"))
     except ValueError:
@@ -434,15 +459,7 @@ def _plan_from_dict(data: object, robot: BipedParams, source: str) -> FootstepPl
     if n < 0:
         return _empty_from_dict(data, status, robot)
     k = robot.n_nodes
-    sides = []
-    for i, st in enumerate(steps):
-        try:
-            sides.append(Side(get(st, "side", f"footsteps[{i}]")))
-        except ValueError:
-            raise bad(f"footsteps[{i}].side", st["side"], "'left' or 'right'") from None
-        region = get(st, "region", f"footsteps[{i}]")
-        if not isinstance(region, str):
-            raise bad(f"footsteps[{i}].region", region, "a region name")
+    sides = r.sides(steps)
     alip = get(data, "alip", "alip")
     planner = get(data, "planner", "planner")
     if planner not in PLANNERS:

@@ -49,6 +49,10 @@ class PhaseKind(str, Enum):
     HOLD = "hold"  # four feet down, body still (end of the walk)
 
 
+#: most gait cycles of one plan (the plan and its simulation grow linearly with them)
+MAX_CYCLES = 1000
+
+
 @dataclass(frozen=True)
 class GaitParams:
     """Inputs of the gait sequencer.
@@ -85,8 +89,9 @@ class GaitParams:
         object.__setattr__(self, "swing_period", positive("swing_period", self.swing_period))
         object.__setattr__(self, "shift_period", positive("shift_period", self.shift_period))
         object.__setattr__(self, "hold_time", non_negative("hold_time", self.hold_time))
-        if isinstance(self.cycles, bool) or not isinstance(self.cycles, int) or self.cycles < 1:
-            raise InputError("cycles", self.cycles, "an integer >= 1")
+        cycles = self.cycles
+        if isinstance(cycles, bool) or not isinstance(cycles, int) or not 1 <= cycles <= MAX_CYCLES:
+            raise InputError("cycles", cycles, f"an integer in 1..{MAX_CYCLES}")
         object.__setattr__(self, "strategy", ZmpStrategy(self.strategy))
         object.__setattr__(self, "posture", BodyPosture(self.posture))
         if self.height is not None:
@@ -334,48 +339,87 @@ def _plan(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
     t = 0.0
     for cycle in range(params.cycles):
         for group in swing_groups(params.strategy):
-            tri_feet = feet.copy()
-            triangles = []
-            for leg in group:
-                stance = [i for i in range(4) if i != leg.idx]
-                triangles.append(support_polygon(tri_feet[stance]))
-                tri_feet[leg.idx] = tri_feet[leg.idx] + u * params.step
-            target, margin = zmp_target(triangles)
-            new_body = _body_for_com(robot, post, target, feet, params.step)
-            phases.append(
-                GaitPhase(
-                    PhaseKind.SHIFT,
-                    t,
-                    params.shift_period,
-                    body,
-                    new_body,
-                    feet.copy(),
-                    zmp_target=target,
-                    target_margin=margin,
-                    cycle=cycle,
-                )
+            body, t = _shift_and_swing(robot, post, params, group, cycle, feet, body, t, phases)
+    _centre_and_hold(robot, post, params, feet, body, t, phases)
+    plan = GaitPlan(robot, params, post, tuple(phases))
+    _check_plan_reach(plan)
+    return plan
+
+
+def _shift_and_swing(
+    robot: QuadrupedRobot,
+    post: SlopePosture,
+    params: GaitParams,
+    group: tuple[Leg, ...],
+    cycle: int,
+    feet: FloatArray,
+    body: FloatArray,
+    t: float,
+    phases: list[GaitPhase],
+) -> tuple[FloatArray, float]:
+    """Append one body shift to the ZMP target of the support triangles of ``group`` (sec. 3),
+    then the swing of each leg of the group (one step along the slope) to ``phases``.
+
+    ``feet`` (4, 3) [m] is updated to the landed feet. Returns the body position [m] after the
+    shift and the time [s] after the last swing.
+    """
+    u = post.slope_direction
+    tri_feet = feet.copy()
+    triangles = []
+    for leg in group:
+        stance = [i for i in range(4) if i != leg.idx]
+        triangles.append(support_polygon(tri_feet[stance]))
+        tri_feet[leg.idx] = tri_feet[leg.idx] + u * params.step
+    target, margin = zmp_target(triangles)
+    new_body = _body_for_com(robot, post, target, feet, params.step)
+    phases.append(
+        GaitPhase(
+            PhaseKind.SHIFT,
+            t,
+            params.shift_period,
+            body,
+            new_body,
+            feet.copy(),
+            zmp_target=target,
+            target_margin=margin,
+            cycle=cycle,
+        )
+    )
+    t += params.shift_period
+    body = new_body
+    for leg in group:
+        land = feet[leg.idx] + u * params.step
+        phases.append(
+            GaitPhase(
+                PhaseKind.SWING,
+                t,
+                params.swing_period,
+                body,
+                body,
+                feet.copy(),
+                leg=leg,
+                foot_end=land,
+                zmp_target=target,
+                target_margin=margin,
+                cycle=cycle,
             )
-            t += params.shift_period
-            body = new_body
-            for leg in group:
-                land = feet[leg.idx] + u * params.step
-                phases.append(
-                    GaitPhase(
-                        PhaseKind.SWING,
-                        t,
-                        params.swing_period,
-                        body,
-                        body,
-                        feet.copy(),
-                        leg=leg,
-                        foot_end=land,
-                        zmp_target=target,
-                        target_margin=margin,
-                        cycle=cycle,
-                    )
-                )
-                t += params.swing_period
-                feet[leg.idx] = land
+        )
+        t += params.swing_period
+        feet[leg.idx] = land
+    return body, t
+
+
+def _centre_and_hold(
+    robot: QuadrupedRobot,
+    post: SlopePosture,
+    params: GaitParams,
+    feet: FloatArray,
+    body: FloatArray,
+    t: float,
+    phases: list[GaitPhase],
+) -> None:
+    """Append the final shift of the CoM over the centre of the four feet, and the standing hold
+    (when ``params.hold_time`` > 0), to ``phases``."""
     centre = feet[:, :2].mean(axis=0)
     final = _body_for_com(robot, post, centre, feet, params.step)
     phases.append(
@@ -403,9 +447,6 @@ def _plan(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
                 cycle=params.cycles - 1,
             )
         )
-    plan = GaitPlan(robot, params, post, tuple(phases))
-    _check_plan_reach(plan)
-    return plan
 
 
 def _check_plan_reach(plan: GaitPlan) -> None:

@@ -602,6 +602,64 @@ def _sample_reach(
     raise InputError("robot.reach", verts.tolist(), f"room for steps >= {forward_min} m forward")
 
 
+def _check_stones(
+    seed: object, n_regions: object, robot: BipedParams | None, max_turn: float, max_rise: float
+) -> BipedParams:
+    """Checked arguments of :func:`random_stepping_stones`; the robot (default ``BipedParams()``)."""
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
+        raise InputError("seed", seed, "an integer")
+    if isinstance(n_regions, bool) or not isinstance(n_regions, int | np.integer) or n_regions < 2:
+        raise InputError("n_regions", n_regions, "an integer >= 2 (start pad + goal pad + stones)")
+    robot = BipedParams() if robot is None else robot
+    if not 0.0 <= max_turn <= robot.theta_max:
+        raise InputError(
+            "max_turn", max_turn, f"an angle in [0, theta_max = {robot.theta_max:.3f}]"
+        )
+    if not 0.0 <= max_rise <= robot.step_height_max:
+        raise InputError("max_rise", max_rise, f"a height in [0, {robot.step_height_max}] m")
+    return robot
+
+
+def _place_region(
+    rng: np.random.Generator,
+    robot: BipedParams,
+    regions: list[Region],
+    point: FloatArray,
+    side: Side,
+    psi: float,
+    last: bool,
+    stone_length: tuple[float, float],
+    stone_width: tuple[float, float],
+    max_turn: float,
+    forward_min: float,
+    margin: float,
+    min_gap: float,
+) -> tuple[FloatArray, float, FloatArray, FloatArray] | None:
+    """The next region of :func:`random_stepping_stones` after the stone reached at ``point``
+    with heading ``psi``: a step drawn in the reach trapezoid of ``side`` (eq. 5.12f), a stone
+    (or the goal pad when ``last``) around it, resampled until ``min_gap`` from ``regions``.
+
+    Returns:
+        ``(reached centre (2,), heading, polygon, goal pad centre (2,))`` or None after 2000 tries.
+    """
+    for _ in range(2_000):
+        q = _sample_reach(rng, robot.reach, side, forward_min, margin)
+        new_psi = psi + float(rng.uniform(-max_turn, max_turn))
+        centre = point + rot2(psi) @ q  # reach is in the stance foot's frame (eq. 5.12f)
+        pad_centre = centre
+        if last:
+            # Goal pad: big enough for both feet, the reached point 0.2 m behind its centre.
+            pad_centre = centre + rot2(new_psi) @ np.array([0.2, 0.0])
+            poly = _rect(pad_centre, 0.6, 0.7, new_psi)
+        else:
+            length = float(rng.uniform(*stone_length))
+            width = float(rng.uniform(*stone_width))
+            poly = _rect(centre, length, width, new_psi)
+        if all(polygon_distance(poly, r.vertices) >= min_gap for r in regions):
+            return centre, new_psi, poly, pad_centre
+    return None
+
+
 def random_stepping_stones(
     seed: int,
     n_regions: int = 8,
@@ -636,17 +694,7 @@ def random_stepping_stones(
         forward_min: smallest forward component of a step [m] (keeps the chain moving on).
         margin: distance of the sampled step from the trapezoid edges [m].
     """
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
-        raise InputError("seed", seed, "an integer")
-    if isinstance(n_regions, bool) or not isinstance(n_regions, int | np.integer) or n_regions < 2:
-        raise InputError("n_regions", n_regions, "an integer >= 2 (start pad + goal pad + stones)")
-    robot = BipedParams() if robot is None else robot
-    if not 0.0 <= max_turn <= robot.theta_max:
-        raise InputError(
-            "max_turn", max_turn, f"an angle in [0, theta_max = {robot.theta_max:.3f}]"
-        )
-    if not 0.0 <= max_rise <= robot.step_height_max:
-        raise InputError("max_rise", max_rise, f"a height in [0, {robot.step_height_max}] m")
+    robot = _check_stones(seed, n_regions, robot, max_turn, max_rise)
     rng = np.random.default_rng(int(seed))
     half_w = robot.stance_width / 2
     left, right = np.array([0.0, half_w, 0.0]), np.array([0.0, -half_w, 0.0])
@@ -656,26 +704,17 @@ def random_stepping_stones(
     goal: Goal | None = None
     for k in range(int(n_regions) - 1):
         last = k == int(n_regions) - 2
-        for _ in range(2_000):
-            q = _sample_reach(rng, robot.reach, side, forward_min, margin)
-            new_psi = psi + float(rng.uniform(-max_turn, max_turn))
-            centre = point + rot2(psi) @ q  # reach is in the stance foot's frame (eq. 5.12f)
-            if last:
-                # Goal pad: big enough for both feet, the reached point 0.2 m behind its centre.
-                pad_centre = centre + rot2(new_psi) @ np.array([0.2, 0.0])
-                poly = _rect(pad_centre, 0.6, 0.7, new_psi)
-            else:
-                length = float(rng.uniform(*stone_length))
-                width = float(rng.uniform(*stone_width))
-                poly = _rect(centre, length, width, new_psi)
-            if all(polygon_distance(poly, r.vertices) >= min_gap for r in regions):
-                break
-        else:
+        placed = _place_region(
+            rng, robot, regions, point, side, psi, last, stone_length, stone_width,
+            max_turn, forward_min, margin, min_gap,
+        )  # fmt: skip
+        if placed is None:
             raise InputError(
                 "n_regions",
                 n_regions,
                 f"fewer regions (no room for region {k + 1} after 2000 tries)",
             )
+        centre, new_psi, poly, pad_centre = placed
         z = z + float(rng.uniform(-max_rise, max_rise))
         if last:
             regions.append(Region.from_height("goal", z, poly))

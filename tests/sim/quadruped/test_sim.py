@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -95,22 +96,22 @@ def walk():
 def test_two_cycles_up_15_degrees_without_falling(walk) -> None:
     _plan, res = walk
     m = res.metrics
-    assert not m["fell"]
+    assert not m.fell
     # every stance sample had three or more loaded feet and a CoP inside their polygon
-    assert m["stance_samples_with_fewer_than_3_contacts"] == 0
-    assert m["stability_margin_min_m"] > 0.0
+    assert m.stance_samples_with_fewer_than_3_contacts == 0
+    assert m.stability_margin_min_m > 0.0
     # it climbs: at least 80 % of the planned distance (2 cycles x 0.4 m along the slope)
-    assert m["distance_up_slope_m"] > 0.8 * m["planned_distance_up_slope_m"]
-    assert m["planned_distance_up_slope_m"] > 0.7
+    assert m.distance_up_slope_m > 0.8 * m.planned_distance_up_slope_m
+    assert m.planned_distance_up_slope_m > 0.7
     # it rose by the slope's share of that distance
     rise = res.trunk_pos[-1, 2] - res.trunk_pos[0, 2]
-    assert rise == pytest.approx(m["distance_up_slope_m"] * math.sin(SLOPE), abs=0.03)
+    assert rise == pytest.approx(m.distance_up_slope_m * math.sin(SLOPE), abs=0.03)
 
 
 def test_measured_cop_follows_the_planned_zmp(walk) -> None:
     _, res = walk
     # within the OSP's inradius on average: the plan is what the robot does
-    assert res.metrics["zmp_error_mean_m"] < 0.08
+    assert res.metrics.zmp_error_mean_m < 0.08
 
 
 def test_stairs_scene_compiles_with_steps() -> None:
@@ -157,3 +158,13 @@ def test_cli_writes_metrics_figures_and_video(tmp_path: Path) -> None:
     if data["video"] is None:
         pytest.skip(f"no GL backend: {data['video_note']}")
     assert (tmp_path / "quadruped.mp4").stat().st_size > 10_000
+
+
+def test_metrics_dict_has_one_key_per_field_and_nested_sway(walk) -> None:
+    _, res = walk
+    d = res.metrics.to_dict()
+    assert list(d) == [f.name for f in dataclasses.fields(res.metrics)]
+    assert d["body_sway_measured"]["path_per_cycle_m"] == pytest.approx(
+        res.metrics.body_sway_measured.path_per_cycle_m
+    )
+    json.dumps(d)  # JSON-ready

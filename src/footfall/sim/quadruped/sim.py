@@ -13,9 +13,9 @@ import itertools
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -37,6 +37,131 @@ FALL_HEIGHT_FRACTION = 0.5
 FALL_TILT = math.radians(30.0)
 #: video frame rate [1/s]
 VIDEO_FPS = 30
+
+
+@dataclass(frozen=True)
+class BodySway:
+    """Body sway per gait cycle, averaged over the cycles (see :func:`body_sway`)."""
+
+    path_per_cycle_m: float
+    """Horizontal path length of the body centre per cycle [m]."""
+    lateral_path_per_cycle_m: float
+    """Lateral (y) path length of the body centre per cycle [m]."""
+    excess_path_per_cycle_m: float
+    """Path length minus net horizontal displacement per cycle: motion spent swaying [m]."""
+    shifts_per_cycle: float
+    """Body shifts per gait cycle (the final centring shift excluded)."""
+
+
+@dataclass(frozen=True)
+class QuadrupedMetrics:
+    """Summary of one simulated walk; measured in MuJoCo unless the name says ``planned``.
+
+    ``None`` marks a measure with no sample to average (for example no stance sample with three
+    loaded feet before a fall).
+    """
+
+    slope_deg: float
+    """Slope angle beta_S [deg]."""
+    body_deg: float
+    """Planned body angle beta_B to the horizontal [deg]."""
+    strategy: str
+    """ZMP placement strategy (:class:`~footfall.quadruped.gait.ZmpStrategy` value)."""
+    step_m: float
+    """Planned step length S along the slope [m]."""
+    swing_height_m: float
+    """Planned swing height H normal to the slope [m]."""
+    swing_period_s: float
+    """Planned swing period T_w [s]."""
+    shift_period_s: float
+    """Planned duration of each body shift [s]."""
+    cycles: int
+    """Number of gait cycles."""
+    gait_duration_s: float
+    """Duration of the gait, settling excluded [s]."""
+    distance_up_slope_m: float
+    """Trunk displacement along the slope direction [m]."""
+    planned_distance_up_slope_m: float
+    """Planned body displacement along the slope direction [m]."""
+    mean_speed_m_s: float
+    """Distance up the slope over gait duration [m/s] (NaN for a zero duration)."""
+    fell: bool
+    """Whether the trunk touched the ground, tilted past FALL_TILT or dropped too low."""
+    fall_time_s: float | None
+    """Gait time of the first fall sample [s], None when it did not fall."""
+    stability_margin_min_m: float | None
+    """Smallest measured stability margin over planned-stance samples with >= 3 contacts [m]."""
+    stability_margin_mean_m: float | None
+    """Mean measured stability margin over the same samples [m]."""
+    stability_margin_min_three_leg_m: float | None
+    """Smallest measured margin over samples with exactly three planned contacts [m]."""
+    stability_margin_mean_three_leg_m: float | None
+    """Mean measured margin over samples with exactly three planned contacts [m]."""
+    planned_margin_min_m: float
+    """Smallest planned stability margin [m]."""
+    planned_margin_min_three_leg_m: float
+    """Smallest planned margin with exactly three planned contacts [m]."""
+    stance_samples: int
+    """Number of samples where the plan has three or more feet down."""
+    stance_samples_with_fewer_than_3_contacts: int
+    """Planned-stance samples with fewer than three loaded feet measured."""
+    zmp_error_mean_m: float | None
+    """Mean distance of the measured CoP from the planned ZMP (eq. 5) [m]."""
+    zmp_error_max_m: float | None
+    """Largest distance of the measured CoP from the planned ZMP [m]."""
+    foot_slip_max_m: float
+    """Largest sliding displacement of a foot over one planned stance [m]."""
+    foot_slip_mean_m: float
+    """Mean sliding displacement of a foot over one planned stance [m]."""
+    foot_backward_slip_total_m: float
+    """Total sliding of the feet down the slope, summed over stances [m]."""
+    trunk_drift_from_plan_m: float
+    """Distance of the final trunk position from the planned final body position [m]."""
+    body_sway_measured: BodySway
+    """Sway of the measured trunk."""
+    body_sway_planned: BodySway
+    """Sway of the planned body."""
+    sim_time_s: float
+    """Simulated time, settling included [s]."""
+    wall_time_s: float
+    """Wall-clock time of the physics and control loop, video excluded [s]."""
+    realtime_factor: float
+    """Simulated seconds per wall-clock second."""
+    video: str | None
+    """Path of the MP4, None when no video was written."""
+    video_note: str
+    """Why there is no video, if there is none."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict with one key per field (the sways as nested dicts)."""
+        return asdict(self)
+
+
+class Measured(Protocol):
+    """What :func:`summarise` reads of a simulated walk (a :class:`SimResult` has it all)."""
+
+    @property
+    def t(self) -> FloatArray: ...
+    @property
+    def trunk_pos(self) -> FloatArray: ...
+    @property
+    def cop(self) -> FloatArray: ...
+    @property
+    def margin(self) -> FloatArray: ...
+    @property
+    def n_contacts(self) -> NDArray[np.int_]: ...
+    @property
+    def slip_vel(self) -> FloatArray: ...
+    @property
+    def planned(self) -> GaitTrajectory: ...
+    @property
+    def wall_time(self) -> float: ...
+    @property
+    def sim_time(self) -> float: ...
+    @property
+    def video(self) -> Path | None: ...
+    @property
+    def video_note(self) -> str: ...
 
 
 @dataclass(frozen=True)
@@ -71,7 +196,7 @@ class SimResult:
     feet: FloatArray
     slip_vel: FloatArray
     planned: GaitTrajectory
-    metrics: dict[str, Any] = field(default_factory=dict)
+    metrics: QuadrupedMetrics
     wall_time: float = 0.0
     sim_time: float = 0.0
     video: Path | None = None
@@ -198,6 +323,122 @@ def _make_renderer(sim: QuadrupedSim, width: int, height: int) -> tuple[Any, str
     return renderer, ""
 
 
+class _Video:
+    """Offscreen MP4 of the tracking camera; a no-op when there is no path or no GL backend."""
+
+    def __init__(self, sim: QuadrupedSim, path: Path | None, size: tuple[int, int]) -> None:
+        self.renderer: Any = None
+        self.writer: Any = None
+        self.note = ""
+        self.path = path
+        #: wall time spent rendering, subtracted from the loop's wall time [s]
+        self.render_time = 0.0
+        if path is None:
+            return
+        self.renderer, self.note = _make_renderer(sim, *size)
+        if self.renderer is not None:
+            import imageio.v2 as imageio
+
+            path.parent.mkdir(parents=True, exist_ok=True)
+            self.writer = imageio.get_writer(str(path), fps=VIDEO_FPS, macro_block_size=8)
+
+    def frame(self, data: Any) -> None:
+        """Append the current scene as a frame."""
+        if self.writer is None:
+            return
+        r0 = time.perf_counter()
+        self.renderer.update_scene(data, camera=nm.TRACK_CAMERA)
+        self.writer.append_data(self.renderer.render())
+        self.render_time += time.perf_counter() - r0
+
+    def close(self) -> Path | None:
+        """Finish the file; its path, or None when none was written."""
+        if self.writer is not None:
+            self.writer.close()
+        if self.renderer is not None:
+            self.renderer.close()
+        return self.path if self.writer is not None else None
+
+
+class _Recorder:
+    """Measured arrays of one walk, filled one control sample at a time (a :class:`Measured`)."""
+
+    def __init__(self, sim: QuadrupedSim, plan: GaitPlan, ref: GaitTrajectory) -> None:
+        self.sim = sim
+        self.plan = plan
+        self.planned = ref
+        self.t = ref.t
+        n = ref.t.shape[0]
+        self.trunk_pos = np.empty((n, 3))
+        self.trunk_pitch = np.empty(n)
+        self.cop = np.full((n, 2), np.nan)
+        self.margin = np.full(n, np.nan)
+        self.n_contacts = np.zeros(n, dtype=int)
+        self.feet = np.empty((n, 4, 3))
+        self.slip_vel = np.zeros((n, 4, 3))
+        #: gait time of the first fall sample [s], NaN while standing
+        self.fallen_at = math.nan
+        self.weight = plan.robot.total_mass * float(-sim.model.opt.gravity[2])
+        self.wall_time = 0.0
+        self.sim_time = 0.0
+        self.video: Path | None = None
+        self.video_note = ""
+
+    def measure(self, k: int) -> None:
+        """Record sample ``k``: trunk, feet, loaded contacts, CoP, margin, slip; detect a fall."""
+        sim, d = self.sim, self.sim.data
+        self.trunk_pos[k] = d.xpos[sim.trunk]
+        self.trunk_pitch[k] = _pitch_of(d.xmat[sim.trunk])
+        self.feet[k] = d.site_xpos[sim.foot_sites]
+        pts, frc, idx, trunk_hit = sim.contacts()
+        loaded = frc[:, 2] > CONTACT_FORCE_FRACTION * self.weight if frc.size else np.zeros(0, bool)
+        self.n_contacts[k] = np.unique(idx[loaded]).size
+        if loaded.any():
+            z_p = float(pts[loaded, 2].mean())
+            self.cop[k], _ = centre_of_pressure(pts[loaded], frc[loaded], z_p)
+            # each foot touches at one point (sphere on plane), so the feet's points span it
+            self.margin[k] = stability_margin(self.cop[k], support_polygon(pts[loaded]))
+        normal = self.plan.posture.slope_normal
+        for j in range(idx.size):
+            self.slip_vel[k, idx[j]] = sim.contact_slip_velocity(idx[j], pts[j], normal)
+        if math.isnan(self.fallen_at) and (trunk_hit or self._fallen(k)):
+            self.fallen_at = float(self.t[k])
+
+    def _fallen(self, k: int) -> bool:
+        """Trunk tilted past FALL_TILT from its planned pitch, or too low above the slope."""
+        post = self.plan.posture
+        tilt = abs(self.trunk_pitch[k] - self.planned.body_pitch)
+        low = self.trunk_pos[k, 2] - post.plane_height(float(self.trunk_pos[k, 0]))
+        return bool(tilt > FALL_TILT or low < FALL_HEIGHT_FRACTION * post.height)
+
+
+def _track(
+    sim: QuadrupedSim,
+    rec: _Recorder,
+    video: _Video,
+    control_dt: float,
+    progress: Callable[[float], None] | None,
+) -> None:
+    """Track the planned joint angles sample by sample, measuring after each control period."""
+    m, d, mj = sim.model, sim.data, sim.mujoco
+    joints = rec.planned.joints
+    substeps = max(1, round(control_dt / m.opt.timestep))
+    frame_every = max(1, round(1.0 / (VIDEO_FPS * control_dt)))
+    n = joints.shape[0]
+    for k in range(n):
+        q0 = joints[k]
+        q1 = joints[min(k + 1, n - 1)]
+        # joint targets interpolated linearly between plan samples at every physics step
+        for s in range(substeps):
+            d.ctrl[sim.actuators] = q0 + (q1 - q0) * (s / substeps)
+            mj.mj_step(m, d)
+        rec.measure(k)
+        if k % frame_every == 0:
+            video.frame(d)
+        if progress is not None and k % 200 == 0:
+            progress(k / n)
+
+
 def simulate(
     plan: GaitPlan,
     settings: SimSettings | None = None,
@@ -224,99 +465,39 @@ def simulate(
     """
     control_dt = positive("control_dt", control_dt)
     sim = QuadrupedSim(plan.robot, plan.posture.slope, settings)
-    m, d = sim.model, sim.data
-    mj = sim.mujoco
     ref = plan.sample(control_dt)
     sim.set_pose(ref.body_pos[0], ref.body_pitch, ref.joints[0])
-    substeps = max(1, round(control_dt / m.opt.timestep))
-
-    renderer: Any = None
-    note = ""
-    writer = None
-    if video_path is not None:
-        renderer, note = _make_renderer(sim, *video_size)
-        if renderer is not None:
-            import imageio.v2 as imageio
-
-            video_path.parent.mkdir(parents=True, exist_ok=True)
-            writer = imageio.get_writer(str(video_path), fps=VIDEO_FPS, macro_block_size=8)
-    frame_every = max(1, round(1.0 / (VIDEO_FPS * control_dt)))
-    render_time = 0.0
-
-    normal = plan.posture.slope_normal
-    weight = plan.robot.total_mass * float(-m.opt.gravity[2])
-    n = ref.t.shape[0]
-    trunk = np.empty((n, 3))
-    pitch = np.empty(n)
-    cop = np.full((n, 2), np.nan)
-    margin = np.full(n, np.nan)
-    ncon = np.zeros(n, dtype=int)
-    feet = np.empty((n, 4, 3))
-    slip_vel = np.zeros((n, 4, 3))
-    fallen_at = math.nan
+    video = _Video(sim, video_path, video_size)
+    rec = _Recorder(sim, plan, ref)
 
     wall0 = time.perf_counter()
     # settle in the initial pose so the legs take the weight before the gait starts
-    for _ in range(round(settle_time / m.opt.timestep)):
-        mj.mj_step(m, d)
-    for k in range(n):
-        q0 = ref.joints[k]
-        q1 = ref.joints[min(k + 1, n - 1)]
-        for s in range(substeps):
-            d.ctrl[sim.actuators] = q0 + (q1 - q0) * (s / substeps)
-            mj.mj_step(m, d)
-        trunk[k] = d.xpos[sim.trunk]
-        pitch[k] = _pitch_of(d.xmat[sim.trunk])
-        feet[k] = d.site_xpos[sim.foot_sites]
-        pts, frc, idx, trunk_hit = sim.contacts()
-        loaded = frc[:, 2] > CONTACT_FORCE_FRACTION * weight if frc.size else np.zeros(0, bool)
-        in_contact = np.unique(idx[loaded])
-        ncon[k] = in_contact.size
-        if loaded.any():
-            z_p = float(pts[loaded, 2].mean())
-            cop[k], _ = centre_of_pressure(pts[loaded], frc[loaded], z_p)
-            # each foot touches at one point (sphere on plane), so the feet's points span it
-            margin[k] = stability_margin(cop[k], support_polygon(pts[loaded]))
-        for j in range(idx.size):
-            slip_vel[k, idx[j]] = sim.contact_slip_velocity(idx[j], pts[j], normal)
-        tilt = abs(pitch[k] - ref.body_pitch)
-        low = trunk[k, 2] - plan.posture.plane_height(float(trunk[k, 0]))
-        if math.isnan(fallen_at) and (
-            trunk_hit or tilt > FALL_TILT or low < FALL_HEIGHT_FRACTION * plan.posture.height
-        ):
-            fallen_at = float(ref.t[k])
-        if writer is not None and k % frame_every == 0:
-            r0 = time.perf_counter()
-            renderer.update_scene(d, camera=nm.TRACK_CAMERA)
-            writer.append_data(renderer.render())
-            render_time += time.perf_counter() - r0
-        if progress is not None and k % 200 == 0:
-            progress(k / n)
-    wall = time.perf_counter() - wall0 - render_time
-    if writer is not None:
-        writer.close()
-    if renderer is not None:
-        renderer.close()
-    result = SimResult(
+    for _ in range(round(settle_time / sim.model.opt.timestep)):
+        sim.mujoco.mj_step(sim.model, sim.data)
+    _track(sim, rec, video, control_dt, progress)
+    rec.wall_time = time.perf_counter() - wall0 - video.render_time
+    rec.video = video.close()
+    rec.video_note = video.note
+    rec.sim_time = settle_time + float(ref.t[-1])
+    return SimResult(
         t=ref.t,
-        trunk_pos=trunk,
-        trunk_pitch=pitch,
-        cop=cop,
-        margin=margin,
-        n_contacts=ncon,
-        feet=feet,
-        slip_vel=slip_vel,
+        trunk_pos=rec.trunk_pos,
+        trunk_pitch=rec.trunk_pitch,
+        cop=rec.cop,
+        margin=rec.margin,
+        n_contacts=rec.n_contacts,
+        feet=rec.feet,
+        slip_vel=rec.slip_vel,
         planned=ref,
-        wall_time=wall,
-        sim_time=settle_time + float(ref.t[-1]),
-        video=video_path if writer is not None else None,
-        video_note=note,
+        metrics=summarise(plan, rec, rec.fallen_at),
+        wall_time=rec.wall_time,
+        sim_time=rec.sim_time,
+        video=rec.video,
+        video_note=rec.video_note,
     )
-    result.metrics.update(summarise(plan, result, fallen_at))
-    return result
 
 
-def _sway(t: FloatArray, pos: FloatArray, cycle_of: NDArray[np.int_], cycles: int) -> dict:
+def _sway(t: FloatArray, pos: FloatArray, cycle_of: NDArray[np.int_], cycles: int) -> list[float]:
     """Per-cycle body sway: horizontal path length, lateral path, excess path over net motion."""
     path, lateral, excess = [], [], []
     for c in range(cycles):
@@ -329,14 +510,10 @@ def _sway(t: FloatArray, pos: FloatArray, cycle_of: NDArray[np.int_], cycles: in
         path.append(length)
         lateral.append(float(np.abs(seg[:, 1]).sum()))
         excess.append(length - float(np.linalg.norm(p[-1] - p[0])))
-    return {
-        "path_per_cycle_m": float(np.mean(path)) if path else math.nan,
-        "lateral_path_per_cycle_m": float(np.mean(lateral)) if lateral else math.nan,
-        "excess_path_per_cycle_m": float(np.mean(excess)) if excess else math.nan,
-    }
+    return [float(np.mean(v)) if v else math.nan for v in (path, lateral, excess)]
 
 
-def body_sway(plan: GaitPlan, traj_t: FloatArray, body: FloatArray) -> dict[str, float]:
+def body_sway(plan: GaitPlan, traj_t: FloatArray, body: FloatArray) -> BodySway:
     """Body sway per gait cycle of a body trajectory sampled at ``traj_t`` (planned or measured).
 
     Three measures per cycle, averaged over cycles: horizontal path length of the body centre,
@@ -349,38 +526,26 @@ def body_sway(plan: GaitPlan, traj_t: FloatArray, body: FloatArray) -> dict[str,
     # the final centring shift and hold are not part of a gait cycle
     tail = np.array([plan.phases[i].t0 >= _last_swing_end(plan) for i in idx])
     cycle_of[tail] = -1
-    out = _sway(traj_t, body, cycle_of, plan.params.cycles)
+    path, lateral, excess = _sway(traj_t, body, cycle_of, plan.params.cycles)
     shifts = [p for p in plan.phases if p.kind is PhaseKind.SHIFT and p.t0 < _last_swing_end(plan)]
-    out["shifts_per_cycle"] = len(shifts) / plan.params.cycles
-    return out
+    return BodySway(path, lateral, excess, len(shifts) / plan.params.cycles)
 
 
 def _last_swing_end(plan: GaitPlan) -> float:
     return max(p.t1 for p in plan.phases if p.kind is PhaseKind.SWING)
 
 
-def summarise(plan: GaitPlan, res: SimResult, fallen_at: float = math.nan) -> dict[str, Any]:
-    """Metrics of a simulated walk (all from measured data unless named ``planned``)."""
-    ref = res.planned
-    post = plan.posture
-    u = post.slope_direction
-    along = res.trunk_pos @ u
-    distance = float(along[-1] - along[0])
-    duration = float(res.t[-1] - res.t[0])
-    # stance phases: the planner has >= 3 feet down; the walk gait has no other phases
-    stance = ref.contact.sum(axis=1) >= 3
-    measured_ok = stance & (res.n_contacts >= 3) & np.isfinite(res.margin)
-    three = ref.contact.sum(axis=1) == 3
-    m_all = res.margin[measured_ok]
-    m_three = res.margin[measured_ok & three]
-    err = np.linalg.norm(res.cop - ref.zmp, axis=1)
-    err_ok = err[measured_ok]
-    # foot slip: integral of the contact points' sliding velocity over each planned stance
+def _foot_slips(res: Measured, u: FloatArray) -> tuple[list[float], list[float]]:
+    """Sliding displacement of each foot over each planned stance, and its part down ``u`` [m].
+
+    The displacement is the integral of the contact point's sliding velocity over the stance.
+    """
+    contact = res.planned.contact
     dt = float(res.t[1] - res.t[0])
     slips: list[float] = []
     backward: list[float] = []
     for i in range(4):
-        c = ref.contact[:, i]
+        c = contact[:, i]
         edges = np.flatnonzero(np.diff(c.astype(int)) != 0) + 1
         bounds = np.concatenate([[0], edges, [c.size]])
         for a, b in itertools.pairwise(bounds):
@@ -389,46 +554,69 @@ def summarise(plan: GaitPlan, res: SimResult, fallen_at: float = math.nan) -> di
             disp = res.slip_vel[a:b, i].sum(axis=0) * dt
             slips.append(float(np.linalg.norm(disp)))
             backward.append(float(-min(0.0, disp @ u)))
+    return slips, backward
+
+
+def _min_mean(x: FloatArray) -> tuple[float | None, float | None]:
+    """(min, mean) of ``x``, or (None, None) when it is empty."""
+    return (float(x.min()), float(x.mean())) if x.size else (None, None)
+
+
+def summarise(plan: GaitPlan, res: Measured, fallen_at: float = math.nan) -> QuadrupedMetrics:
+    """Metrics of a simulated walk (all from measured data unless named ``planned``)."""
+    ref = res.planned
+    post = plan.posture
+    prm = plan.params
+    u = post.slope_direction
+    along = res.trunk_pos @ u
+    distance = float(along[-1] - along[0])
+    duration = float(res.t[-1] - res.t[0])
+    # stance phases: the planner has >= 3 feet down; the walk gait has no other phases
+    stance = ref.contact.sum(axis=1) >= 3
+    measured_ok = stance & (res.n_contacts >= 3) & np.isfinite(res.margin)
+    three = ref.contact.sum(axis=1) == 3
+    m_min, m_mean = _min_mean(res.margin[measured_ok])
+    m3_min, m3_mean = _min_mean(res.margin[measured_ok & three])
+    err_ok = np.linalg.norm(res.cop - ref.zmp, axis=1)[measured_ok]
+    slips, backward = _foot_slips(res, u)
     fell = not math.isnan(fallen_at)
-    sway_meas = body_sway(plan, res.t, res.trunk_pos)
-    sway_plan = body_sway(plan, ref.t, ref.body_pos)
-    return {
-        "slope_deg": math.degrees(post.slope),
-        "body_deg": math.degrees(post.body_pitch),
-        "strategy": plan.params.strategy.value,
-        "step_m": plan.params.step,
-        "swing_height_m": plan.params.swing_height,
-        "swing_period_s": plan.params.swing_period,
-        "shift_period_s": plan.params.shift_period,
-        "cycles": plan.params.cycles,
-        "gait_duration_s": duration,
-        "distance_up_slope_m": distance,
-        "planned_distance_up_slope_m": float((ref.body_pos[-1] - ref.body_pos[0]) @ u),
-        "mean_speed_m_s": distance / duration if duration > 0 else math.nan,
-        "fell": fell,
-        "fall_time_s": None if not fell else fallen_at,
-        "stability_margin_min_m": float(m_all.min()) if m_all.size else None,
-        "stability_margin_mean_m": float(m_all.mean()) if m_all.size else None,
-        "stability_margin_min_three_leg_m": float(m_three.min()) if m_three.size else None,
-        "stability_margin_mean_three_leg_m": float(m_three.mean()) if m_three.size else None,
-        "planned_margin_min_m": float(np.nanmin(ref.margin)),
-        "planned_margin_min_three_leg_m": float(np.nanmin(ref.margin[three])),
-        "stance_samples": int(stance.sum()),
-        "stance_samples_with_fewer_than_3_contacts": int((stance & (res.n_contacts < 3)).sum()),
-        "zmp_error_mean_m": float(err_ok.mean()) if err_ok.size else None,
-        "zmp_error_max_m": float(err_ok.max()) if err_ok.size else None,
-        "foot_slip_max_m": max(slips) if slips else 0.0,
-        "foot_slip_mean_m": float(np.mean(slips)) if slips else 0.0,
-        "foot_backward_slip_total_m": float(np.sum(backward)) if backward else 0.0,
-        "trunk_drift_from_plan_m": float(np.linalg.norm(res.trunk_pos[-1] - ref.body_pos[-1])),
-        "body_sway_measured": sway_meas,
-        "body_sway_planned": sway_plan,
-        "sim_time_s": res.sim_time,
-        "wall_time_s": res.wall_time,
-        "realtime_factor": res.sim_time / res.wall_time if res.wall_time > 0 else math.nan,
-        "video": str(res.video) if res.video is not None else None,
-        "video_note": res.video_note,
-    }
+    return QuadrupedMetrics(
+        slope_deg=math.degrees(post.slope),
+        body_deg=math.degrees(post.body_pitch),
+        strategy=prm.strategy.value,
+        step_m=prm.step,
+        swing_height_m=prm.swing_height,
+        swing_period_s=prm.swing_period,
+        shift_period_s=prm.shift_period,
+        cycles=prm.cycles,
+        gait_duration_s=duration,
+        distance_up_slope_m=distance,
+        planned_distance_up_slope_m=float((ref.body_pos[-1] - ref.body_pos[0]) @ u),
+        mean_speed_m_s=distance / duration if duration > 0 else math.nan,
+        fell=fell,
+        fall_time_s=None if not fell else fallen_at,
+        stability_margin_min_m=m_min,
+        stability_margin_mean_m=m_mean,
+        stability_margin_min_three_leg_m=m3_min,
+        stability_margin_mean_three_leg_m=m3_mean,
+        planned_margin_min_m=float(np.nanmin(ref.margin)),
+        planned_margin_min_three_leg_m=float(np.nanmin(ref.margin[three])),
+        stance_samples=int(stance.sum()),
+        stance_samples_with_fewer_than_3_contacts=int((stance & (res.n_contacts < 3)).sum()),
+        zmp_error_mean_m=float(err_ok.mean()) if err_ok.size else None,
+        zmp_error_max_m=float(err_ok.max()) if err_ok.size else None,
+        foot_slip_max_m=max(slips) if slips else 0.0,
+        foot_slip_mean_m=float(np.mean(slips)) if slips else 0.0,
+        foot_backward_slip_total_m=float(np.sum(backward)) if backward else 0.0,
+        trunk_drift_from_plan_m=float(np.linalg.norm(res.trunk_pos[-1] - ref.body_pos[-1])),
+        body_sway_measured=body_sway(plan, res.t, res.trunk_pos),
+        body_sway_planned=body_sway(plan, ref.t, ref.body_pos),
+        sim_time_s=res.sim_time,
+        wall_time_s=res.wall_time,
+        realtime_factor=res.sim_time / res.wall_time if res.wall_time > 0 else math.nan,
+        video=str(res.video) if res.video is not None else None,
+        video_note=res.video_note,
+    )
 
 
 def run_slope_walk(
@@ -440,76 +628,3 @@ def run_slope_walk(
     """Plan (raising InputError before any simulation on bad input) and simulate a slope walk."""
     plan = plan_gait(robot, params)
     return plan, simulate(plan, settings, video_path=video_path)
-
-
-def benchmark_quadruped(
-    slope_deg: float = 15.0,
-    body_deg: float = 10.0,
-    sim_cycles: int = 6,
-    plan_cycles: int = 10,
-    plan_repeats: int = 20,
-) -> dict[str, Any]:
-    """Speed of the slope walk (issue goals: >= 5x real time; 10-cycle plan < 50 ms).
-
-    Measures, in one run on the current core:
-
-    * the closed-loop simulation (control, contact forces, CoP, margins, slip; no video) as
-      simulated seconds per wall second, against a baseline of bare ``mj_step`` calls on the same
-      model for the same simulated time (so ``overhead_ratio`` is what footfall's loop costs on
-      top of the physics);
-    * the gait plan of ``plan_cycles`` cycles (``plan_gait``) and its dense sampling at 100 Hz
-      with joint angles and eq.-(5) ZMP (``GaitPlan.sample``), median of ``plan_repeats``.
-
-    Returns:
-        A JSON-ready dict of timings and ratios.
-    """
-    import mujoco
-
-    robot = QuadrupedRobot()
-    slope, pitch = math.radians(slope_deg), math.radians(body_deg)
-    plan = plan_gait(robot, GaitParams(slope, pitch, cycles=sim_cycles))
-    res = simulate(plan)
-    loop_rtf = res.sim_time / res.wall_time
-
-    base = QuadrupedSim(robot, slope)
-    ref = plan.sample(0.01, with_zmp=False)
-    base.set_pose(ref.body_pos[0], ref.body_pitch, ref.joints[0])
-    steps = round(res.sim_time / base.model.opt.timestep)
-    t0 = time.perf_counter()
-    for _ in range(steps):
-        mujoco.mj_step(base.model, base.data)
-    base_wall = time.perf_counter() - t0
-    base_rtf = res.sim_time / base_wall
-
-    params = GaitParams(slope, pitch, cycles=plan_cycles)
-    plan_gait(robot, params).sample(0.01)  # warm-up (imports, caches)
-    plan_times, sample_times = [], []
-    for _ in range(plan_repeats):
-        t0 = time.perf_counter()
-        p = plan_gait(robot, params)
-        t1 = time.perf_counter()
-        p.sample(0.01)
-        plan_times.append(t1 - t0)
-        sample_times.append(time.perf_counter() - t1)
-    plan_ms = 1e3 * float(np.median(plan_times))
-    sample_ms = 1e3 * float(np.median(sample_times))
-    return {
-        "slope_deg": slope_deg,
-        "body_deg": body_deg,
-        "sim_cycles": sim_cycles,
-        "simulated_s": res.sim_time,
-        "loop_wall_s": res.wall_time,
-        "loop_realtime_factor": loop_rtf,
-        "baseline_mj_step_realtime_factor": base_rtf,
-        "overhead_ratio": base_rtf / loop_rtf,
-        "realtime_goal": 5.0,
-        "realtime_vs_goal": loop_rtf / 5.0,
-        "fell": res.metrics["fell"],
-        "plan_cycles": plan_cycles,
-        "plan_ms_median": plan_ms,
-        "sample_100hz_ms_median": sample_ms,
-        "plan_plus_sample_ms_median": plan_ms + sample_ms,
-        "plan_goal_ms": 50.0,
-        "plan_goal_over_plan_ms": 50.0 / plan_ms,
-        "plan_goal_over_plan_plus_sample_ms": 50.0 / (plan_ms + sample_ms),
-    }

@@ -488,45 +488,16 @@ def _matvec_add(
 def walk(
     x0: np.ndarray,
     foot0: np.ndarray,
-    p_refs: np.ndarray,
-    x_refs: np.ndarray,
-    cos_h: np.ndarray,
-    sin_h: np.ndarray,
-    n_b_all: np.ndarray,
-    first_block: np.ndarray,
-    gain: np.ndarray,
-    q_map: np.ndarray,
-    p_scaled: np.ndarray,
-    d_theta: np.ndarray,
-    d_u: np.ndarray,
-    u_limits: np.ndarray,
-    tol: float,
-    max_iter: int,
-    plant: tuple[
-        np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray
-    ],
-    push_tab: np.ndarray,
-    push_any: np.ndarray,
-    push_const: np.ndarray,
-    noise: np.ndarray,
-    place_err: np.ndarray,
-    decay: np.ndarray,
-    d0: np.ndarray,
-    d_span: np.ndarray,
+    refs: tuple[np.ndarray, ...],
+    mpc: tuple[np.ndarray, ...],
+    newton: tuple[float, int],
+    plant: tuple[np.ndarray, ...],
+    pushes: tuple[np.ndarray, ...],
+    errors: tuple[np.ndarray, ...],
+    fall: tuple[np.ndarray, ...],
     scalars: np.ndarray,
     n_ds: int,
-    out_t: np.ndarray,
-    out_stance: np.ndarray,
-    out_single: np.ndarray,
-    out_com: np.ndarray,
-    out_cop: np.ndarray,
-    out_cop_off: np.ndarray,
-    out_tau_cmd: np.ndarray,
-    out_tau: np.ndarray,
-    out_sat: np.ndarray,
-    out_feet: np.ndarray,
-    out_solve_time: np.ndarray,
-    out_x: np.ndarray,
+    out: tuple[np.ndarray, ...],
     mem: np.ndarray,
 ) -> tuple[int, int, bool, float, float]:
     """The closed loop of ``simulate`` over the whole walk (see the module docstring).
@@ -534,53 +505,37 @@ def walk(
     Args:
         x0: initial ALIP state (4,).
         foot0: initial stance footstep (3,) [m].
-        p_refs: planned next footstep of each phase (n, 3) [m].
-        x_refs: planned state after each phase's reset (n, 4).
-        cos_h, sin_h: cosine and sine of each phase's stance heading (n,).
-        n_b_all .. u_limits: :class:`footfall.control.mpc.PaddedMPC` fields; tol, max_iter: Newton.
+        refs: per phase (n phases): planned next footstep (n, 3) [m], planned state after the
+            reset (n, 4), cosine and sine of the stance heading (n,).
+        mpc: the :class:`footfall.control.mpc.PaddedMPC` fields ``(n_b .. u_limits)``.
+        newton: Newton tolerance and iteration limit.
         plant: true-plant matrices ``(Ad_tick (4, 4), Bd_tick (4, 2), Ad_sub, Bd_sub,
             Ad_ds_tick (8, 8), Ad_ds_sub (8, 8), Bd_ds_sub (8, 2))``.
-        push_tab: push torque per tick row and sub-step (rows, n_sub, 2) [N m]; push_any and
-            push_const: per row, any push / the same push on every sub-step.
-        noise: state-estimate noise per single-support tick (n M, 4).
-        place_err: landing error per step (n, 2) [m].
-        decay: ``exp(-omega T_r)`` per tick (M,); d0, d_span: fall-test constants (4,) [m].
+        pushes: push torque per tick row and sub-step (rows, n_sub, 2) [N m]; per row, any push /
+            the same push on every sub-step.
+        errors: state-estimate noise per single-support tick (n M, 4), landing error per step
+            (n, 2) [m].
+        fall: ``exp(-omega T_r)`` per tick (M,), and the fall-test constants d0, d_span (4,) [m].
         scalars: ``[dt, dt_ds, t_ds, m g, 1 / (m z_H omega), sole half-length, half-width]``.
         n_ds: double-support ticks.
-        out_*: preallocated sample arrays (zeros), filled up to the returned sample count;
-            out_feet (n + 1, 3) the landed footsteps; out_solve_time (n M,) [s]; out_x (4,) the
-            final state.
+        out: preallocated sample arrays (zeros) ``t, stance, single, com, cop, cop_offset,
+            torque_cmd, torque, saturated`` filled up to the returned sample count, then the
+            landed footsteps (n + 1, 3), the solve times (n M,) [s] and the final state (4,).
         mem: MPC integer memory (:data:`MEM_SIZE`,), last good tick -1.
 
     Returns:
         ``(samples, footsteps, fell, fall_time, t)``.
     """
-    ad_t, bd_t, ad_s, bd_s, ad_ds, ad_dss, bd_dss = plant
-    dt, dt_ds, t_ds, mg, kxi, hx, hy = (
-        scalars[0],
-        scalars[1],
-        scalars[2],
-        scalars[3],
-        scalars[4],
-        scalars[5],
-        scalars[6],
-    )
+    p_refs = refs[0]
+    out_feet, out_x = out[9], out[11]
     n = p_refs.shape[0]
-    m_ticks = decay.shape[0]
-    n_sub = push_tab.shape[1]
-    nu = gain.shape[1]
-    last_u = np.zeros(nu)
-    last_lam = np.zeros(nu // 2)
-    last_foot = np.zeros(3)
-    torque = np.zeros(2)
-    next_foot = np.zeros(3)
-    theta = np.empty(10)
+    m_ticks = fall[0].shape[0]
+    nu = mpc[2].shape[1]
+    # MPC memory across ticks (last good torques, multipliers, footstep) and its outputs.
+    solver = (np.zeros(nu), np.zeros(nu // 2), np.zeros(3), np.zeros(2), np.zeros(3))
     x = x0.copy()
-    x_new = np.empty(4)
-    u = np.empty(2)
-    u_p = np.empty(2)
-    s_aug = np.empty(8)
-    s_new = np.empty(8)
+    # work space: x_new, u, u_p, s_aug, s_new, theta
+    work = (np.empty(4), np.empty(2), np.empty(2), np.empty(8), np.empty(8), np.empty(10))
     out_feet[0] = foot0
     n_feet = 1
     fell = False
@@ -590,120 +545,203 @@ def walk(
     t = 0.0
     for i in range(n):
         stance = out_feet[n_feet - 1]
-        cth, sth = cos_h[i], sin_h[i]
-        theta[4] = p_refs[i, 0] - stance[0]
-        theta[5] = p_refs[i, 1] - stance[1]
-        theta[6:] = x_refs[i]
-        for k in range(m_ticks):
-            for r in range(4):
-                theta[r] = x[r] + noise[i * m_ticks + k, r]
-            t0 = _clock_ns()
-            mpc_step(
-                k,
-                theta,
-                stance,
-                p_refs[i],
-                n_b_all,
-                first_block,
-                gain,
-                q_map,
-                p_scaled,
-                d_theta,
-                d_u,
-                u_limits,
-                tol,
-                max_iter,
-                mem,
-                last_u,
-                last_lam,
-                last_foot,
-                torque,
-                next_foot,
-            )
-            out_solve_time[n_solve] = (_clock_ns() - t0) * 1e-9
-            n_solve += 1
-            # CoP of the command in the foot frame, clipped to the sole.
-            cwx, cwy = -torque[1] / mg, torque[0] / mg
-            ox, oy = cth * cwx + sth * cwy, -sth * cwx + cth * cwy
-            cx, cy = _clip(ox, -hx, hx), _clip(oy, -hy, hy)
-            wx, wy = cth * cx - sth * cy, sth * cx + cth * cy
-            u[0], u[1] = mg * wy, -mg * wx
-            out_t[j], out_stance[j], out_single[j] = t, i, True
-            out_com[j, 0], out_com[j, 1] = stance[0] + x[0], stance[1] + x[1]
-            out_cop[j, 0], out_cop[j, 1] = stance[0] + wx, stance[1] + wy
-            out_cop_off[j, 0], out_cop_off[j, 1] = cx, cy
-            out_tau_cmd[j, 0], out_tau_cmd[j, 1] = torque[0], torque[1]
-            out_tau[j, 0], out_tau[j, 1] = u[0], u[1]
-            out_sat[j] = cx != ox or cy != oy
-            j += 1
-            jt = i * (m_ticks + n_ds) + k
-            if not push_any[jt]:
-                _matvec_add(ad_t, x, bd_t, u, x_new)
-                x[:] = x_new
-            elif push_const[jt]:
-                u_p[0], u_p[1] = u[0] + push_tab[jt, 0, 0], u[1] + push_tab[jt, 0, 1]
-                _matvec_add(ad_t, x, bd_t, u_p, x_new)
-                x[:] = x_new
-            else:
-                for q in range(n_sub):
-                    u_p[0], u_p[1] = u[0] + push_tab[jt, q, 0], u[1] + push_tab[jt, q, 1]
-                    _matvec_add(ad_s, x, bd_s, u_p, x_new)
-                    x[:] = x_new
-            t += dt
-            # Fall test on the true state.
-            if not (
-                math.isfinite(x[0])
-                and math.isfinite(x[1])
-                and math.isfinite(x[2])
-                and math.isfinite(x[3])
-            ):
-                fell, fall_time = True, t
-                break
-            gx, gy = x[0] + kxi * x[3], x[1] - kxi * x[2]
-            fx, fy = cth * gx + sth * gy, -sth * gx + cth * gy
-            e = decay[k]
-            if (
-                fx > d0[0] + d_span[0] * e
-                or -fx > d0[1] + d_span[1] * e
-                or fy > d0[2] + d_span[2] * e
-                or -fy > d0[3] + d_span[3] * e
-            ):
-                fell, fall_time = True, t
-                break
+        j, t, n_solve, fell = _single_support(
+            i, j, t, n_solve, x, stance, refs, mpc, newton, plant, pushes, errors[0], fall,
+            scalars, n_ds, out, mem, solver, work
+        )  # fmt: skip
         if fell:
+            fall_time = t
             break
-        # Double support: the contact point moves linearly to the new foot (eq. 5.8-5.10).
-        px, py = next_foot[0] + place_err[i, 0], next_foot[1] + place_err[i, 1]
-        dx, dy = px - stance[0], py - stance[1]
-        s_aug[:4] = x
-        s_aug[4], s_aug[5] = 0.0, 0.0
-        s_aug[6], s_aug[7] = dx / t_ds, dy / t_ds
-        for k in range(n_ds):
-            out_t[j], out_stance[j] = t, i
-            out_com[j, 0], out_com[j, 1] = stance[0] + s_aug[0], stance[1] + s_aug[1]
-            out_cop[j, 0], out_cop[j, 1] = stance[0] + s_aug[4], stance[1] + s_aug[5]
-            j += 1
-            jt = i * (m_ticks + n_ds) + m_ticks + k
-            if not push_any[jt]:
-                _matvec(ad_ds, s_aug, s_new)
-                s_aug[:] = s_new
-            else:
-                for q in range(n_sub):
-                    _matvec_add(ad_dss, s_aug, bd_dss, push_tab[jt, q], s_new)
-                    s_aug[:] = s_new
-            t += dt_ds
-        x[:] = s_aug[:4]
-        x[0] -= dx
-        x[1] -= dy
-        out_feet[n_feet, 0], out_feet[n_feet, 1], out_feet[n_feet, 2] = px, py, next_foot[2]
+        row = i * (m_ticks + n_ds) + m_ticks  # push row of the first double-support tick
+        j, t = _double_support(
+            i, j, t, x, stance, solver[4], errors[1], plant, pushes, row, scalars, n_ds, out, work
+        )
         n_feet += 1
-        if not (
-            math.isfinite(x[0])
-            and math.isfinite(x[1])
-            and math.isfinite(x[2])
-            and math.isfinite(x[3])
-        ):
+        if not _finite4(x):
             fell, fall_time = True, t
             break
     out_x[:] = x
     return j, n_feet, fell, fall_time, t
+
+
+@njit(cache=True)
+def _single_support(
+    i: int,
+    j: int,
+    t: float,
+    n_solve: int,
+    x: np.ndarray,
+    stance: np.ndarray,
+    refs: tuple[np.ndarray, ...],
+    mpc: tuple[np.ndarray, ...],
+    newton: tuple[float, int],
+    plant: tuple[np.ndarray, ...],
+    pushes: tuple[np.ndarray, ...],
+    noise: np.ndarray,
+    fall: tuple[np.ndarray, ...],
+    scalars: np.ndarray,
+    n_ds: int,
+    out: tuple[np.ndarray, ...],
+    mem: np.ndarray,
+    solver: tuple[np.ndarray, ...],
+    work: tuple[np.ndarray, ...],
+) -> tuple[int, float, int, bool]:
+    """Phase ``i``'s single support from sample ``j``, time ``t``, solve ``n_solve``: per tick
+    the MPC on the noisy state, the clipped CoP, the true plant (``x`` in place), the fall test.
+
+    Returns:
+        ``(j, t, n_solve, fell)`` after the last tick (the tick of the fall when it fell).
+    """
+    p_refs, x_refs, cos_h, sin_h = refs
+    theta, out_solve_time = work[5], out[10]
+    m_ticks = fall[0].shape[0]
+    n_b_all, first_block, gain, q_map, p_scaled, d_theta, d_u, u_limits = mpc
+    last_u, last_lam, last_foot, torque, foot = solver
+    tol, max_iter = newton
+    out_t, out_stance, out_single, out_com, out_cop = out[0], out[1], out[2], out[3], out[4]
+    out_cop_off, out_tau_cmd, out_tau, out_sat = out[5], out[6], out[7], out[8]
+    ad_t, bd_t, ad_s, bd_s = plant[0], plant[1], plant[2], plant[3]
+    push_tab, push_any, push_const = pushes
+    decay, d0, d_span = fall
+    mg, kxi, hx, hy = scalars[3], scalars[4], scalars[5], scalars[6]
+    x_new, u, u_p = work[0], work[1], work[2]
+    n_sub = push_tab.shape[1]
+    cth, sth = cos_h[i], sin_h[i]
+    theta[4] = p_refs[i, 0] - stance[0]
+    theta[5] = p_refs[i, 1] - stance[1]
+    theta[6:] = x_refs[i]
+    for k in range(m_ticks):
+        for r in range(4):
+            theta[r] = x[r] + noise[i * m_ticks + k, r]
+        t0 = _clock_ns()
+        mpc_step(
+            k, theta, stance, p_refs[i], n_b_all, first_block, gain, q_map, p_scaled, d_theta,
+            d_u, u_limits, tol, max_iter, mem, last_u, last_lam, last_foot, torque, foot
+        )  # fmt: skip
+        out_solve_time[n_solve] = (_clock_ns() - t0) * 1e-9
+        n_solve += 1
+        ox, oy, cx, cy, wx, wy = _sole_cop(torque[0], torque[1], cth, sth, mg, hx, hy)
+        u[0], u[1] = mg * wy, -mg * wx
+        out_t[j], out_stance[j], out_single[j] = t, i, True
+        out_com[j, 0], out_com[j, 1] = stance[0] + x[0], stance[1] + x[1]
+        out_cop[j, 0], out_cop[j, 1] = stance[0] + wx, stance[1] + wy
+        out_cop_off[j, 0], out_cop_off[j, 1] = cx, cy
+        out_tau_cmd[j, 0], out_tau_cmd[j, 1] = torque[0], torque[1]
+        out_tau[j, 0], out_tau[j, 1] = u[0], u[1]
+        out_sat[j] = cx != ox or cy != oy
+        j += 1
+        jt = i * (m_ticks + n_ds) + k
+        if not push_any[jt]:
+            _matvec_add(ad_t, x, bd_t, u, x_new)
+            x[:] = x_new
+        elif push_const[jt]:
+            u_p[0], u_p[1] = u[0] + push_tab[jt, 0, 0], u[1] + push_tab[jt, 0, 1]
+            _matvec_add(ad_t, x, bd_t, u_p, x_new)
+            x[:] = x_new
+        else:
+            for q in range(n_sub):
+                u_p[0], u_p[1] = u[0] + push_tab[jt, q, 0], u[1] + push_tab[jt, q, 1]
+                _matvec_add(ad_s, x, bd_s, u_p, x_new)
+                x[:] = x_new
+        t += scalars[0]
+        # Fall test on the true state.
+        if not _finite4(x) or _beyond(x, cth, sth, kxi, decay[k], d0, d_span):
+            return j, t, n_solve, True
+    return j, t, n_solve, False
+
+
+@njit(cache=True)
+def _sole_cop(
+    t0: float, t1: float, cth: float, sth: float, mg: float, hx: float, hy: float
+) -> tuple[float, float, float, float, float, float]:
+    """CoP of the torque command ``(t0, t1)`` in the foot frame (heading cosine ``cth``, sine
+    ``sth``), ``(ox, oy)``, clipped to the sole half-sizes, ``(cx, cy)``, and the clipped CoP
+    back in the world frame relative to the foot, ``(wx, wy)`` [m]."""
+    cwx, cwy = -t1 / mg, t0 / mg
+    ox, oy = cth * cwx + sth * cwy, -sth * cwx + cth * cwy
+    cx, cy = _clip(ox, -hx, hx), _clip(oy, -hy, hy)
+    wx, wy = cth * cx - sth * cy, sth * cx + cth * cy
+    return ox, oy, cx, cy, wx, wy
+
+
+@njit(cache=True)
+def _beyond(
+    x: np.ndarray,
+    cth: float,
+    sth: float,
+    kxi: float,
+    e: float,
+    d0: np.ndarray,
+    d_span: np.ndarray,
+) -> bool:
+    """Fall bound: the instantaneous capture point ``(x + kxi L_y, y - kxi L_x)`` in the foot
+    frame lies beyond ``d0 + d_span e`` in one of the directions (+x, -x, +y, -y)."""
+    gx, gy = x[0] + kxi * x[3], x[1] - kxi * x[2]
+    fx, fy = cth * gx + sth * gy, -sth * gx + cth * gy
+    return (
+        fx > d0[0] + d_span[0] * e
+        or -fx > d0[1] + d_span[1] * e
+        or fy > d0[2] + d_span[2] * e
+        or -fy > d0[3] + d_span[3] * e
+    )
+
+
+@njit(cache=True)
+def _finite4(x: np.ndarray) -> bool:
+    """All four entries of the ALIP state are finite."""
+    return (
+        math.isfinite(x[0]) and math.isfinite(x[1]) and math.isfinite(x[2]) and math.isfinite(x[3])
+    )
+
+
+@njit(cache=True)
+def _double_support(
+    i: int,
+    j: int,
+    t: float,
+    x: np.ndarray,
+    stance: np.ndarray,
+    next_foot: np.ndarray,
+    place_err: np.ndarray,
+    plant: tuple[np.ndarray, ...],
+    pushes: tuple[np.ndarray, ...],
+    row: int,
+    scalars: np.ndarray,
+    n_ds: int,
+    out: tuple[np.ndarray, ...],
+    work: tuple[np.ndarray, ...],
+) -> tuple[int, float]:
+    """Phase ``i``'s double support from sample ``j`` at time ``t``: the contact point moves
+    linearly to the new foot (eq. 5.8-5.10), which is recorded as landed footstep ``i + 1``; ``x``
+    ends relative to it. ``row`` is the push-table row of its first tick. Returns the next sample
+    index and the time."""
+    ad_ds, ad_dss, bd_dss = plant[4], plant[5], plant[6]
+    push_tab, push_any = pushes[0], pushes[1]
+    out_t, out_stance, out_com, out_cop, out_feet = out[0], out[1], out[3], out[4], out[9]
+    s_aug, s_new = work[3], work[4]
+    dt_ds, t_ds = scalars[1], scalars[2]
+    px, py = next_foot[0] + place_err[i, 0], next_foot[1] + place_err[i, 1]
+    dx, dy = px - stance[0], py - stance[1]
+    s_aug[:4] = x
+    s_aug[4], s_aug[5] = 0.0, 0.0
+    s_aug[6], s_aug[7] = dx / t_ds, dy / t_ds
+    for k in range(n_ds):
+        out_t[j], out_stance[j] = t, i
+        out_com[j, 0], out_com[j, 1] = stance[0] + s_aug[0], stance[1] + s_aug[1]
+        out_cop[j, 0], out_cop[j, 1] = stance[0] + s_aug[4], stance[1] + s_aug[5]
+        j += 1
+        jt = row + k
+        if not push_any[jt]:
+            _matvec(ad_ds, s_aug, s_new)
+            s_aug[:] = s_new
+        else:
+            for q in range(push_tab.shape[1]):
+                _matvec_add(ad_dss, s_aug, bd_dss, push_tab[jt, q], s_new)
+                s_aug[:] = s_new
+        t += dt_ds
+    x[:] = s_aug[:4]
+    x[0] -= dx
+    x[1] -= dy
+    n_feet = i + 1
+    out_feet[n_feet, 0], out_feet[n_feet, 1], out_feet[n_feet, 2] = px, py, next_foot[2]
+    return j, t

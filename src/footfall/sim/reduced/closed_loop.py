@@ -57,7 +57,14 @@ from numpy.typing import NDArray
 from footfall._geometry import rot2
 from footfall._typing import FloatArray
 from footfall._validate import non_negative, positive
-from footfall.control.mpc import MPC, SOLVERS, CondensedMPC, MPCWeights, build_mpc
+from footfall.control.mpc import (
+    MPC,
+    SOLVERS,
+    CondensedMPC,
+    MPCSolution,
+    MPCWeights,
+    build_mpc,
+)
 from footfall.errors import InputError, SolverUnavailableError
 from footfall.models._linear import zoh
 from footfall.models.alip import ALIP
@@ -94,9 +101,9 @@ class SimOptions:
         mpc_nodes: torque blocks + 1 of the MPC (default: the plan robot's K).
         solver: MPC backend, ``newton`` or ``clarabel``.
         engine: how the loop runs: ``python`` (the numpy reference), ``compiled`` (the same loop
-            compiled with numba, newton solver only; same trajectories up to rounding, about
-            20x faster: ``footfall bench sim``) or ``auto`` (compiled when numba is installed and the solver is
-            ``newton``).
+            compiled with numba, newton solver only; same trajectories up to rounding; its speed
+            is measured by ``footfall bench sim``) or ``auto`` (compiled when numba is installed
+            and the solver is ``newton``).
     """
 
     control_rate: float = 500.0
@@ -401,6 +408,53 @@ class _Trace:
     n_fallbacks: int = 0
 
 
+def _true_plant(true: ALIP, dt: float, dt_ds: float, n_sub: int) -> tuple[FloatArray, ...]:
+    """Exact matrices of the true plant (model mismatch): ``(Ad, Bd)`` of one tick and of one
+    sub-step (eq. 5.7), and of the double support augmented with the contact point moving at
+    constant velocity (eq. 5.8-5.10): ``A`` of one tick, ``(A, B)`` of one sub-step (8 states)."""
+    ad_t, bd_t = true.discretize(dt)
+    ad_s, bd_s = true.discretize(dt / n_sub)
+    a_aug = np.zeros((8, 8))
+    a_aug[:4, :4] = true.A
+    a_aug[:4, 4:6] = true.E[:, :2]  # contact displacement acts like the torque E d (eq. 5.10)
+    a_aug[4:6, 6:8] = np.eye(2)
+    b_aug = np.zeros((8, 2))
+    b_aug[2:4] = np.eye(2)
+    ad_ds, _ = zoh(a_aug, b_aug, dt_ds)
+    ad_dss, bd_dss = zoh(a_aug, b_aug, dt_ds / n_sub)
+    return ad_t, bd_t, ad_s, bd_s, ad_ds, ad_dss, bd_dss
+
+
+def _push_table(
+    robot: BipedParams,
+    opts: SimOptions,
+    n: int,
+    m_ticks: int,
+    dt: float,
+    n_ds: int,
+    dt_ds: float,
+    zh: float,
+) -> FloatArray:
+    """Push torque ``z_H (-F_y, F_x)`` [N m] on every plant sub-step of the walk, tabulated once:
+    row ``i (M + n_ds) + k`` is tick k of phase i (k >= M: double support), columns the
+    sub-steps; shape (n (M + n_ds), n_sub, 2)."""
+    n_sub = opts.substeps
+    starts = np.concatenate(
+        [np.arange(m_ticks) * dt, robot.t_ss + np.arange(n_ds) * dt_ds]
+    )  # tick start within a step
+    lengths = np.concatenate([np.full(m_ticks, dt), np.full(n_ds, dt_ds)])
+    step_period = robot.t_ss + robot.t_ds
+    t_start = (np.arange(n)[:, None] * step_period + starts[None]).ravel()
+    h_sub = np.tile(lengths, n) / n_sub
+    mids = t_start[:, None] + (np.arange(n_sub)[None] + 0.5) * h_sub[:, None]
+    push_tab = np.zeros((t_start.shape[0], n_sub, 2))
+    for p in opts.pushes:
+        on = (mids >= p.start) & (mids < p.start + p.duration)
+        f = p.force[:2]
+        push_tab[on] += zh * np.array([-f[1], f[0]])
+    return push_tab
+
+
 def _prepare(plan: FootstepPlan, opts: SimOptions, goal: FloatArray | None) -> _Walk:
     robot = plan.robot
     n = plan.n_steps
@@ -417,36 +471,11 @@ def _prepare(plan: FootstepPlan, opts: SimOptions, goal: FloatArray | None) -> _
         else np.asarray(goal, dtype=float)[:2]
     )
 
-    # True plant (model mismatch) and its exact one-tick, sub-step and double-support matrices.
     true = ALIP(robot.mass * opts.mass_scale, robot.com_height * opts.com_height_scale, robot.g)
     mzh, zh = true.mass * true.com_height, true.com_height
-    ad_t, bd_t = true.discretize(dt)
-    ad_s, bd_s = true.discretize(dt / n_sub)
-    a_aug = np.zeros((8, 8))
-    a_aug[:4, :4] = true.A
-    a_aug[:4, 4:6] = true.E[:, :2]  # contact displacement acts like the torque E d (eq. 5.10)
-    a_aug[4:6, 6:8] = np.eye(2)
-    b_aug = np.zeros((8, 2))
-    b_aug[2:4] = np.eye(2)
-    ad_ds, _ = zoh(a_aug, b_aug, dt_ds)
-    ad_dss, bd_dss = zoh(a_aug, b_aug, dt_ds / n_sub)
+    ad_t, bd_t, ad_s, bd_s, ad_ds, ad_dss, bd_dss = _true_plant(true, dt, dt_ds, n_sub)
     d0, d_span = viability_bounds(robot, true.omega, f_len, f_wid)
-
-    # Push torque z_H (-F_y, F_x) on every plant sub-step of the walk, tabulated once: row
-    # i (M + n_ds) + k is tick k of phase i (k >= M: double support), columns the sub-steps.
-    starts = np.concatenate(
-        [np.arange(m_ticks) * dt, robot.t_ss + np.arange(n_ds) * dt_ds]
-    )  # tick start within a step
-    lengths = np.concatenate([np.full(m_ticks, dt), np.full(n_ds, dt_ds)])
-    step_period = robot.t_ss + robot.t_ds
-    t_start = (np.arange(n)[:, None] * step_period + starts[None]).ravel()
-    h_sub = np.tile(lengths, n) / n_sub
-    mids = t_start[:, None] + (np.arange(n_sub)[None] + 0.5) * h_sub[:, None]
-    push_tab = np.zeros((t_start.shape[0], n_sub, 2))
-    for p in opts.pushes:
-        on = (mids >= p.start) & (mids < p.start + p.duration)
-        f = p.force[:2]
-        push_tab[on] += zh * np.array([-f[1], f[0]])
+    push_tab = _push_table(robot, opts, n, m_ticks, dt, n_ds, dt_ds, zh)
 
     rng = np.random.default_rng(opts.seed)
     noise = rng.standard_normal((n * m_ticks, 4)) * np.array(
@@ -514,105 +543,145 @@ def _new_trace(w: _Walk) -> _Trace:
 
 def _walk_python(w: _Walk) -> _Trace:
     """The reference loop (numpy, the :class:`MPC` class); see the module docstring."""
-    tr = _new_trace(w)
-    mpc = MPC(w.mdl, w.solver)
-    plan = w.plan
-    m_ticks, n_ds, n_sub, dt, dt_ds = w.m_ticks, w.n_ds, w.n_sub, w.dt, w.dt_ds
-    mg = w.mg
-    d0, d_span, decay = w.d0, w.d_span, w.decay
-    ad_t, bd_t, ad_s, bd_s = w.ad_t, w.bd_t, w.ad_s, w.bd_s
-    push_tab, push_any, push_const = w.push_tab, w.push_any, w.push_const
-    hx, hy = float(w.half[0]), float(w.half[1])
-    kxi = 1.0 / (w.mzh * w.omega)
-    n_solve = 0
-    x = np.array(plan.states[0, 0], dtype=float)
-    feet = [np.array(plan.footsteps[0], dtype=float)]
-    fell = False
-    fall_time = math.nan
-    j = 0  # sample index
-    t = 0.0
-    for i in range(w.n):
-        stance = feet[-1]
+    return _PythonLoop(w).run()
+
+
+class _PythonLoop:
+    """The reference loop's state between ticks: true ALIP state, time, landed feet, samples.
+
+    Each phase ``i`` is a single support (an MPC solve, the clipped CoP and the plant per tick,
+    then the fall test) followed by the double support with the moving contact.
+    """
+
+    def __init__(self, w: _Walk) -> None:
+        self.w = w
+        self.tr = _new_trace(w)
+        self.mpc = MPC(w.mdl, w.solver)
+        self.x = np.array(w.plan.states[0, 0], dtype=float)
+        self.feet = [np.array(w.plan.footsteps[0], dtype=float)]
+        self.fell = False
+        self.fall_time = math.nan
+        self.j = 0  # sample index
+        self.t = 0.0
+        self.n_solve = 0
+
+    def run(self) -> _Trace:
+        """Walk every phase until the end or a fall; the trace of the walk."""
+        for i in range(self.w.n):
+            sol = self.single_support(i)
+            if self.fell:
+                break
+            assert sol is not None
+            self.double_support(i, sol)
+            if self.fell:
+                break
+        tr = self.tr
+        tr.samples, tr.feet, tr.x, tr.time = self.j, np.array(self.feet), self.x, self.t
+        tr.fell, tr.fall_time = self.fell, self.fall_time
+        tr.solve_times = tr.solve_times[: self.n_solve]
+        tr.n_solves, tr.n_fallbacks = self.mpc.n_solves, self.mpc.n_fallbacks
+        return tr
+
+    def single_support(self, i: int) -> MPCSolution | None:
+        """The M ticks of phase ``i``'s single support; the last MPC solution."""
+        w = self.w
+        stance = self.feet[-1]
         p_ref = w.p_refs[i]
         sol = None
         cth, sth = float(w.cos_h[i]), float(w.sin_h[i])
         theta = np.empty(10)
         theta[4:6] = p_ref[:2] - stance[:2]
         theta[6:] = w.x_refs[i]
-        for k in range(m_ticks):
-            theta[:4] = x
-            theta[:4] += w.noise[i * m_ticks + k]
-            sol = mpc.solve_theta(k, theta, stance, p_ref)
-            tr.solve_times[n_solve] = sol.solve_time
-            n_solve += 1
-            u_cmd = sol.torques[0]
-            # CoP of the command in the foot frame, clipped to the sole (the foot rolls otherwise).
-            cwx, cwy = -float(u_cmd[1]) / mg, float(u_cmd[0]) / mg
-            ox, oy = cth * cwx + sth * cwy, -sth * cwx + cth * cwy
-            cx, cy = min(max(ox, -hx), hx), min(max(oy, -hy), hy)
-            wx, wy = cth * cx - sth * cy, sth * cx + cth * cy
-            u = np.array([mg * wy, -mg * wx])
-            tr.t[j], tr.stance[j], tr.single[j] = t, i, True
-            tr.com[j] = stance[:2] + x[:2]
-            tr.cop[j] = (stance[0] + wx, stance[1] + wy)
-            tr.cop_off[j], tr.tau_cmd[j], tr.tau[j] = (cx, cy), u_cmd, u
-            tr.sat[j] = cx != ox or cy != oy
-            j += 1
-            jt = i * (m_ticks + n_ds) + k
-            if not push_any[jt]:
-                x = ad_t @ x + bd_t @ u
-            elif push_const[jt]:
-                x = ad_t @ x + bd_t @ (u + push_tab[jt, 0])
-            else:
-                for q in range(n_sub):
-                    x = ad_s @ x + bd_s @ (u + push_tab[jt, q])
-            t += dt
-            # Fall test on the true state (module docstring).
-            if not np.isfinite(x).all():
-                fell, fall_time = True, t
+        for k in range(w.m_ticks):
+            theta[:4] = self.x
+            theta[:4] += w.noise[i * w.m_ticks + k]
+            sol = self.mpc.solve_theta(k, theta, stance, p_ref)
+            self.tr.solve_times[self.n_solve] = sol.solve_time
+            self.n_solve += 1
+            u = self._apply(i, stance, sol.torques[0], cth, sth)
+            self._plant(i * (w.m_ticks + w.n_ds) + k, u)
+            self.t += w.dt
+            if self._falls(k, cth, sth):
+                self.fell, self.fall_time = True, self.t
                 break
-            gx, gy = float(x[0] + kxi * x[3]), float(x[1] - kxi * x[2])
-            fx, fy = cth * gx + sth * gy, -sth * gx + cth * gy
-            e = decay[k]
-            if (
-                fx > d0[0] + d_span[0] * e
-                or -fx > d0[1] + d_span[1] * e
-                or fy > d0[2] + d_span[2] * e
-                or -fy > d0[3] + d_span[3] * e
-            ):
-                fell, fall_time = True, t
-                break
-        if fell:
-            break
-        assert sol is not None
+        return sol
+
+    def _apply(
+        self, i: int, stance: FloatArray, u_cmd: FloatArray, c: float, s: float
+    ) -> FloatArray:
+        """Record the tick and return the applied torque: the command's CoP in the foot frame
+        (heading cosine ``c``, sine ``s``) clipped to the sole (the foot rolls otherwise)."""
+        w, tr, j = self.w, self.tr, self.j
+        mg, hx, hy = w.mg, float(w.half[0]), float(w.half[1])
+        cwx, cwy = -float(u_cmd[1]) / mg, float(u_cmd[0]) / mg
+        ox, oy = c * cwx + s * cwy, -s * cwx + c * cwy
+        cx, cy = min(max(ox, -hx), hx), min(max(oy, -hy), hy)
+        wx, wy = c * cx - s * cy, s * cx + c * cy
+        u = np.array([mg * wy, -mg * wx])
+        tr.t[j], tr.stance[j], tr.single[j] = self.t, i, True
+        tr.com[j] = stance[:2] + self.x[:2]
+        tr.cop[j] = (stance[0] + wx, stance[1] + wy)
+        tr.cop_off[j], tr.tau_cmd[j], tr.tau[j] = (cx, cy), u_cmd, u
+        tr.sat[j] = cx != ox or cy != oy
+        self.j += 1
+        return u
+
+    def _plant(self, jt: int, u: FloatArray) -> None:
+        """One control tick of the true plant (eq. 5.7) under ``u`` and the pushes of row ``jt``."""
+        w = self.w
+        x = self.x
+        if not w.push_any[jt]:
+            x = w.ad_t @ x + w.bd_t @ u
+        elif w.push_const[jt]:
+            x = w.ad_t @ x + w.bd_t @ (u + w.push_tab[jt, 0])
+        else:
+            for q in range(w.n_sub):
+                x = w.ad_s @ x + w.bd_s @ (u + w.push_tab[jt, q])
+        self.x = x
+
+    def _falls(self, k: int, c: float, s: float) -> bool:
+        """The fall test on the true state after tick ``k`` (module docstring)."""
+        w, x = self.w, self.x
+        if not np.isfinite(x).all():
+            return True
+        kxi = 1.0 / (w.mzh * w.omega)
+        gx, gy = float(x[0] + kxi * x[3]), float(x[1] - kxi * x[2])
+        fx, fy = c * gx + s * gy, -s * gx + c * gy
+        d0, d_span, e = w.d0, w.d_span, w.decay[k]
+        return bool(
+            fx > d0[0] + d_span[0] * e
+            or -fx > d0[1] + d_span[1] * e
+            or fy > d0[2] + d_span[2] * e
+            or -fy > d0[3] + d_span[3] * e
+        )
+
+    def double_support(self, i: int, sol: MPCSolution) -> None:
+        """Phase ``i``'s double support: the contact point moves linearly to the new foot
+        (eq. 5.8-5.10); then the state is re-expressed relative to the new stance foot."""
+        w, tr = self.w, self.tr
+        stance = self.feet[-1]
         p_next = np.array(sol.next_footstep, dtype=float)
         p_next[:2] += w.place_err[i]
         delta = p_next[:2] - stance[:2]
-        # Double support: the contact point moves linearly to the new foot (eq. 5.8-5.10).
-        s_aug = np.concatenate([x, np.zeros(2), delta / w.t_ds])
-        for k in range(n_ds):
-            tr.t[j], tr.stance[j] = t, i
-            tr.com[j] = stance[:2] + s_aug[:2]
-            tr.cop[j] = stance[:2] + s_aug[4:6]
-            j += 1
-            jt = i * (m_ticks + n_ds) + m_ticks + k
-            if not push_any[jt]:
+        s_aug = np.concatenate([self.x, np.zeros(2), delta / w.t_ds])
+        for k in range(w.n_ds):
+            tr.t[self.j], tr.stance[self.j] = self.t, i
+            tr.com[self.j] = stance[:2] + s_aug[:2]
+            tr.cop[self.j] = stance[:2] + s_aug[4:6]
+            self.j += 1
+            jt = i * (w.m_ticks + w.n_ds) + w.m_ticks + k
+            if not w.push_any[jt]:
                 s_aug = w.ad_ds @ s_aug
             else:
-                for q in range(n_sub):
-                    s_aug = w.ad_dss @ s_aug + w.bd_dss @ push_tab[jt, q]
-            t += dt_ds
+                for q in range(w.n_sub):
+                    s_aug = w.ad_dss @ s_aug + w.bd_dss @ w.push_tab[jt, q]
+            self.t += w.dt_ds
         x = s_aug[:4].copy()
         x[:2] -= delta
-        feet.append(p_next)
+        self.x = x
+        self.feet.append(p_next)
         if not np.all(np.isfinite(x)):
-            fell, fall_time = True, t
-            break
-    tr.samples, tr.feet, tr.x, tr.time = j, np.array(feet), x, t
-    tr.fell, tr.fall_time = fell, fall_time
-    tr.solve_times = tr.solve_times[:n_solve]
-    tr.n_solves, tr.n_fallbacks = mpc.n_solves, mpc.n_fallbacks
-    return tr
+            self.fell, self.fall_time = True, self.t
 
 
 def _walk_compiled(w: _Walk) -> _Trace:
@@ -633,43 +702,38 @@ def _walk_compiled(w: _Walk) -> _Trace:
     samples, n_feet, fell, fall_time, t = kernel.walk(
         np.array(plan.states[0, 0], dtype=float),
         np.array(plan.footsteps[0], dtype=float),
-        w.p_refs,
-        w.x_refs,
-        w.cos_h,
-        w.sin_h,
-        pad.n_b,
-        pad.first_block,
-        pad.gain,
-        pad.q_map,
-        pad.p_scaled,
-        pad.d_theta,
-        pad.d_u,
-        pad.u_limits,
-        DUAL_TOL,
-        MAX_NEWTON_ITER,
+        (w.p_refs, w.x_refs, w.cos_h, w.sin_h),
+        (
+            pad.n_b,
+            pad.first_block,
+            pad.gain,
+            pad.q_map,
+            pad.p_scaled,
+            pad.d_theta,
+            pad.d_u,
+            pad.u_limits,
+        ),
+        (DUAL_TOL, MAX_NEWTON_ITER),
         (w.ad_t, w.bd_t, w.ad_s, w.bd_s, w.ad_ds, w.ad_dss, w.bd_dss),
-        w.push_tab,
-        w.push_any,
-        w.push_const,
-        w.noise,
-        w.place_err,
-        w.decay,
-        w.d0,
-        w.d_span,
+        (w.push_tab, w.push_any, w.push_const),
+        (w.noise, w.place_err),
+        (w.decay, w.d0, w.d_span),
         scalars,
         w.n_ds,
-        tr.t,
-        tr.stance,
-        tr.single,
-        tr.com,
-        tr.cop,
-        tr.cop_off,
-        tr.tau_cmd,
-        tr.tau,
-        tr.sat,
-        feet,
-        tr.solve_times,
-        x_out,
+        (
+            tr.t,
+            tr.stance,
+            tr.single,
+            tr.com,
+            tr.cop,
+            tr.cop_off,
+            tr.tau_cmd,
+            tr.tau,
+            tr.sat,
+            feet,
+            tr.solve_times,
+            x_out,
+        ),
         mem,
     )
     tr.samples, tr.feet, tr.x, tr.time = int(samples), feet[:n_feet], x_out, float(t)
