@@ -76,5 +76,5 @@ def test_a_plan_with_a_nan_footstep_is_refused_at_construction() -> None:
     feet[3, 0] = np.nan
     with pytest.raises(InputError, match=r"plan.footsteps\[3\]"):
         replace(plan, footsteps=feet)
-    with pytest.raises(InputError, match="plan.headings"):
+    with pytest.raises(InputError, match=r"plan\.headings"):
         replace(plan, headings=plan.headings[:-1])
