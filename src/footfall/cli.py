@@ -272,6 +272,11 @@ def plan(
         help="Beyond the document: bound each foot's horizontal swing (consecutive footholds of "
         "the same foot) to this length [m]; omitted: no bound.",
     ),
+    heading_segments: int = typer.Option(
+        16,
+        help="Heading segments L of the linear reach model (eq. 5.12f-h): more segments make it "
+        "less conservative (longer steps allowed) and the problem larger.",
+    ),
     out: Path = typer.Option(Path("out/plan"), help="Output folder for plan.json and plan.png."),
 ) -> None:
     """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists."""
@@ -292,6 +297,7 @@ def plan(
         region_margin=region_margin,
         reach_both_frames=reach_both_frames,
         swing_max=swing_max,
+        heading_segments=heading_segments,
     )
     robot_params = None if robot is None else _walker_params(robot, sc.robot)
     with console.status(f"planning {sc.name} with {planner} ...") as status:

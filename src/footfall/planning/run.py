@@ -70,12 +70,13 @@ def _search_note(found: int, start: int, tried: list[dict[str, object]]) -> str:
     open_ = [f"{t['n_steps']} ({t['status']})" for t in tried if t["status"] != "infeasible"]
     note = f"first N with a plan: {found} (searched from the lower bound {start}"
     if proven:
-        note += f"; proven infeasible: N = {', '.join(map(str, proven))}"
+        # proven for the planner's model (conservative linear reach): see the plans' messages
+        note += f"; proven infeasible: N = {', '.join(map(str, proven))} for the planner's model"
     if open_:
         return (
             note + f"; not decided: N = {', '.join(open_)}, so a plan with fewer steps may exist)"
         )
-    return note + f"; so {found} is the smallest N with a plan)"
+    return note + f"; so {found} is the smallest N with a plan in the planner's model)"
 
 
 def plan_min_steps(
