@@ -61,6 +61,7 @@ from footfall.planning.plan import (
     MAX_STEPS,
     FootstepPlan,
     PlannerOptions,
+    check_planning_arguments,
     goal_feet,
     result_meta,
     wrap_near,
@@ -166,6 +167,7 @@ def build_footstep_problem(
     Returns:
         The inspectable model.
     """
+    check_planning_arguments(scene, robot, options)
     robot = robot or scene.robot
     options = options or PlannerOptions()
     if isinstance(n_steps, bool) or not isinstance(n_steps, int) or not 1 <= n_steps <= MAX_STEPS:
@@ -544,6 +546,7 @@ def plan_footsteps(
     """
     from footfall.planning.diagnose import geometric_infeasibility
 
+    check_planning_arguments(scene, robot, options)
     options = options or PlannerOptions()
     fp = build_footstep_problem(scene, robot, n_steps, options)
     early = geometric_infeasibility(

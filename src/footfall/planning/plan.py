@@ -10,12 +10,12 @@ from typing import Any
 import numpy as np
 
 from footfall._typing import FloatArray
-from footfall._validate import non_negative, positive
+from footfall._validate import instance_of, non_negative, positive
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.solvers import KNOWN_BACKENDS
 from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
-from footfall.terrain.scene import robot_to_dict
+from footfall.terrain.scene import Scene, robot_to_dict
 
 PLANNERS = ("miqcqp", "kinematic", "reactive")
 #: the words of plan.json's ``alip.layout`` (see :meth:`FootstepPlan.to_dict`)
@@ -378,6 +378,16 @@ class FootstepPlan:
         """
         _check_stance_footsteps(data, source)
         return _plan_from_dict(data, robot, source)
+
+
+def check_planning_arguments(scene: object, robot: object = None, options: object = None) -> None:
+    """The argument types every planner takes: a :class:`Scene`, a :class:`BipedParams` or None,
+    :class:`PlannerOptions` or None; :class:`InputError` naming the argument otherwise."""
+    instance_of("scene", scene, Scene, "a Scene (footfall.terrain.resolve_scene)")
+    if robot is not None:
+        instance_of("robot", robot, BipedParams, "a BipedParams or None")
+    if options is not None:
+        instance_of("options", options, PlannerOptions, "a PlannerOptions or None")
 
 
 def wrap_near(angle: float, reference: float) -> float:

@@ -8,7 +8,12 @@ from dataclasses import replace
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
 from footfall.planning.diagnose import min_steps_lower_bound
-from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
+from footfall.planning.plan import (
+    FootstepPlan,
+    PlannerOptions,
+    check_planner_name,
+    check_planning_arguments,
+)
 from footfall.terrain.scene import Scene
 
 #: how many footsteps beyond the geometric lower bound ``--min-steps`` tries by default
@@ -33,6 +38,7 @@ def make_plan(
         options: planner options.
         robot: robot parameters (default ``scene.robot``).
     """
+    check_planning_arguments(scene, robot, options)
     check_planner_name(planner)
     options = options or PlannerOptions()
     if planner == "reactive":
