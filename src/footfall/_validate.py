@@ -71,3 +71,10 @@ def names_in(field: str, names: Sequence[str], valid: Sequence[str]) -> list[str
         if n not in valid:
             raise InputError(field, n, f"one of {', '.join(valid)}")
     return out
+
+
+def instance_of(field: str, value: object, types: type | tuple[type, ...], expected: str) -> None:
+    """Raise :class:`InputError` naming ``field`` unless ``value`` is one of ``types``: a public
+    function given the wrong type says which argument, instead of an AttributeError deep inside."""
+    if not isinstance(value, types):
+        raise InputError(field, type(value).__name__, expected)

@@ -314,6 +314,11 @@ def plan(
         help="Beyond the document: bound each foot's horizontal swing (consecutive footholds of "
         "the same foot) to this length [m]; omitted: no bound.",
     ),
+    heading_segments: int = typer.Option(
+        16,
+        help="Heading segments L of the linear reach model (eq. 5.12f-h): more segments make it "
+        "less conservative (longer steps allowed) and the problem larger.",
+    ),
     out: Path = typer.Option(Path("out/plan"), help="Output folder for plan.json and plan.png."),
 ) -> None:
     """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists."""
@@ -334,6 +339,7 @@ def plan(
         region_margin=region_margin,
         reach_both_frames=reach_both_frames,
         swing_max=swing_max,
+        heading_segments=heading_segments,
     )
     robot_params = None if robot is None else _walker_params(robot, sc.robot)
     with console.status(f"planning {sc.name} with {planner} ...") as status:
@@ -365,6 +371,41 @@ def plan(
         console.print("the plan violates the checker's constraints (see plan.json 'check')")
     if not result.reaches_goal:
         raise typer.Exit(1)
+
+
+@app.command("check")
+def check_command(
+    plan_file: Path = typer.Argument(..., help="A plan.json written by `footfall plan`."),
+    scene_file: Path | None = typer.Argument(None, help="Scene YAML file (or use --scene)."),
+    scene: str | None = typer.Option(None, help="Built-in scene name (see `footfall scenes`)."),
+    out: Path | None = typer.Option(
+        None, help="Output folder for check.json (omitted: print only)."
+    ),
+) -> None:
+    """Check a saved plan against a scene with the independent checker, for the robot the plan
+    was made for. Exit 0: valid; 1: a constraint is violated (each printed with its footstep and
+    amount); 2: bad input."""
+    from footfall.planning import check_plan, load_plan
+
+    sc = resolve_scene_arguments(scene_file, scene)
+    if out is not None:
+        output_folder(out)
+    result = load_plan(plan_file, sc)
+    report = check_plan(result, sc)
+    if out is not None:
+        lines = [] if report.ok else report.summary().splitlines()
+        payload = {"plan": str(plan_file), "scene": sc.name, "ok": report.ok, "violations": lines}
+        write_json(out / "check.json", {**payload, "checked": list(report.checked)})
+    if report.ok:
+        console.print(
+            f"{plan_file}: valid on {sc.name} ({result.n_steps} steps; checked "
+            f"{', '.join(report.checked)})"
+        )
+        return
+    console.print(f"{plan_file}: {len(report.violations)} violated constraint(s) on {sc.name}")
+    for v in report.violations:
+        console.print(f"  {v.describe()}")
+    raise typer.Exit(1)
 
 
 # --- quadruped (document 001) ---

@@ -5,7 +5,8 @@
   :func:`build_footstep_problem` returns its inspectable model.
 - :func:`plan_kinematic`, :func:`plan_reactive` — the two baselines; :func:`make_plan` dispatches
   by name and :func:`plan_min_steps` searches the smallest N.
-- :func:`check_plan` — an independent constraint checker.
+- :func:`check_plan` — an independent constraint checker; :func:`load_plan` reads a saved
+  ``plan.json`` back.
 """
 
 from footfall.planning.check import CheckReport, Violation, check_plan
@@ -14,6 +15,7 @@ from footfall.planning.lip_examples import example as lip_example
 from footfall.planning.lip_walk import LipWalk, LipWalkParams, lip_walk, optimal_foothold
 from footfall.planning.miqcqp import FootstepProblem, build_footstep_problem, plan_footsteps
 from footfall.planning.plan import PLANNERS, FootstepPlan, PlannerOptions, PlannerWeights
+from footfall.planning.plan_file import load_plan
 from footfall.planning.reactive import plan_reactive
 from footfall.planning.run import make_plan, plan_min_steps
 
@@ -31,6 +33,7 @@ __all__ = [
     "check_plan",
     "lip_example",
     "lip_walk",
+    "load_plan",
     "make_plan",
     "optimal_foothold",
     "plan_footsteps",

@@ -26,6 +26,7 @@ import numpy as np
 from footfall._io import write_json
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
+from footfall.planning.check import check_plan
 from footfall.planning.plan import FootstepPlan, PlannerOptions
 from footfall.planning.run import make_plan
 from footfall.terrain.scene import Scene, robot_to_dict, scene_to_dict
@@ -142,16 +143,46 @@ def cached_plan(
     """:func:`footfall.planning.make_plan`, served from ``cache`` when it holds the plan.
 
     Only plans with footsteps are stored: a failed search is made again next time (it may have
-    hit a time limit).
+    hit a time limit). A cached plan is re-checked before use (:func:`cache_mismatch`): one that
+    an edited or damaged file broke is discarded, planned again (the file is overwritten) and
+    the new plan's message says so.
     """
     options = options or PlannerOptions()
     robot = robot if robot is not None else scene.robot
     key = plan_key(scene, planner, n_steps, options, robot)
+    discarded = ""
     if cache is not None:
         hit = cache.load(key, robot)
         if hit is not None:
-            return hit
+            problem = cache_mismatch(hit, scene, n_steps)
+            if not problem:
+                return hit
+            discarded = f" (cached plan {cache.path(key).name} discarded: {problem}; planned again)"
     plan = make_plan(scene, planner, n_steps, options, robot)
     if cache is not None and plan.has_solution:
         cache.save(key, plan, scene.name)
+    if discarded:
+        plan = dataclasses.replace(plan, message=plan.message + discarded)
     return plan
+
+
+#: the checker's violations that no planner's output has, so a cached plan showing one was
+#: altered after it was made (a kinematic plan may exceed U_max and a reactive one stop short of
+#: the goal by design, so torque and goal are not among them)
+CACHE_RECHECK = ("start", "alternation", "region")
+
+
+def cache_mismatch(plan: FootstepPlan, scene: Scene, n_steps: int | None) -> str:
+    """Why a cached ``plan`` cannot be the one asked for on ``scene`` ("" when it can).
+
+    It must have footsteps (only those are stored), ``n_steps`` of them when N was asked for,
+    start from the scene's stance foot and keep every footstep on its region
+    (:func:`footfall.planning.check_plan`, the kinds of :data:`CACHE_RECHECK`).
+    """
+    if not plan.has_solution:
+        return "no footsteps"
+    if n_steps is not None and plan.n_steps != n_steps:
+        return f"{plan.n_steps} footsteps where N = {n_steps} was asked for"
+    report = check_plan(plan, scene)
+    bad = [v for v in report.violations if v.kind in CACHE_RECHECK]
+    return bad[0].describe() if bad else ""

@@ -17,6 +17,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from footfall._typing import FloatArray
+from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import FootstepPlan
 from footfall.terrain.scene import Scene
@@ -39,6 +40,14 @@ class Violation:
     step: int
     amount: float
     message: str
+
+    def describe(self) -> str:
+        """One line: the kind, the footstep (``step`` -1: the whole plan), the amount, the message.
+
+        The amount is in the kind's unit: m for geometry, rad for headings, N m for torques, the
+        state's mixed units for dynamics."""
+        where = "the whole plan" if self.step < 0 else f"footstep {self.step}"
+        return f"{self.kind} at {where} (amount {self.amount:.3g}): {self.message}"
 
 
 @dataclass(frozen=True)
@@ -65,10 +74,10 @@ class CheckReport:
         return {v.kind for v in self.violations}
 
     def summary(self) -> str:
-        """One line per violation (or "ok")."""
+        """One line per violation (:meth:`Violation.describe`), or "ok"."""
         if self.ok:
             return "ok"
-        return "\n".join(f"{v.kind} (step {v.step}): {v.message}" for v in self.violations)
+        return "\n".join(v.describe() for v in self.violations)
 
 
 def _inside_polygon(xy: FloatArray, corners: FloatArray, tol: float) -> float:
@@ -146,6 +155,12 @@ def check_plan(plan: FootstepPlan, scene: Scene, robot: BipedParams | None = Non
     (when the plan was made with ``swing_max``), heading rate, torque bound, ALIP dynamics and
     resets (re-simulated), and the goal (last two footsteps at the goal pose).
     """
+    if not isinstance(plan, FootstepPlan):
+        raise InputError("plan", plan, "a FootstepPlan (make_plan, load_plan)")
+    if not isinstance(scene, Scene):
+        raise InputError("scene", scene, "a Scene (footfall.terrain.resolve_scene)")
+    if robot is not None and not isinstance(robot, BipedParams):
+        raise InputError("robot", robot, "a BipedParams or None")
     robot = robot or plan.robot
     if not plan.has_solution:
         return CheckReport((Violation("no_solution", 0, math.inf, plan.message),), math.inf)

@@ -7,7 +7,7 @@ from collections import deque
 
 import numpy as np
 
-from footfall._geometry import point_polygon_distance
+from footfall._geometry import point_polygon_distance, rot2
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import goal_feet, wrap_near
 from footfall.terrain.scene import Scene
@@ -129,19 +129,80 @@ def geometric_infeasibility(
     return "infeasible: " + "; ".join(reasons) if reasons else None
 
 
+#: headings sampled across one heading segment by :func:`linear_reach_forward`
+_SEGMENT_SAMPLES = 33
+
+
+def linear_reach_forward(robot: BipedParams, heading_segments: int) -> tuple[float, float]:
+    """The longest forward step [m] the linear reach rows of eq. 5.12f allow with
+    ``heading_segments`` segments, and the reach polygon's own (its largest forward vertex).
+
+    With the heading ``theta`` in a segment ``[phi_l, phi_{l+1}]``, every trapezoid row is imposed
+    rotated to both segment ends with a positive bound shrunk by ``cos(dphi / 2)`` (module
+    docstring of :mod:`footfall.planning.miqcqp`), so the rows cut into the polygon. The first
+    value is the largest forward component ``q_x`` of a step (stance frame) the rows allow, the
+    best over headings sampled across a segment (a small linear program per heading).
+    """
+    from scipy.optimize import linprog
+
+    g_rows, h_rows = robot.reach.halfspaces(Side.RIGHT)
+    half = math.pi / heading_segments
+    h_eff = np.where(h_rows > 0, h_rows * math.cos(half), h_rows)
+    best = -math.inf
+    for t in np.linspace(-half, half, _SEGMENT_SAMPLES):
+        # the row (Rot(phi) g)^T d <= h' with d = Rot(theta) q is (Rot(phi - theta) g)^T q <= h'
+        a_ub = np.vstack([g_rows @ rot2(a).T for a in (-half - t, half - t)])
+        res = linprog(
+            [-1.0, 0.0], A_ub=a_ub, b_ub=np.concatenate([h_eff, h_eff]), bounds=(None, None)
+        )
+        if res.status == 0:
+            best = max(best, -float(res.fun))
+    return best, float(np.max(robot.reach.vertices[:, 0]))
+
+
+def reach_model_note(robot: BipedParams, heading_segments: int | None) -> str:
+    """What the planner's linear reach model (eq. 5.12f with L segments) gives up, in words."""
+    if heading_segments is None:
+        return "the planner's reach model (eq. 5.12f)"
+    linear, polygon = linear_reach_forward(robot, heading_segments)
+    return (
+        f"the conservative linear reach model (eq. 5.12f-h; with L = {heading_segments} heading "
+        f"segments it allows a forward step of at most about {linear:.3f} m where the reach "
+        f"polygon allows {polygon:.3f} m)"
+    )
+
+
 def diagnose_infeasible(
     scene: Scene,
     robot: BipedParams,
     n_steps: int,
     region_margin: float = 0.0,
     swing_max: float | None = None,
+    heading_segments: int | None = None,
+    torque_bound: bool = True,
 ) -> str:
-    """Say what is known about why ``n_steps`` footsteps cannot reach the goal of ``scene``."""
+    """Say what is known about why ``n_steps`` footsteps cannot reach the goal of ``scene``.
+
+    A geometric reason (:func:`geometric_infeasibility`) holds for any planner. Otherwise the
+    solver proved only that its model has no plan: the linear reach rows are conservative (see
+    :func:`linear_reach_forward`), so a plan the true reach polygon allows may exist, and the
+    message says so and names the option that relaxes the model (``heading_segments``). With
+    ``torque_bound`` False (the kinematic planner) the torque bound is not part of the model and
+    is not cited.
+    """
     found = geometric_infeasibility(scene, robot, n_steps, region_margin, swing_max)
     if found is not None:
         return found
+    torque = f", the ankle-torque bound U_max = {robot.u_max:g} N m" if torque_bound else ""
+    relax = (
+        "more heading segments make it less conservative (heading_segments / "
+        "--heading-segments, now "
+        f"{heading_segments}); or try more steps (--min-steps)"
+        if heading_segments is not None
+        else "try more steps (--min-steps)"
+    )
     return (
-        f"infeasible: no assignment of regions and headings satisfies reach, step height, torque "
-        f"bound ({robot.u_max:g} N m) and goal with {n_steps} footsteps; try more steps "
-        "(--min-steps)"
+        f"infeasible within the planner's model: no plan with {n_steps} footsteps satisfies the "
+        f"regions, {reach_model_note(robot, heading_segments)}, step height, heading rate"
+        f"{torque} and the goal; a plan outside this model is not ruled out: {relax}"
     )

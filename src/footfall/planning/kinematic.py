@@ -45,7 +45,15 @@ def plan_kinematic(
     meta = result_meta(res)
     if res.x is None:
         msg = (
-            diagnose_infeasible(scene, kin.robot, n_steps, options.region_margin, options.swing_max)
+            diagnose_infeasible(
+                scene,
+                kin.robot,
+                n_steps,
+                options.region_margin,
+                options.swing_max,
+                heading_segments=options.heading_segments,
+                torque_bound=False,
+            )
             if res.status is SolveStatus.INFEASIBLE
             else f"kinematic planner found no plan ({res.stats.get('raw_status')})"
         )
@@ -68,8 +76,16 @@ def plan_kinematic(
         dyn_problem = fix_variables(
             full.problem, np.concatenate(fixed_idx), np.concatenate(fixed_val)
         )
+        if dyn.status is SolveStatus.INFEASIBLE:
+            why = "no ALIP trajectory for these footsteps keeps"
+        else:  # time limit or error: nothing proven about the bound
+            why = f"no ALIP trajectory was found ({dyn.status.value}) that keeps"
         dyn = solve(dyn_problem, options.solver, solver_opts)
-        note += f"; these footsteps need more than U_max = {kin.robot.u_max:g} N m of ankle torque"
+        note += (
+            f"; {why} the ankle torque within U_max = {kin.robot.u_max:g} N m, which the "
+            "kinematic planner does not enforce: the trajectory shown is the least-torque one "
+            "without that bound"
+        )
     meta["stats"]["dynamics_status"] = dyn.status.value
     meta["stats"]["dynamics_objective"] = dyn.objective
     meta["solve_time"] = res.solve_time + dyn.solve_time

@@ -30,7 +30,7 @@ import numpy as np
 
 from footfall._geometry import rot2
 from footfall._typing import FloatArray
-from footfall._validate import finite_vector, non_negative, positive
+from footfall._validate import finite_vector, instance_of, non_negative, positive
 from footfall.errors import InputError
 from footfall.models.lip import GRAVITY, LIP
 
@@ -238,6 +238,7 @@ def lip_walk(params: LipWalkParams) -> LipWalk:
     Returns:
         The footholds, per-step initial CoM states and final state.
     """
+    instance_of("params", params, LipWalkParams, "a LipWalkParams (see footfall.planning)")
     lip = LIP(params.z_c, params.g)
     t_sup = params.t_sup
     tc = lip.Tc

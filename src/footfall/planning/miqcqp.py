@@ -61,6 +61,7 @@ from footfall.planning.plan import (
     MAX_STEPS,
     FootstepPlan,
     PlannerOptions,
+    check_planning_arguments,
     goal_feet,
     result_meta,
     wrap_near,
@@ -166,6 +167,7 @@ def build_footstep_problem(
     Returns:
         The inspectable model.
     """
+    check_planning_arguments(scene, robot, options)
     robot = robot or scene.robot
     options = options or PlannerOptions()
     if isinstance(n_steps, bool) or not isinstance(n_steps, int) or not 1 <= n_steps <= MAX_STEPS:
@@ -542,8 +544,9 @@ def plan_footsteps(
         A :class:`FootstepPlan`; its status says whether it is optimal (within the gap), a
         time-limited incumbent, or infeasible (with a diagnosis in ``message``).
     """
-    from footfall.planning.diagnose import diagnose_infeasible, geometric_infeasibility
+    from footfall.planning.diagnose import geometric_infeasibility
 
+    check_planning_arguments(scene, robot, options)
     options = options or PlannerOptions()
     fp = build_footstep_problem(scene, robot, n_steps, options)
     early = geometric_infeasibility(
@@ -560,16 +563,14 @@ def plan_footsteps(
             "miqcqp",
             SolveStatus.INFEASIBLE,
             fp.robot,
-            diagnose_infeasible(scene, fp.robot, n_steps, options.region_margin, options.swing_max),
+            _model_infeasible(scene, fp.robot, n_steps, options),
             solver=options.solver,
         )
     result = solve(fp.problem, options.solver, options.solver_options())
     meta = result_meta(result)
     if result.x is None:
         if result.status is SolveStatus.INFEASIBLE:
-            message = diagnose_infeasible(
-                scene, fp.robot, n_steps, options.region_margin, options.swing_max
-            )
+            message = _model_infeasible(scene, fp.robot, n_steps, options)
         elif result.status is SolveStatus.TIME_LIMIT:
             message = f"no feasible plan found within the time limit of {options.time_limit:g} s"
         else:
@@ -581,3 +582,20 @@ def plan_footsteps(
         SolveStatus.FEASIBLE: f"feasible plan, gap {result.gap:.3g}",
     }.get(result.status, "")
     return extract_plan(fp, result.x, message=message, **meta)
+
+
+def _model_infeasible(
+    scene: Scene, robot: BipedParams, n_steps: int, options: PlannerOptions
+) -> str:
+    """The message of a plan the MIQCQP proved infeasible: infeasible for its model (the
+    conservative linear reach with L heading segments), which rules out no other plan."""
+    from footfall.planning.diagnose import diagnose_infeasible
+
+    return diagnose_infeasible(
+        scene,
+        robot,
+        n_steps,
+        options.region_margin,
+        options.swing_max,
+        heading_segments=options.heading_segments,
+    )

@@ -10,14 +10,21 @@ from typing import Any
 import numpy as np
 
 from footfall._typing import FloatArray
-from footfall._validate import non_negative, positive
+from footfall._validate import instance_of, non_negative, positive
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.solvers import DEFAULT_SOLVER, KNOWN_BACKENDS
 from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
 from footfall.solvers.bnb import BnbSettings
+from footfall.terrain.scene import Scene, robot_to_dict
 
 PLANNERS = ("miqcqp", "kinematic", "reactive")
+#: the words of plan.json's ``alip.layout`` (see :meth:`FootstepPlan.to_dict`)
+ALIP_LAYOUT = (
+    "states[i] are the K nodes of single support on footstep i (stance_footstep[i] = i), "
+    "measured from footstep i; torques[i] act during that support; final_state is measured "
+    "from footstep N"
+)
 
 
 @dataclass(frozen=True)
@@ -313,8 +320,22 @@ class FootstepPlan:
         ``solve_time_s``, ``solver``, ``region_margin`` [m], ``reach_both_frames``, ``swing_max``
         [m] (null: no swing bound), ``heading_segments``, ``stats``, ``robot``, ``footsteps``
         (``index``, ``side``, ``position``, ``heading``, ``region``; index 0 is the initial stance
-        foot) and ``alip`` (``states`` per step: K states of 4; ``torques`` per step: K - 1
-        torques of 2; ``final_state``; the state layout). Unknown numbers (NaN, inf) are null.
+        foot) and ``alip``. Unknown numbers (NaN, inf) are null.
+
+        ``robot`` holds every field of the robot (the scene YAML schema's ``robot:``, from
+        :func:`footfall.terrain.scene.robot_to_dict`), so a reader can rebuild the robot the plan was
+        made for even when it is not the scene's (a MuJoCo walker's).
+
+        ``alip`` pairs each block of states with its footstep explicitly:
+
+        - ``states``: N blocks, block ``i`` is the K nodes of single support on footstep ``i``
+          (0..N-1; footstep 0 is the initial stance foot), measured from that footstep, each
+          state laid out as ``state_layout`` (x_c, y_c [m], L_x, L_y [kg m^2/s]);
+        - ``torques``: N blocks of K - 1 ankle torques (tau_x, tau_y) [N m], block ``i`` acting
+          during the single support on footstep ``i``;
+        - ``stance_footstep``: the footstep index of each block, ``[0, 1, ..., N-1]``;
+        - ``layout``: the sentence above in words, for a reader without this docstring;
+        - ``final_state``: the state after the last reset, relative to footstep N.
         """
         stats = {k: (_num(v) if isinstance(v, float) else v) for k, v in self.stats.items()}
         r = self.robot
@@ -333,14 +354,7 @@ class FootstepPlan:
             "swing_max": self.swing_max,
             "heading_segments": self.heading_segments,
             "stats": stats,
-            "robot": {
-                "mass": r.mass,
-                "com_height": r.com_height,
-                "t_ss": r.t_ss,
-                "t_ds": r.t_ds,
-                "n_nodes": r.n_nodes,
-                "u_max": r.u_max,
-            },
+            "robot": robot_to_dict(r),
             "footsteps": [
                 {
                     "index": i,
@@ -353,6 +367,8 @@ class FootstepPlan:
             ],
             "alip": {
                 "state_layout": ["x_c [m]", "y_c [m]", "L_x [kg m^2/s]", "L_y [kg m^2/s]"],
+                "layout": ALIP_LAYOUT,
+                "stance_footstep": list(range(self.states.shape[0])),
                 "states": self.states.tolist(),
                 "torques": self.torques.tolist(),
                 "final_state": [_num(v) for v in self.final_state],
@@ -365,9 +381,23 @@ class FootstepPlan:
 
         Every field is checked (types, shapes for ``robot.n_nodes``, finite numbers, known
         statuses and sides); a bad one raises :class:`InputError` naming ``source`` and the field.
-        Nothing in the file is executed: it is JSON data.
+        Nothing in the file is executed: it is JSON data. ``alip.layout`` is informative and
+        ignored; ``alip.stance_footstep``, when present, must be ``[0, 1, ..., N-1]`` (the only
+        pairing this format has), so a file that pairs the states otherwise is refused rather than
+        read with another meaning.
         """
+        _check_stance_footsteps(data, source)
         return _plan_from_dict(data, robot, source)
+
+
+def check_planning_arguments(scene: object, robot: object = None, options: object = None) -> None:
+    """The argument types every planner takes: a :class:`Scene`, a :class:`BipedParams` or None,
+    :class:`PlannerOptions` or None; :class:`InputError` naming the argument otherwise."""
+    instance_of("scene", scene, Scene, "a Scene (footfall.terrain.resolve_scene)")
+    if robot is not None:
+        instance_of("robot", robot, BipedParams, "a BipedParams or None")
+    if options is not None:
+        instance_of("options", options, PlannerOptions, "a PlannerOptions or None")
 
 
 def wrap_near(angle: float, reference: float) -> float:
@@ -392,6 +422,19 @@ def check_planner_name(name: str) -> str:
 def _num(v: float) -> float | None:
     """JSON has no NaN/inf: unknown numbers become null."""
     return float(v) if math.isfinite(v) else None
+
+
+def _check_stance_footsteps(data: object, source: str) -> None:
+    """``alip.stance_footstep`` of a plan file, when present, is ``[0, 1, ..., N-1]``."""
+    alip = data.get("alip") if isinstance(data, dict) else None
+    if not isinstance(alip, dict) or "stance_footstep" not in alip:
+        return  # files written before the key existed
+    pairing = alip["stance_footstep"]
+    states = alip.get("states")
+    n = len(states) if isinstance(states, list) else None
+    if n is None or pairing != list(range(n)):
+        want = f"[0, 1, ..., {n - 1}]" if n else "[] (one index per block of states)"
+        raise InputError(f"{source}.alip.stance_footstep", pairing, want)
 
 
 class _Reader:

@@ -8,7 +8,12 @@ from dataclasses import replace
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
 from footfall.planning.diagnose import min_steps_lower_bound
-from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
+from footfall.planning.plan import (
+    FootstepPlan,
+    PlannerOptions,
+    check_planner_name,
+    check_planning_arguments,
+)
 from footfall.terrain.scene import Scene
 
 #: how many footsteps beyond the geometric lower bound ``--min-steps`` tries by default
@@ -33,6 +38,7 @@ def make_plan(
         options: planner options.
         robot: robot parameters (default ``scene.robot``).
     """
+    check_planning_arguments(scene, robot, options)
     check_planner_name(planner)
     options = options or PlannerOptions()
     if planner == "reactive":
@@ -70,12 +76,13 @@ def _search_note(found: int, start: int, tried: list[dict[str, object]]) -> str:
     open_ = [f"{t['n_steps']} ({t['status']})" for t in tried if t["status"] != "infeasible"]
     note = f"first N with a plan: {found} (searched from the lower bound {start}"
     if proven:
-        note += f"; proven infeasible: N = {', '.join(map(str, proven))}"
+        # proven for the planner's model (conservative linear reach): see the plans' messages
+        note += f"; proven infeasible: N = {', '.join(map(str, proven))} for the planner's model"
     if open_:
         return (
             note + f"; not decided: N = {', '.join(open_)}, so a plan with fewer steps may exist)"
         )
-    return note + f"; so {found} is the smallest N with a plan)"
+    return note + f"; so {found} is the smallest N with a plan in the planner's model)"
 
 
 def plan_min_steps(

@@ -468,6 +468,10 @@ def load_scene(path_or_text: str | Path) -> Scene:
     Raises:
         SceneError: naming the field path and the line, e.g. ``start.left (line 12 of a.yaml)``.
     """
+    if not isinstance(path_or_text, str | Path):
+        raise SceneError(
+            "path_or_text", type(path_or_text).__name__, "a YAML file path (str or Path) or text"
+        )
     source: str | None = None
     if isinstance(path_or_text, Path) or (
         "\n" not in path_or_text

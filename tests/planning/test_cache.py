@@ -1,0 +1,49 @@
+"""The plan cache re-checks what it serves: an altered cached plan is discarded and made again."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from footfall.planning import PlannerOptions, check_plan, make_plan
+from footfall.planning.cache import PlanCache, cached_plan, plan_key
+from tests.planning.scenes import SHORT_FLAT, scene
+
+#: how far a tampered footstep is moved [m]: far off the 3 m x 2 m ground
+TAMPER = 5.0
+
+
+def test_a_valid_cached_plan_is_served(tmp_path: Path) -> None:
+    sc, cache = scene(SHORT_FLAT), PlanCache(tmp_path)
+    made = cached_plan(sc, "miqcqp", 3, cache=cache)
+    again = cached_plan(sc, "miqcqp", 3, cache=cache)
+    assert "loaded from cache" in again.message
+    np.testing.assert_array_equal(again.footsteps, made.footsteps)
+
+
+def test_a_tampered_cached_plan_is_not_returned(tmp_path: Path) -> None:
+    sc, cache = scene(SHORT_FLAT), PlanCache(tmp_path)
+    made = cached_plan(sc, "miqcqp", 3, cache=cache)
+    (path,) = tmp_path.glob("plan-*.json")
+    data = json.loads(path.read_text())
+    data["footsteps"][2]["position"][0] += TAMPER
+    path.write_text(json.dumps(data))
+    again = cached_plan(sc, "miqcqp", 3, cache=cache)
+    assert "loaded from cache" not in again.message
+    assert "discarded" in again.message and "footstep 2" in again.message
+    np.testing.assert_allclose(again.footsteps, made.footsteps, atol=1e-6)
+    assert check_plan(again, sc).ok
+    # the file was overwritten with the new plan: the next call is a clean hit
+    third = cached_plan(sc, "miqcqp", 3, cache=cache)
+    assert "loaded from cache" in third.message and "discarded" not in third.message
+
+
+def test_a_cached_plan_with_another_n_is_not_used(tmp_path: Path) -> None:
+    sc, cache = scene(SHORT_FLAT), PlanCache(tmp_path)
+    three = make_plan(sc, "miqcqp", 3)
+    cache.save(plan_key(sc, "miqcqp", 4, PlannerOptions()), three, sc.name)
+    four = cached_plan(sc, "miqcqp", 4, cache=cache)
+    assert four.n_steps == 4 and "discarded" in four.message
+    assert "loaded from cache" not in four.message
