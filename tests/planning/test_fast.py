@@ -20,10 +20,11 @@ from footfall.planning.check import check_plan
 from footfall.planning.miqcqp import build_footstep_problem, plan_footsteps
 from footfall.planning.plan import PlannerOptions
 from footfall.solvers import ProblemBuilder, SolverOptions, SolveStatus, bnb, solve
-from footfall.solvers.bnb import BnbSettings, branching, links, relaxation, workers
+from footfall.solvers.bnb import model as bnb_model
 from footfall.solvers.bnb import search as bnb_search
 from footfall.solvers.bnb import structure as bnb_structure
 from footfall.solvers.problem import MIQCQP, fix_variables
+from footfall.solvers.settings import BnbSettings, branching, links, relaxation, workers
 from footfall.terrain.scene import random_stepping_stones
 
 #: relative optimality gap of both solvers in the equality tests
@@ -394,7 +395,7 @@ def test_member_violations_are_the_largest_row_violations() -> None:
 
 def _link_structure(
     problem: MIQCQP, staircase: bool = True, min_drop: float = DEFAULTS.link_min_drop
-) -> bnb_structure._Structure:
+) -> bnb_model._Structure:
     settings = BnbSettings(links=True, staircase=staircase, link_min_drop=min_drop)
     return bnb.analyse(problem, settings=settings)
 

@@ -15,7 +15,7 @@ from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.solvers import DEFAULT_SOLVER, KNOWN_BACKENDS
 from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
-from footfall.solvers.bnb import BnbSettings
+from footfall.solvers.settings import BnbSettings
 from footfall.terrain.scene import Scene, robot_to_dict
 
 PLANNERS = ("miqcqp", "kinematic", "reactive")

@@ -4,15 +4,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import Enum
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from footfall._validate import non_negative, positive
-
-if TYPE_CHECKING:
-    from footfall.solvers.bnb import BnbSettings
+from footfall.errors import InputError
+from footfall.solvers.settings import BnbSettings
 
 
 class SolveStatus(str, Enum):
@@ -42,7 +41,7 @@ class SolverOptions:
         verbose: print the backend's log.
         seed: random seed of the backend.
         initial_solution: optional full variable vector used as a warm start (MIP start).
-        bnb: settings of the ``bnb`` backend (:class:`footfall.solvers.bnb.BnbSettings`; the
+        bnb: settings of the ``bnb`` backend (:class:`footfall.solvers.settings.BnbSettings`; the
             other backends ignore them).
     """
 
@@ -53,28 +52,16 @@ class SolverOptions:
     verbose: bool = False
     seed: int = 0
     initial_solution: NDArray[np.float64] | None = field(default=None, compare=False)
-    # a factory: importing the bnb package here would import this module back half-initialised
-    bnb: BnbSettings = field(default_factory=lambda: _bnb_settings()())
+    bnb: BnbSettings = field(default_factory=BnbSettings)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "time_limit", positive("time_limit", self.time_limit))
         object.__setattr__(self, "gap", non_negative("gap", self.gap))
         object.__setattr__(self, "abs_gap", non_negative("abs_gap", self.abs_gap))
         if isinstance(self.threads, bool) or not isinstance(self.threads, int) or self.threads < 1:
-            from footfall.errors import InputError
-
             raise InputError("threads", self.threads, "an integer >= 1")
-        if not isinstance(self.bnb, _bnb_settings()):
-            from footfall.errors import InputError
-
+        if not isinstance(self.bnb, BnbSettings):
             raise InputError("bnb", self.bnb, "a footfall.solvers.bnb.BnbSettings")
-
-
-def _bnb_settings() -> type[BnbSettings]:
-    """The class :class:`footfall.solvers.bnb.BnbSettings` (imported when first needed)."""
-    from footfall.solvers.bnb import BnbSettings
-
-    return BnbSettings
 
 
 @dataclass(frozen=True)

@@ -73,7 +73,7 @@ differ, the optimum within the gap does not). A worker that dies or raises stops
 limit, returning the best point and an honest gap; a node whose solve fails numerically makes the
 result ``feasible`` at best, never ``optimal``.
 
-Modules: :mod:`~footfall.solvers.bnb.settings` (:class:`BnbSettings`),
+Modules: :mod:`~footfall.solvers.settings` (:class:`BnbSettings`),
 :mod:`~footfall.solvers.bnb.structure` (:func:`analyse`), :mod:`~footfall.solvers.bnb.links`,
 :mod:`~footfall.solvers.bnb.templates` and :mod:`~footfall.solvers.bnb.relaxation` (the node
 relaxation), :mod:`~footfall.solvers.bnb.branching`, :mod:`~footfall.solvers.bnb.workers`,
@@ -84,9 +84,9 @@ from __future__ import annotations
 
 from footfall.solvers.bnb.relaxation import HullRelaxation
 from footfall.solvers.bnb.search import NAME, solve
-from footfall.solvers.bnb.settings import BnbSettings
 from footfall.solvers.bnb.structure import UnsupportedProblem, analyse
 from footfall.solvers.bnb.workers import WorkerError
+from footfall.solvers.settings import BnbSettings
 
 __all__ = [
     "NAME",

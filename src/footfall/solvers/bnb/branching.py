@@ -17,8 +17,8 @@ import numpy as np
 
 from footfall._typing import FloatArray
 from footfall.solvers.bnb.links import _propagate
+from footfall.solvers.bnb.model import _Structure
 from footfall.solvers.bnb.relaxation import HullRelaxation
-from footfall.solvers.bnb.structure import _Structure
 
 
 @dataclass(order=True)

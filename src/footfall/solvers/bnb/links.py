@@ -9,30 +9,11 @@ form a staircase (:func:`_staircase`), and children drop the members left withou
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-from footfall._typing import FloatArray, IntArray
-from footfall.solvers.bnb.settings import BnbSettings
-
-if TYPE_CHECKING:
-    from footfall.solvers.bnb.structure import _Structure
-
-
-@dataclass(frozen=True)
-class _Link:
-    """Two choice groups coupled by plain rows, and the member pairs those rows allow.
-
-    Attributes:
-        groups: the two group indices ``(g1, g2)``.
-        pairs: binaries ``(z1, z2)`` of the compatible member pairs, (P, 2); a pair is dropped only
-            when the plain rows between the groups cannot hold on the box both members imply.
-    """
-
-    groups: tuple[int, int]
-    pairs: IntArray
+from footfall._typing import FloatArray
+from footfall.solvers.bnb.model import _Link, _Structure
+from footfall.solvers.settings import BnbSettings
 
 
 def _staircase(

@@ -27,9 +27,9 @@ from footfall.solvers.bnb.workers import _Workers
 
 if TYPE_CHECKING:
     from footfall.solvers.base import SolverOptions
+    from footfall.solvers.bnb.model import _Structure
     from footfall.solvers.bnb.relaxation import HullRelaxation
-    from footfall.solvers.bnb.settings import BnbSettings
-    from footfall.solvers.bnb.structure import _Structure
+    from footfall.solvers.settings import BnbSettings
 
 #: a node's allowed members: per group, the binaries it may still use
 Allowed = tuple[tuple[int, ...], ...]

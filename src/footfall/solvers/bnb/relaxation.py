@@ -18,8 +18,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from footfall._typing import FloatArray, IntArray
-from footfall.solvers.bnb.settings import BnbSettings
-from footfall.solvers.bnb.structure import _Structure
+from footfall.solvers.bnb.model import _Structure
 from footfall.solvers.bnb.templates import (
     _Base,
     _cat,
@@ -29,6 +28,7 @@ from footfall.solvers.bnb.templates import (
     _templates,
     _with_prefix,
 )
+from footfall.solvers.settings import BnbSettings
 
 #: Clarabel statuses that end a node solve (anything else is retried once, then "failed")
 _CLARABEL_DONE = ("Solved", "AlmostSolved", "PrimalInfeasible", "AlmostPrimalInfeasible")

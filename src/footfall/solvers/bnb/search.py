@@ -22,8 +22,9 @@ from footfall._typing import FloatArray
 from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
 from footfall.solvers.bnb import probing
 from footfall.solvers.bnb.branching import _branch, _choice, _dive, _finish, _Node, _root_allowed
+from footfall.solvers.bnb.model import _Structure
 from footfall.solvers.bnb.relaxation import HullRelaxation, _Relaxation
-from footfall.solvers.bnb.structure import UnsupportedProblem, _Structure, analyse
+from footfall.solvers.bnb.structure import UnsupportedProblem, analyse
 from footfall.solvers.bnb.workers import _Workers
 from footfall.solvers.problem import MIQCQP
 

@@ -20,7 +20,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from footfall._typing import FloatArray, IntArray
-from footfall.solvers.bnb.structure import _Group, _Member, _Structure
+from footfall.solvers.bnb.model import _Group, _Member, _Structure
 from footfall.solvers.problem import MIQCQP
 
 
