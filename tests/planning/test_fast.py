@@ -20,11 +20,12 @@ from footfall.planning.check import check_plan
 from footfall.planning.miqcqp import build_footstep_problem, plan_footsteps
 from footfall.planning.plan import PlannerOptions
 from footfall.solvers import ProblemBuilder, SolverOptions, SolveStatus, bnb, solve
+from footfall.solvers.bnb import branching, links, relaxation, workers
 from footfall.solvers.bnb import model as bnb_model
 from footfall.solvers.bnb import search as bnb_search
 from footfall.solvers.bnb import structure as bnb_structure
 from footfall.solvers.problem import MIQCQP, fix_variables
-from footfall.solvers.settings import BnbSettings, branching, links, relaxation, workers
+from footfall.solvers.settings import BnbSettings
 from footfall.terrain.scene import random_stepping_stones
 
 #: relative optimality gap of both solvers in the equality tests
