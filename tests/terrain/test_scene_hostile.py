@@ -70,3 +70,25 @@ def test_non_utf8_bytes_name_the_file(tmp_path: Path) -> None:
     bad.write_bytes(b"name: \xff\xfe\n")
     with pytest.raises(SceneError, match="UTF-8"):
         load_scene(bad)
+
+
+def test_too_many_regions_are_refused_before_they_are_built() -> None:
+    import yaml
+
+    from footfall.terrain.terrain import MAX_REGIONS
+
+    data = yaml.safe_load(scene_to_yaml(builtin_scene("flat")))
+    square = [[0.0, 0.0], [0.5, 0.0], [0.5, 0.5], [0.0, 0.5]]
+    data["regions"] = [
+        {"name": f"r{i}", "height": 0.0, "vertices": square} for i in range(MAX_REGIONS + 1)
+    ]
+    with pytest.raises(SceneError, match="regions"):
+        load_scene(yaml.safe_dump(data))
+
+
+def test_python_tags_run_nothing(tmp_path: Path) -> None:
+    marker = tmp_path / "pwned"
+    text = f'name: !!python/object/apply:os.system ["touch {marker}"]\n'
+    with pytest.raises(SceneError, match="constructor"):
+        load_scene(text)
+    assert not marker.exists()

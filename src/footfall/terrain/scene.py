@@ -26,7 +26,7 @@ from footfall._validate import finite, finite_vector
 from footfall.errors import InputError, SceneError
 from footfall.models.biped import BipedParams, ReachTrapezoid, Side
 from footfall.terrain.region import Region
-from footfall.terrain.terrain import Terrain
+from footfall.terrain.terrain import MAX_REGIONS, Terrain
 
 #: tolerance [m] for the start feet and the goal to count as on a region (plane and polygon); looser
 #: than Region.contains' default because hand-written YAML heights are rounded
@@ -395,6 +395,8 @@ def _pydantic_error(err: ValidationError, loc: _Locator) -> SceneError:
     return loc.error(path, first.get("input"), f"{first['msg'].lower()}{more}")
 
 
+#: YAML's safe loader (no Python objects from tags), libyaml's C implementation when installed
+_SAFE_LOADER: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 #: largest scene file or text accepted [bytes]; the largest built-in scene is a few kB
 MAX_SCENE_BYTES = 4_000_000
 #: most YAML nodes a scene may expand to, aliases counted at every use (a ~1 kB "billion laughs"
@@ -485,9 +487,10 @@ def load_scene(path_or_text: str | Path) -> Scene:
     if len(text) > MAX_SCENE_BYTES:
         raise SceneError("scene", f"{len(text)} characters", f"at most {MAX_SCENE_BYTES}")
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        root = yaml.compose(text, Loader=_SAFE_LOADER)
         _check_expanded_size(root, source)
-        data = yaml.safe_load(text)
+        # constructed from the checked node graph: the text is parsed once
+        data = None if root is None else _SAFE_LOADER("").construct_document(root)
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f" (line {mark.line + 1}" + (f" of {source})" if source else ")") if mark else ""
@@ -500,6 +503,11 @@ def load_scene(path_or_text: str | Path) -> Scene:
     loc = _Locator(root, source)
     if not isinstance(data, dict):
         raise loc.error((), type(data).__name__, "a mapping with name, start, goal and regions")
+    regions = data.get("regions")
+    if (
+        isinstance(regions, list) and len(regions) > MAX_REGIONS
+    ):  # refuse before any work per region
+        raise loc.error(("regions",), f"{len(regions)} regions", f"1..{MAX_REGIONS} regions")
     try:
         spec = _SceneSpec.model_validate(data)
     except ValidationError as e:
