@@ -1,0 +1,5 @@
+"""``python -m footfall.cli``: the same as ``footfall``."""
+
+from footfall.cli import main
+
+main()

@@ -1,0 +1,101 @@
+"""What every ``footfall`` command shares: the app, the console, option conventions and checks."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import typer
+from rich.console import Console
+from rich.text import Text
+
+from footfall.errors import InputError
+
+app = typer.Typer(
+    name="footfall",
+    help="Footstep planning for legged robots (LIP/ALIP, MIQCQP planner, quadruped ZMP gaits).",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    # help texts are plain text: units like [s] and extras like footfall[robots] must show as typed
+    rich_markup_mode=None,
+)
+#: user-facing messages (scene names, paths, install hints) are printed as typed, never as markup
+console = Console(stderr=True, markup=False, highlight=False, soft_wrap=True)
+
+
+def _say_error(prefix: str, message: str) -> None:
+    """Print ``prefix: message`` on stderr, the prefix in bold red, the message as plain text."""
+    console.print(Text(f"{prefix}: ", style="bold red") + Text(message))
+
+
+@app.callback()
+def _root() -> None:
+    """Footstep planning for legged robots (LIP/ALIP, MIQCQP planner, quadruped ZMP gaits)."""
+
+
+_THREADS_HELP = (
+    "Worker processes of the bnb backend / solver threads (default: 2, or the cores if fewer; "
+    "at most the cores this process may use)."
+)
+
+
+def _threads(threads: int | None) -> int:
+    """``--threads``: as given, or the default of two workers where two cores exist."""
+    if threads is not None:
+        return threads
+    from footfall.planning.plan import available_cores
+
+    return min(2, available_cores())
+
+
+def output_folder(out: Path) -> Path:
+    """Create ``out`` (and its parents) and check that it is a writable folder, before any work
+    whose result would otherwise be lost."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise InputError("out", str(out), "a folder (a file of that name exists)") from None
+    except OSError as e:
+        raise InputError("out", str(out), f"a folder that can be created ({e.strerror})") from None
+    if not out.is_dir():
+        raise InputError("out", str(out), "a folder (a file of that name exists)")
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise InputError("out", str(out), "a folder this user may write to")
+    return out
+
+
+def parse_floats(field: str, text: str) -> list[float]:
+    """Parse a comma-separated list of numbers, naming ``field`` on error."""
+    try:
+        return [float(v) for v in text.split(",") if v.strip() != ""]
+    except ValueError:
+        raise InputError(field, text, "comma-separated numbers, e.g. 0,0.3,0.3") from None
+
+
+@contextmanager
+def _progress_bar() -> Iterator[Callable[[str, int, int], None]]:
+    """A console progress bar; yields ``progress(what, done, total)`` (total 0: unknown)."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn())
+    with Progress(*columns, TimeElapsedColumn(), console=console) as bar:
+        task = bar.add_task("planning", total=None)
+
+        def progress(what: str, done: int, total: int) -> None:
+            bar.update(task, description=what, completed=done, total=total or None)
+
+        yield progress
+
+
+def _list_arg(text: str) -> list[str]:
+    """The non-empty items of a comma-separated option."""
+    return [item.strip() for item in text.split(",") if item.strip()]
+
+
+def _positive_int(field: str, value: int) -> int:
+    if value < 1:
+        raise InputError(field, value, "an integer >= 1")
+    return value

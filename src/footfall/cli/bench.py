@@ -1,0 +1,142 @@
+"""``footfall bench``: timings as ratios against a baseline measured in the same run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from footfall._io import write_json
+from footfall.cli._common import (
+    _threads,
+    app,
+    console,
+    parse_floats,
+)
+from footfall.errors import InputError
+from footfall.terrain.resolve import resolve_scene
+
+# --- bench (issue 5) ---
+bench_app = typer.Typer(help="Benchmarks.", no_args_is_help=True)
+app.add_typer(bench_app, name="bench")
+
+
+@bench_app.command("plan")
+def bench_plan_cmd(
+    steps: str = typer.Option("6,10,15", help="Numbers of footsteps N, comma separated."),
+    nodes: str = typer.Option("5,10", help="Numbers of ALIP nodes K, comma separated."),
+    seeds: str = typer.Option("0,1,2", help="Seeds of the random stepping-stone scenes."),
+    regions: int = typer.Option(8, help="Regions per random scene."),
+    scenes: str = typer.Option("", help="Built-in scenes to add, comma separated."),
+    time_limit_direct: float = typer.Option(60.0, help="Time limit of the direct SCIP model [s]."),
+    time_limit_fast: float = typer.Option(60.0, help="Time limit of the fast planner [s]."),
+    gap: float = typer.Option(1e-3, help="Relative optimality gap of both."),
+    fast_only: bool = typer.Option(False, help="Skip the direct model."),
+    fast_threads: int = typer.Option(2, help="Worker processes of the fast planner."),
+    out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_plan.json/.md."),
+) -> None:
+    """Direct SCIP model vs the fast planner on the same instances: a table of times and gaps."""
+    from footfall.experiments.bench import bench_plan, format_table, rows_to_dict
+
+    def ints(field: str, text: str) -> list[int]:
+        vals = parse_floats(field, text)
+        if not vals or any(v != int(v) or v < 1 for v in vals):
+            raise InputError(field, text, "comma-separated positive integers, e.g. 6,10")
+        return [int(v) for v in vals]
+
+    def ints0(field: str, text: str) -> list[int]:
+        vals = parse_floats(field, text)
+        if not vals or any(v != int(v) or v < 0 for v in vals):
+            raise InputError(field, text, "comma-separated integers >= 0, e.g. 0,1,2")
+        return [int(v) for v in vals]
+
+    rows = bench_plan(
+        n_steps=ints("steps", steps),
+        n_nodes=ints("nodes", nodes),
+        seeds=ints0("seeds", seeds),
+        n_regions=regions,
+        scenes=[s for s in scenes.split(",") if s.strip()],
+        time_limit_direct=time_limit_direct,
+        time_limit_fast=time_limit_fast,
+        gap=gap,
+        direct=not fast_only,
+        fast_threads=fast_threads,
+        progress=lambda run: console.print(
+            f"{run.instance} N={run.n_steps} K={run.n_nodes} {run.solver}: {run.status} "
+            f"{run.time:.2f} s obj {run.objective:.6g}"
+        ),
+    )
+    table = format_table(rows)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(out / "bench_plan.json", {"runs": rows_to_dict(rows)})
+    (out / "bench_plan.md").write_text(table + "\n")
+    print(table)
+
+
+@bench_app.command("sim")
+def bench_sim_cmd(
+    scene: str = typer.Option("flat", "--scene", help="Built-in scene name or YAML file."),
+    planner: str = typer.Option(
+        "reactive", help="Planner of the walk: miqcqp, kinematic, reactive."
+    ),
+    nodes: str = typer.Option(
+        "plan,10", help="MPC nodes K, comma separated ('plan': the plan robot's K)."
+    ),
+    runs: int = typer.Option(5, help="Timed runs per engine and K."),
+    rate: float = typer.Option(500.0, help="Control rate [Hz]."),
+    out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_sim.json/.md."),
+) -> None:
+    """Reduced-order closed loop (issue 4): x real time of the python and compiled engines.
+
+    The walk has estimate noise and two pushes; the engines run alternately in the same run.
+    """
+    from footfall.experiments.bench import (
+        bench_sim,
+        bench_sim_options,
+        format_sim_table,
+        sim_speed_to_dict,
+    )
+    from footfall.planning import PlannerOptions, make_plan
+    from footfall.planning.plan import check_planner_name
+
+    check_planner_name(planner)
+    k_list: list[int | None] = []
+    for item in (s.strip() for s in nodes.split(",")):
+        if item == "plan":
+            k_list.append(None)
+        elif item.isdigit() and int(item) >= 2:
+            k_list.append(int(item))
+        else:
+            raise InputError(
+                "nodes", nodes, "comma-separated integers >= 2 or 'plan', e.g. plan,10"
+            )
+    sc = resolve_scene(scene)
+    plan = make_plan(sc, planner, None, PlannerOptions(threads=_threads(None)))
+    if not plan.has_solution:
+        from footfall.errors import InfeasibleError
+
+        raise InfeasibleError(f"{planner} found no plan for {sc.name}: {plan.message}")
+    rows = bench_sim(plan, k_list, runs=runs, options=bench_sim_options(rate))
+    table = format_sim_table(rows)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(
+        out / "bench_sim.json",
+        {"scene": sc.name, "planner": planner, "rows": sim_speed_to_dict(rows)},
+    )
+    (out / "bench_sim.md").write_text(table + "\n")
+    print(table)
+
+
+@bench_app.command("quadruped")
+def bench_quadruped_cmd(
+    slope_deg: float = typer.Option(15.0, help="Slope angle [deg]."),
+    body_deg: float = typer.Option(10.0, help="Body angle [deg]."),
+    out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_quadruped.json."),
+) -> None:
+    """Quadruped slope walk: simulated s per wall s vs bare mj_step, and gait-plan time."""
+    from footfall.experiments.bench import benchmark_quadruped
+
+    result = benchmark_quadruped(slope_deg=slope_deg, body_deg=body_deg)
+    write_json(out / "bench_quadruped.json", result)
+    for key, value in result.items():
+        console.print(f"{key}: {value}")

@@ -1,0 +1,445 @@
+"""Commands that walk plans: ``simulate`` and ``compare`` (000 sec. 5.5), ``walk`` (MuJoCo bipeds),
+``quadruped`` (001) and the ``demo``."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import typer
+
+from footfall._io import write_json
+from footfall._validate import names_in, non_negative
+from footfall.cli._common import (
+    _THREADS_HELP,
+    _list_arg,
+    _positive_int,
+    _progress_bar,
+    _threads,
+    app,
+    console,
+    output_folder,
+)
+from footfall.errors import InputError
+from footfall.terrain.resolve import resolve_scene, resolve_scene_arguments
+
+
+# --- demo ---
+@app.command()
+def demo(out: Path = typer.Option(Path("out/demo"), help="Output folder.")) -> None:
+    """Run the main demo on built-in defaults and write figures and JSON into OUT."""
+    from footfall.experiments.demo import run_demo
+
+    labels = {
+        "lip": "LIP walks (document 004)",
+        "plans": "footstep plans (document 000)",
+        "closed_loop": "MPC closed loop (document 000 eq. 5.19)",
+        "quadruped": "quadruped on a slope in MuJoCo (document 001)",
+    }
+    with console.status("footfall demo") as status:
+        summary = run_demo(out, progress=lambda key: status.update(f"demo: {labels[key]} ..."))
+    for line in summary["lines"]:
+        typer.echo(line)
+    typer.echo(f"wrote {out / 'demo.json'}")
+
+
+# --- quadruped (document 001) ---
+@app.command("quadruped")
+def quadruped_cmd(
+    slope_deg: float = typer.Option(15.0, help="Slope angle beta_S [deg]."),
+    body_deg: float = typer.Option(
+        10.0, help="Body angle beta_B to the horizontal [deg], in [0, slope]."
+    ),
+    step: float = typer.Option(0.4, help="Step length S along the slope [m]."),
+    height: float = typer.Option(0.1, help="Swing height H normal to the slope [m]."),
+    cycles: int = typer.Option(6, help="Number of gait cycles."),
+    swing_period: float = typer.Option(0.5, help="Swing period T_w [s]."),
+    shift_period: float = typer.Option(1.5, help="Duration of each body shift [s]."),
+    strategy: str = typer.Option("osp", help="ZMP placement: osp, incentre or transverse."),
+    compare: bool = typer.Option(False, help="Also run the other strategies (body sway table)."),
+    out: Path = typer.Option("out/quadruped", help="Output folder."),
+    video: bool = typer.Option(True, "--video/--no-video", help="Render an MP4 (offscreen GL)."),
+) -> None:
+    """Walk gait up a slope (document 001): plan with ZMP/OSP, simulate in MuJoCo, measure."""
+    import math
+
+    if video:
+        # must be chosen before MuJoCo is imported; EGL works headless here
+        os.environ.setdefault("MUJOCO_GL", "egl")
+    from footfall.experiments.slope_walk import compare_strategies, plan_strategies
+    from footfall.quadruped import GaitParams, QuadrupedRobot, ZmpStrategy
+    from footfall.sim.quadruped.sim import simulate
+    from footfall.viz.quadruped_plots import save_walk_figures
+
+    if not math.isfinite(slope_deg) or not 0.0 <= slope_deg <= 60.0:
+        raise InputError("--slope-deg", slope_deg, "a slope in [0, 60] deg")
+    if not math.isfinite(body_deg) or not 0.0 <= body_deg <= slope_deg:
+        raise InputError(
+            "--body-deg", body_deg, f"a body angle within [0, --slope-deg] = [0, {slope_deg:g}] deg"
+        )
+    try:
+        strat = ZmpStrategy(strategy)
+    except ValueError:
+        raise InputError("--strategy", strategy, "one of osp, incentre, transverse") from None
+    params = GaitParams(
+        slope=math.radians(slope_deg),
+        body_pitch=math.radians(body_deg),
+        step=step,
+        swing_height=height,
+        swing_period=swing_period,
+        shift_period=shift_period,
+        cycles=cycles,
+        strategy=strat,
+    )
+    output_folder(out)
+    plans, infeasible = plan_strategies(QuadrupedRobot(), params, compare)
+    plan = plans[strat]
+    console.print(f"simulating {cycles} cycles on {slope_deg:g} deg ({plan.duration:.1f} s)...")
+    res = simulate(plan, video_path=out / "quadruped.mp4" if video else None)
+    if video and res.video is None:
+        console.print(res.video_note)
+    payload = res.metrics.to_dict()
+    if compare:
+        payload["strategy_comparison"] = compare_strategies(plans, res)
+        payload["strategy_comparison_infeasible"] = infeasible
+    figs = save_walk_figures(plan, res, out, f"{slope_deg:g}°/{body_deg:g}°")
+    payload["figures"] = [str(f) for f in figs]
+    write_json(out / "quadruped.json", payload)
+    m = res.metrics
+    console.print(
+        f"distance {m.distance_up_slope_m:.2f} m, speed {m.mean_speed_m_s:.3f} m/s, "
+        f"fell {m.fell}, margin min {m.stability_margin_min_m:.3f} m "
+        f"mean {m.stability_margin_mean_m:.3f} m, {m.realtime_factor:.0f}x real time"
+    )
+    console.print(f"wrote {out / 'quadruped.json'}")
+
+
+@app.command("simulate")
+def simulate_command(
+    scene: str = typer.Option("flat", "--scene", help="Built-in scene name or YAML file."),
+    planner: str = typer.Option("miqcqp", help="Planner: miqcqp, kinematic or reactive."),
+    steps: int | None = typer.Option(
+        None, help="Footsteps N of miqcqp/kinematic (default: the smallest N with a miqcqp plan)."
+    ),
+    time_limit: float = typer.Option(60.0, "--time-limit", help="Planner time limit [s]."),
+    threads: int | None = typer.Option(None, help=_THREADS_HELP),
+    push: float = typer.Option(0.0, help="Push impulse [N s]; 0 for none."),
+    push_time: float = typer.Option(1.0, help="Push start time [s]."),
+    push_direction: float = typer.Option(90.0, help="Push direction [deg] (0 = +x, 90 = +y)."),
+    push_duration: float = typer.Option(0.1, help="Push pulse length [s]."),
+    noise_pos: float = typer.Option(0.0, help="CoM position estimate noise (std) [m]."),
+    noise_vel: float = typer.Option(0.0, help="CoM velocity estimate noise (std) [m/s]."),
+    placement_error: float = typer.Option(0.0, help="Landing error (std per axis) [m]."),
+    mass_scale: float = typer.Option(1.0, help="True mass / model mass."),
+    com_height_scale: float = typer.Option(1.0, help="True CoM height / model CoM height."),
+    rate: float = typer.Option(500.0, help="Control rate [Hz]."),
+    seed: int = typer.Option(0, help="Random seed."),
+    engine: str = typer.Option(
+        "auto", help="Loop engine: auto, compiled (numba) or python (reference)."
+    ),
+    out: Path = typer.Option(Path("out/simulate"), help="Output folder."),
+) -> None:
+    """Plan a scene, walk it in closed loop (MPC eq. 5.19 on the ALIP plant), write sim.json + figures."""
+    import math
+
+    from footfall.planning import PlannerOptions, make_plan
+    from footfall.planning.plan import check_planner_name
+    from footfall.sim import Push, SimOptions, simulate
+    from footfall.sim.reduced.closed_loop import run_report
+    from footfall.viz.sim_plots import save_sim_figures
+
+    check_planner_name(planner)
+    opts = SimOptions(
+        control_rate=rate,
+        noise_pos=noise_pos,
+        noise_vel=noise_vel,
+        mass_scale=mass_scale,
+        com_height_scale=com_height_scale,
+        pushes=(Push.horizontal(push_time, push, math.radians(push_direction), push_duration),)
+        if push != 0
+        else (),
+        placement_error=placement_error,
+        seed=seed,
+        engine=engine,
+    )
+    sc = resolve_scene(scene)
+    output_folder(out)
+    # the reactive planner walks until the goal: --steps is for the horizon planners
+    n = None if planner == "reactive" else steps
+    plan = make_plan(
+        sc, planner, n, PlannerOptions(time_limit=time_limit, threads=_threads(threads))
+    )
+    if not plan.has_solution:
+        from footfall.errors import InfeasibleError
+
+        raise InfeasibleError(f"{planner} found no plan for {sc.name}: {plan.message}")
+    res = simulate(plan, opts, goal=sc.goal.position)
+    m = res.metrics
+    write_json(out / "sim.json", run_report(sc.name, plan, opts, res))
+    figs = save_sim_figures(res, out, sc.terrain)
+    outcome = f"FELL at {m.fall_time:.2f} s" if m.fell else ("stopped" if m.stopped else "walked")
+    typer.echo(
+        f"{sc.name} / {planner}: {outcome}; single-support ZMP offset mean "
+        f"{1000 * m.zmp_offset_mean:.1f} mm, max {1000 * m.zmp_offset_max:.1f} mm; "
+        f"goal error {m.goal_error:.3f} m; wrote {out / 'sim.json'} and {len(figs)} figures"
+    )
+
+
+# --- compare (issue 4) ---
+#: help of the walks' ``--heading-segments`` (``walk``, ``compare --sim mujoco``)
+_WALK_SEGMENTS_HELP = (
+    "Heading segments L of the miqcqp / kinematic plans (eq. 5.12g-h); default: 64 for the "
+    "robot-aware plans (with 16, straight plans step wide at theta = 0, a breakpoint of the 16; "
+    "see plan_for_walk), the document's 16 with --document-reach."
+)
+
+
+@app.command("compare")
+def compare_command(
+    scenes: str = typer.Option(
+        "discrete_steps,stairs_slope_gap", help="Comma-separated scene names or YAML files."
+    ),
+    planners: str = typer.Option("miqcqp,kinematic,reactive", help="Comma-separated planners."),
+    trials: int = typer.Option(50, help="Seeded trials per scene and planner."),
+    workers: int = typer.Option(2, help="Worker processes."),
+    steps: str | None = typer.Option(
+        None,
+        help="Footsteps N of miqcqp/kinematic: one number, or per scene 'name=N,name=N' "
+        "(default: the smallest N with a miqcqp plan).",
+    ),
+    time_limit: float = typer.Option(60.0, "--time-limit", help="Planner time limit [s]."),
+    threads: int | None = typer.Option(None, help=_THREADS_HELP),
+    push_max: float = typer.Option(15.0, help="Push impulses uniform in [0, push_max] [N s]."),
+    noise_pos: float = typer.Option(0.002, help="CoM position estimate noise (std) [m]."),
+    noise_vel: float = typer.Option(0.02, help="CoM velocity estimate noise (std) [m/s]."),
+    placement_error: float = typer.Option(0.01, help="Landing error (std per axis) [m]."),
+    mismatch: float = typer.Option(0.0, help="Mass/CoM-height mismatch fraction (uniform +-)."),
+    rate: float = typer.Option(500.0, help="Control rate [Hz]."),
+    out: Path = typer.Option(Path("out/compare"), help="Output folder (plans cached in plans/)."),
+    sim: str = typer.Option(
+        "reduced",
+        help="reduced: the ALIP plant (fast, --trials disturbed trials); mujoco: the 30 kg biped "
+        "in MuJoCo (--trials seeded walks, each with one push of push_max N s over 0.1 s).",
+    ),
+    robot_aware: bool = typer.Option(
+        True,
+        "--robot-aware/--document-reach",
+        help="--sim mujoco: plan miqcqp/kinematic with the options beyond the document (as "
+        "`walk`); --document-reach: the document's problem (the reduced simulation always is).",
+    ),
+    heading_segments: int | None = typer.Option(None, help="--sim mujoco: " + _WALK_SEGMENTS_HELP),
+) -> None:
+    """Section 5.5: every planner through the same MPC and plant over seeded disturbed trials."""
+
+    if sim not in ("reduced", "mujoco"):
+        raise InputError("sim", sim, "reduced or mujoco")
+    n_steps = _steps_arg(steps)
+    if sim == "mujoco":
+        _compare_mujoco(
+            scenes,
+            planners,
+            trials,
+            push_max,
+            time_limit,
+            out,
+            n_steps,
+            robot_aware,
+            heading_segments,
+        )
+        return
+
+    from footfall.experiments.compare import (
+        TrialSpec,
+        describe,
+        run_compare,
+        summary_lines,
+        write_outputs,
+    )
+    from footfall.planning.plan import PLANNERS, PlannerOptions
+
+    _positive_int("trials", trials)
+    _positive_int("workers", workers)
+    names = names_in("planners", planners.split(","), PLANNERS)
+    spec = TrialSpec(
+        push_max=push_max,
+        noise_pos=noise_pos,
+        noise_vel=noise_vel,
+        placement_error=placement_error,
+        mismatch=mismatch,
+        control_rate=rate,
+    )
+    scene_objs = {sc.name: sc for sc in map(resolve_scene, _list_arg(scenes))}
+    output_folder(out)
+    if not scene_objs:
+        raise InputError("scenes", scenes, "one or more scene names or YAML files")
+    # The MPC's small matrices run fastest single-threaded; spawned workers read this.
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    with _progress_bar() as progress:
+        options = PlannerOptions(time_limit=time_limit, threads=_threads(threads))
+        rows, table, plans = run_compare(
+            scene_objs, names, trials, out, spec, workers, n_steps, options, progress
+        )
+    paths = write_outputs(out, rows, table, describe(spec, trials, time_limit, plans))
+    for line in summary_lines(table):
+        console.print(line)
+    console.print(f"wrote {', '.join(str(p) for p in paths)}")
+
+
+def _steps_arg(steps: str | None) -> int | dict[str, int] | None:
+    """``--steps`` of ``compare``: one N for every scene, or ``scene=N,scene=N``."""
+    if steps is None:
+        return None
+    out: int | dict[str, int]
+    try:
+        if "=" in steps:
+            out = {k.strip(): int(v) for k, v in (kv.split("=") for kv in steps.split(","))}
+        else:
+            out = int(steps)
+    except ValueError:
+        raise InputError("steps", steps, "an integer or 'scene=N,scene=N'") from None
+    values = out.values() if isinstance(out, dict) else [out]
+    if any(v < 1 for v in values):
+        raise InputError("steps", steps, "step counts >= 1")
+    return out
+
+
+def _compare_mujoco(
+    scenes: str,
+    planners: str,
+    trials: int,
+    push_max: float,
+    time_limit: float,
+    out: Path,
+    n_steps: int | dict[str, int] | None = None,
+    robot_aware: bool = True,
+    heading_segments: int | None = None,
+) -> None:
+    """``compare --sim mujoco``: the section 5.5 table from MuJoCo walks (issue 7)."""
+    from footfall.experiments.compare_mujoco import (
+        compare_mujoco,
+        compare_table,
+        describe,
+        steps_per_pair,
+        summary_lines,
+        write_mujoco_outputs,
+    )
+    from footfall.planning.plan import PLANNERS
+    from footfall.sim.biped.plans import PUSH_DURATION
+    from footfall.terrain.scene import builtin_scene_names
+
+    _positive_int("trials", trials)
+    output_folder(out)
+    push_max = non_negative("push_max", push_max)
+    names = names_in("planners", planners.split(","), PLANNERS)
+    scene_names = names_in("scenes", _list_arg(scenes), builtin_scene_names())
+    force = push_max / PUSH_DURATION
+    per_pair = steps_per_pair(scene_names, names, n_steps)
+    with console.status("walking in MuJoCo ...") as status:
+        rows = compare_mujoco(
+            scene_names,
+            names,
+            seeds=tuple(range(trials)),
+            push=force,
+            n_steps=per_pair,
+            time_limit=time_limit,
+            cache_dir=out / "plans",
+            progress=lambda line: status.update(line),
+            robot_aware=robot_aware,
+            heading_segments=heading_segments,
+        )
+    table = compare_table(rows)
+    paths = write_mujoco_outputs(out, rows, table, describe(trials, force, PUSH_DURATION))
+    for line in summary_lines(table):
+        console.print(line)
+    console.print(f"wrote {', '.join(str(p) for p in paths)}")
+
+
+# --- walk (issue 7) ---
+@app.command("walk")
+def walk_cmd(
+    scene_file: Path | None = typer.Argument(None, help="Scene YAML file (or use --scene)."),
+    scene: str | None = typer.Option(None, help="Built-in scene name (see `footfall scenes`)."),
+    planner: str = typer.Option("miqcqp", help="miqcqp, kinematic or reactive."),
+    steps: int | None = typer.Option(
+        None, help="Footsteps N (optimising planners); omitted: the smallest N with a plan."
+    ),
+    time_limit: float = typer.Option(300.0, help="Planner time limit per solve [s]."),
+    push: float = typer.Option(0.0, help="Magnitude of one seeded horizontal push [N] (0: none)."),
+    seed: int = typer.Option(0, help="Seed of the push direction and timing."),
+    out: Path = typer.Option(Path("out/walk"), help="Output folder."),
+    video: bool = typer.Option(True, "--video/--no-video", help="Write walk.mp4 (offscreen GL)."),
+    robot: str = typer.Option(
+        "biped",
+        help="biped (ours) or g1 (Unitree G1 from example-robot-data: pip install "
+        "'footfall[robots]'); the plan is made for its measured mass, CoM height and feet.",
+    ),
+    robot_aware: bool = typer.Option(
+        True,
+        "--robot-aware/--document-reach",
+        help="Plan miqcqp/kinematic with the options beyond the document (reach in both feet's "
+        "frames, swing bound); --document-reach: eq. (5.12f) in the stance foot's frame only.",
+    ),
+    heading_segments: int | None = typer.Option(None, help=_WALK_SEGMENTS_HELP),
+) -> None:
+    """Walk a footstep plan with the MuJoCo biped (document 000, section 5.5).
+
+    Writes walk.json (fell or not, time to goal, footstep tracking error, single-support ZMP
+    offset statistics per step), walk.png, walk.mp4 and plan.json (the plan walked; plans are
+    cached in --out/plans and reused while nothing they depend on changes). Exit 1 when the robot falls or misses the goal.
+    The optimising planners plan for this robot beyond the document: each step in the reach set
+    of both feet's frames and every swing at most ``SWING_MAX`` (``plan_for_walk``), unless
+    ``--document-reach``.
+    """
+
+    if video:
+        # headless offscreen rendering; MuJoCo picks its GL backend when it is first imported
+        os.environ.setdefault("MUJOCO_GL", "egl")
+    from footfall.planning.plan import check_planner_name
+    from footfall.sim.biped.options import WalkOptions
+    from footfall.sim.biped.plans import plan_for_walk, random_push, robot_model
+    from footfall.sim.biped.result import walk_report
+    from footfall.sim.biped.walk import walk
+    from footfall.viz.walk_plot import plot_walk
+
+    check_planner_name(planner)
+    if steps is not None and steps < 1:
+        raise InputError("steps", steps, "an integer >= 1")
+    push = non_negative("push", push)
+    model = robot_model(robot)
+    sc = resolve_scene_arguments(scene_file, scene)
+    output_folder(out)
+    with console.status(f"planning {sc.name} with {planner} for the {robot} ..."):
+        plan = plan_for_walk(
+            sc,
+            planner,
+            steps,
+            time_limit,
+            out / "plans",
+            model=model,
+            robot_aware=robot_aware,
+            heading_segments=heading_segments,
+        )
+    write_json(out / "plan.json", plan.to_dict(sc.name))
+    if not plan.has_solution:
+        console.print(f"{sc.name}: {planner} found no plan ({plan.status.value}). {plan.message}")
+        raise typer.Exit(1)
+    pushes = (random_push(seed, push, plan, WalkOptions()),) if push > 0 else ()
+    opts = WalkOptions(pushes=pushes)
+    with console.status(f"walking {plan.n_steps} steps in MuJoCo ..."):
+        res = walk(
+            sc, plan, opts, model_params=model, video_path=out / "walk.mp4" if video else None
+        )
+    write_json(out / "walk.json", walk_report(sc.name, planner, robot, plan, pushes, res))
+    plot_walk(res, sc, out / "walk.png", title=f"{sc.name}, {planner}, {robot}")
+    m = res.metrics
+    console.print(
+        f"{sc.name} / {planner} / {robot}: {plan.n_steps} steps, fell={m.fell}, "
+        f"reached goal={m.reached_goal}, footstep error mean "
+        f"{m.footstep_error_m.mean:.3f} m, ZMP offset mean {m.zmp.mean:.3f} m "
+        f"max {m.zmp.max:.3f} m"
+    )
+    if res.video_note:
+        console.print(res.video_note)
+    console.print(f"wrote {out / 'walk.json'}, walk.png" + (", walk.mp4" if res.video else ""))
+    if m.fell or not m.reached_goal:
+        raise typer.Exit(1)
