@@ -458,7 +458,7 @@ class _Reader:
     ) -> FloatArray:
         try:
             arr = np.array(value, dtype=float)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise self.bad(fld, value, f"numbers of shape {shape}") from None
         if arr.shape != shape:
             raise self.bad(fld, value, f"numbers of shape {shape}, got {arr.shape}")
@@ -473,14 +473,26 @@ class _Reader:
             raise self.bad(fld, value, "a number or null")
         return float(value)
 
+    def nullable_list(self, value: object, fld: str) -> list[Any]:
+        """A list whose nulls (unknown numbers) become NaN."""
+        if not isinstance(value, list):
+            raise self.bad(fld, value, "a list of numbers or nulls")
+        return [math.nan if v is None else v for v in value]
+
+    def flag(self, value: object, fld: str) -> bool:
+        if not isinstance(value, bool):
+            raise self.bad(fld, value, "true or false")
+        return value
+
     def sides(self, steps: list[Any]) -> list[Side]:
         """The side of every footstep, checking that each also names its region."""
         sides = []
         for i, st in enumerate(steps):
+            side = self.get(st, "side", f"footsteps[{i}]")
             try:
-                sides.append(Side(self.get(st, "side", f"footsteps[{i}]")))
-            except ValueError:
-                raise self.bad(f"footsteps[{i}].side", st["side"], "'left' or 'right'") from None
+                sides.append(Side(side))
+            except (TypeError, ValueError):
+                raise self.bad(f"footsteps[{i}].side", side, "'left' or 'right'") from None
             region = self.get(st, "region", f"footsteps[{i}]")
             if not isinstance(region, str):
                 raise self.bad(f"footsteps[{i}].region", region, "a region name")
@@ -491,10 +503,11 @@ def _plan_from_dict(data: object, robot: BipedParams, source: str) -> FootstepPl
     """See :meth:`FootstepPlan.from_dict`."""
     r = _Reader(source)
     bad, get, array, number = r.bad, r.get, r.array, r.number
+    status_value = get(data, "status", "status")
     try:
-        status = SolveStatus(get(data, "status", "status"))
-    except ValueError:
-        raise bad("status", get(data, "status", "status"), "a SolveStatus value") from None
+        status = SolveStatus(status_value)
+    except (TypeError, ValueError):
+        raise bad("status", status_value, "a SolveStatus value") from None
     steps = get(data, "footsteps", "footsteps")
     if not isinstance(steps, list):
         raise bad("footsteps", steps, "a list of footsteps")
@@ -525,7 +538,7 @@ def _plan_from_dict(data: object, robot: BipedParams, source: str) -> FootstepPl
         states=array(get(alip, "states", "alip"), "alip.states", (n, k, 4)),
         torques=array(get(alip, "torques", "alip"), "alip.torques", (n, k - 1, 2)),
         final_state=array(
-            [math.nan if v is None else v for v in get(alip, "final_state", "alip")],
+            r.nullable_list(get(alip, "final_state", "alip"), "alip.final_state"),
             "alip.final_state",
             (4,),
             nan_ok=True,
@@ -537,7 +550,7 @@ def _plan_from_dict(data: object, robot: BipedParams, source: str) -> FootstepPl
         solver=str(data.get("solver", "none")),
         message=str(data.get("message", "")),
         region_margin=number(data.get("region_margin"), "region_margin", 0.0),
-        reach_both_frames=bool(data.get("reach_both_frames", False)),
+        reach_both_frames=r.flag(data.get("reach_both_frames", False), "reach_both_frames"),
         swing_max=None if swing is None else number(swing, "swing_max", math.nan),
         heading_segments=segments,
     )

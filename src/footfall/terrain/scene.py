@@ -495,18 +495,15 @@ def load_scene(path_or_text: str | Path) -> Scene:
         mark = getattr(e, "problem_mark", None)
         where = f" (line {mark.line + 1}" + (f" of {source})" if source else ")") if mark else ""
         problem = getattr(e, "problem", None) or str(e)
-        raise SceneError(
-            f"yaml{where}",
-            text.splitlines()[mark.line] if mark else None,
-            f"valid YAML ({problem})",
-        ) from None
+        lines = text.splitlines()
+        shown = lines[mark.line] if mark and mark.line < len(lines) else None  # past the end: EOF
+        raise SceneError(f"yaml{where}", shown, f"valid YAML ({problem})") from None
     loc = _Locator(root, source)
     if not isinstance(data, dict):
         raise loc.error((), type(data).__name__, "a mapping with name, start, goal and regions")
     regions = data.get("regions")
-    if (
-        isinstance(regions, list) and len(regions) > MAX_REGIONS
-    ):  # refuse before any work per region
+    # refused before any work per region
+    if isinstance(regions, list) and len(regions) > MAX_REGIONS:
         raise loc.error(("regions",), f"{len(regions)} regions", f"1..{MAX_REGIONS} regions")
     try:
         spec = _SceneSpec.model_validate(data)
