@@ -11,6 +11,7 @@ from footfall.cli._common import (
     _threads,
     app,
     console,
+    output_folder,
     parse_floats,
 )
 from footfall.errors import InputError
@@ -50,6 +51,7 @@ def bench_plan_cmd(
             raise InputError(field, text, "comma-separated integers >= 0, e.g. 0,1,2")
         return [int(v) for v in vals]
 
+    output_folder(out)
     rows = bench_plan(
         n_steps=ints("steps", steps),
         n_nodes=ints("nodes", nodes),
@@ -67,7 +69,6 @@ def bench_plan_cmd(
         ),
     )
     table = format_table(rows)
-    out.mkdir(parents=True, exist_ok=True)
     write_json(out / "bench_plan.json", {"runs": rows_to_dict(rows)})
     (out / "bench_plan.md").write_text(table + "\n")
     print(table)
@@ -111,6 +112,7 @@ def bench_sim_cmd(
                 "nodes", nodes, "comma-separated integers >= 2 or 'plan', e.g. plan,10"
             )
     sc = resolve_scene(scene)
+    output_folder(out)
     plan = make_plan(sc, planner, None, PlannerOptions(threads=_threads(None)))
     if not plan.has_solution:
         from footfall.errors import InfeasibleError
@@ -118,7 +120,6 @@ def bench_sim_cmd(
         raise InfeasibleError(f"{planner} found no plan for {sc.name}: {plan.message}")
     rows = bench_sim(plan, k_list, runs=runs, options=bench_sim_options(rate))
     table = format_sim_table(rows)
-    out.mkdir(parents=True, exist_ok=True)
     write_json(
         out / "bench_sim.json",
         {"scene": sc.name, "planner": planner, "rows": sim_speed_to_dict(rows)},
@@ -136,6 +137,7 @@ def bench_quadruped_cmd(
     """Quadruped slope walk: simulated s per wall s vs bare mj_step, and gait-plan time."""
     from footfall.experiments.bench import benchmark_quadruped
 
+    output_folder(out)
     result = benchmark_quadruped(slope_deg=slope_deg, body_deg=body_deg)
     write_json(out / "bench_quadruped.json", result)
     for key, value in result.items():
