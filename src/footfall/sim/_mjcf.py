@@ -55,3 +55,42 @@ class SimSettings:
         for name in ("timestep", "kp", "kv", "torque_limit", "friction", "impratio"):
             object.__setattr__(self, name, positive(f"sim.{name}", getattr(self, name)))
         object.__setattr__(self, "armature", non_negative("sim.armature", self.armature))
+
+
+def mjcf_preamble(
+    settings: SimSettings, joint_damping: float, geom_default: str, shadow_size: int
+) -> str:
+    """The ``<compiler>``, ``<option>``, ``<visual>`` and ``<default>`` elements every generated
+    robot shares: radians, the implicit-fast integrator with an elliptic friction cone (feet do
+    not creep on slopes), an offscreen buffer for 1280 x 720 video, and the joint defaults."""
+    s = settings
+    return f"""<compiler angle="radian" autolimits="true"/>
+  <option timestep="{s.timestep:.6g}" integrator="implicitfast" cone="elliptic"
+          impratio="{s.impratio:.6g}"/>
+  <visual>
+    <global offwidth="1280" offheight="720"/>
+    <quality shadowsize="{shadow_size}"/>
+  </visual>
+  <default>
+    <joint damping="{joint_damping:g}" armature="{s.armature:.6g}"/>
+    <geom {geom_default}/>
+  </default>"""
+
+
+#: the checker texture of the ground and the robot's materials, shared by every generated model
+GRID_TEXTURE = """<texture name="grid" type="2d" builtin="checker" rgb1="0.55 0.6 0.55" rgb2="0.45 0.5 0.45"
+             width="512" height="512"/>"""
+ROBOT_MATERIALS = """<material name="body" rgba="0.25 0.35 0.6 1"/>
+    <material name="leg" rgba="0.7 0.7 0.72 1"/>
+    <material name="joint" rgba="0.3 0.3 0.3 1"/>
+    <material name="foot" rgba="0.15 0.15 0.15 1"/>"""
+
+
+def position_actuator(name: str, joint_attr: str, settings: SimSettings) -> str:
+    """A position servo on a joint (``joint_attr`` is the quoted attribute value) with the
+    settings' gains and torque limit."""
+    s = settings
+    return (
+        f'<position name="{name}" joint={joint_attr} kp="{s.kp:.6g}" kv="{s.kv:.6g}" '
+        f'forcerange="{fmt(-s.torque_limit, s.torque_limit)}"/>'
+    )

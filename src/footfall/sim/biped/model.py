@@ -29,7 +29,16 @@ from footfall._validate import non_negative, positive
 from footfall.control.adjusters import U_MAX_FOOT_SHARE
 from footfall.errors import FootfallError, InputError
 from footfall.models.biped import BipedParams, Side
-from footfall.sim._mjcf import SimSettings, box_inertia, fmt, rod_inertia
+from footfall.sim._mjcf import (
+    GRID_TEXTURE,
+    ROBOT_MATERIALS,
+    SimSettings,
+    box_inertia,
+    fmt,
+    mjcf_preamble,
+    position_actuator,
+    rod_inertia,
+)
 from footfall.sim.biped import names as nm
 
 #: the planner's swing bound L_swing for this biped [m] (``PlannerOptions.swing_max``, beyond the
@@ -369,32 +378,18 @@ def biped_mjcf(
     ti = fmt(*box_inertia(p.torso_mass, *p.torso_size))
     legs = "".join(_leg_xml(p, s, side) for side in (Side.LEFT, Side.RIGHT))
     actuators = "\n    ".join(
-        f'<position name="{nm.actuator(side, j)}" joint="{nm.joint(side, j)}" '
-        f'kp="{s.kp:.6g}" kv="{s.kv:.6g}" forcerange="{fmt(-s.torque_limit, s.torque_limit)}"/>'
+        position_actuator(nm.actuator(side, j), f'"{nm.joint(side, j)}"', s)
         for side in (Side.LEFT, Side.RIGHT)
         for j in nm.LEG_JOINTS
     )
+    preamble = mjcf_preamble(s, 0.5, f'solref="0.004 1" group="{nm.ROBOT_GROUP}"', 2048)
     col = f'contype="{nm.ROBOT_CONTYPE}" conaffinity="{nm.ROBOT_CONAFFINITY}"'
     return f"""<mujoco model="{nm.MODEL_NAME}">
-  <compiler angle="radian" autolimits="true"/>
-  <option timestep="{s.timestep:.6g}" integrator="implicitfast" cone="elliptic"
-          impratio="{s.impratio:.6g}"/>
-  <visual>
-    <global offwidth="1280" offheight="720"/>
-    <quality shadowsize="2048"/>
-  </visual>
-  <default>
-    <joint damping="0.5" armature="{s.armature:.6g}"/>
-    <geom solref="0.004 1" group="{nm.ROBOT_GROUP}"/>
-  </default>
+  {preamble}
   <asset>
-    <texture name="grid" type="2d" builtin="checker" rgb1="0.55 0.6 0.55" rgb2="0.45 0.5 0.45"
-             width="512" height="512"/>
+    {GRID_TEXTURE}
     <material name="terrain" texture="grid" texrepeat="4 4" texuniform="true"/>
-    <material name="body" rgba="0.25 0.35 0.6 1"/>
-    <material name="leg" rgba="0.7 0.7 0.72 1"/>
-    <material name="joint" rgba="0.3 0.3 0.3 1"/>
-    <material name="foot" rgba="0.15 0.15 0.15 1"/>
+    {ROBOT_MATERIALS}
     {asset_xml}
   </asset>
   <worldbody>

@@ -25,7 +25,16 @@ import numpy as np
 from footfall._validate import positive
 from footfall.errors import InputError
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
-from footfall.sim._mjcf import SimSettings, box_inertia, fmt, rod_inertia
+from footfall.sim._mjcf import (
+    GRID_TEXTURE,
+    ROBOT_MATERIALS,
+    SimSettings,
+    box_inertia,
+    fmt,
+    mjcf_preamble,
+    position_actuator,
+    rod_inertia,
+)
 from footfall.sim.quadruped import names as nm
 
 #: joint axes in the parent body frame, in ``JOINT_NAMES`` order (ab/ad about x, pitch/knee about y)
@@ -132,33 +141,19 @@ def quadruped_mjcf(
     bi = box_inertia(robot.body_mass, robot.body_length, robot.body_width, robot.body_height)
     legs = "".join(_leg_xml(robot, s, i) for i in range(len(LEGS)))
     actuators = "\n    ".join(
-        f'<position name="{nm.actuator(leg, jn)}" joint={quoteattr(nm.joint(leg, jn))} '
-        f'kp="{s.kp:.6g}" kv="{s.kv:.6g}" forcerange="{fmt(-s.torque_limit, s.torque_limit)}"/>'
+        position_actuator(nm.actuator(leg, jn), quoteattr(nm.joint(leg, jn)), s)
         for leg in LEGS
         for jn in JOINT_NAMES
     )
+    preamble = mjcf_preamble(s, 2.0, 'solref="0.005 1"', 0)
     half = (robot.body_length / 2, robot.body_width / 2, robot.body_height / 2)
     return f"""<mujoco model="{nm.MODEL_NAME}">
-  <compiler angle="radian" autolimits="true"/>
-  <option timestep="{s.timestep:.6g}" integrator="implicitfast" cone="elliptic"
-          impratio="{s.impratio:.6g}"/>
-  <visual>
-    <global offwidth="1280" offheight="720"/>
-    <quality shadowsize="0"/>
-  </visual>
-  <default>
-    <joint damping="2" armature="{s.armature:.6g}"/>
-    <geom solref="0.005 1"/>
-  </default>
+  {preamble}
   <asset>
-    <texture name="grid" type="2d" builtin="checker" rgb1="0.55 0.6 0.55" rgb2="0.45 0.5 0.45"
-             width="512" height="512"/>
+    {GRID_TEXTURE}
     <material name="ground" texture="grid" texrepeat="8 8" texuniform="true"/>
     <material name="stairs" rgba="0.6 0.55 0.5 1"/>
-    <material name="body" rgba="0.25 0.35 0.6 1"/>
-    <material name="leg" rgba="0.7 0.7 0.72 1"/>
-    <material name="joint" rgba="0.3 0.3 0.3 1"/>
-    <material name="foot" rgba="0.15 0.15 0.15 1"/>
+    {ROBOT_MATERIALS}
   </asset>
   <worldbody>
     <light pos="0 -3 6" dir="0 0.4 -1" directional="true"/>
