@@ -47,3 +47,26 @@ def test_a_cached_plan_with_another_n_is_not_used(tmp_path: Path) -> None:
     four = cached_plan(sc, "miqcqp", 4, cache=cache)
     assert four.n_steps == 4 and "discarded" in four.message
     assert "loaded from cache" not in four.message
+
+
+def test_a_scene_name_never_reaches_a_path(tmp_path: Path) -> None:
+    from dataclasses import replace
+
+    plans = tmp_path / "out" / "plans"
+    sc = replace(scene(SHORT_FLAT), name="../../../escaped")
+    cached_plan(sc, "miqcqp", 3, cache=PlanCache(plans))
+    written = [p for p in tmp_path.rglob("*") if p.is_file()]
+    assert written and all(p.parent == plans for p in written), written
+    assert all(p.name.startswith("plan-") and p.suffix == ".json" for p in written)
+
+
+def test_an_edited_scene_of_the_same_name_is_planned_again(tmp_path: Path) -> None:
+    from dataclasses import replace
+
+    cache = PlanCache(tmp_path)
+    sc = scene(SHORT_FLAT)
+    cached_plan(sc, "miqcqp", 3, cache=cache)
+    moved = replace(sc, goal=replace(sc.goal, position=sc.goal.position + np.array([0.05, 0, 0])))
+    again = cached_plan(moved, "miqcqp", 3, cache=cache)
+    assert "loaded from cache" not in again.message
+    assert len(list(tmp_path.glob("plan-*.json"))) == 2
