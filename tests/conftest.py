@@ -3,10 +3,23 @@
 import os
 from dataclasses import replace
 
+from hypothesis import settings
+
 from footfall.planning.plan import FootstepPlan
 
 # MuJoCo picks its GL backend at import; offscreen EGL works headless (tests that render say so).
 os.environ.setdefault("MUJOCO_GL", "egl")
+
+# Hypothesis draws the same examples on every run by default (profile "ci", also what CI runs), so
+# a failure reproduces from the test id alone and a green run means the same thing everywhere;
+# FOOTFALL_HYPOTHESIS=dev draws fresh examples each run (and keeps failures in .hypothesis/) to
+# look for new counterexamples. Tests keep their own max_examples; deadline None because the
+# examples solve problems whose time varies with machine load.
+settings.register_profile(
+    "ci", derandomize=True, max_examples=100, deadline=None, print_blob=True, database=None
+)
+settings.register_profile("dev", derandomize=False, max_examples=100, deadline=None)
+settings.load_profile(os.environ.get("FOOTFALL_HYPOTHESIS", "ci"))
 
 
 #: agreement between closed-form/discrete models and a tight solve_ivp integration
