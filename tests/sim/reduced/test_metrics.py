@@ -4,6 +4,7 @@ trajectories of a run with numpy, and on a hand-made trace whose values are know
 from __future__ import annotations
 
 import math
+import time
 from types import SimpleNamespace
 
 import numpy as np
@@ -95,6 +96,10 @@ def hand_made_run() -> tuple[SimpleNamespace, SimpleNamespace]:
     # landed: the first step 5 cm off (3, 4 cm), the second on the plan
     feet = np.array([[0, 0.1, 0], [0.33, -0.06, 0], [0.6, 0.1, 0]])
     n = single.size
+    # the engines preallocate: rows past `samples` are never written and must be ignored
+    pad = 3
+    single, stance = np.r_[single, [True] * pad], np.r_[stance, [1] * pad]
+    cop_off, sat = np.vstack([cop_off, np.full((pad, 2), 9.0)]), np.r_[sat, [True] * pad]
     plan = SimpleNamespace(
         footsteps=plan_feet,
         headings=np.zeros(4),
@@ -112,14 +117,14 @@ def hand_made_run() -> tuple[SimpleNamespace, SimpleNamespace]:
     )
     trace = SimpleNamespace(
         samples=n,
-        t=np.arange(n) * 0.01,
+        t=np.arange(n + pad) * 0.01,
         stance=stance,
         single=single,
-        com=np.zeros((n, 2)),
-        cop=np.zeros((n, 2)),
+        com=np.arange(2 * (n + pad)).reshape(-1, 2) * 0.1,
+        cop=np.arange(2 * (n + pad)).reshape(-1, 2) * 0.2,
         cop_off=cop_off,
-        tau_cmd=np.zeros((n, 2)),
-        tau=np.zeros((n, 2)),
+        tau_cmd=np.arange(2 * (n + pad)).reshape(-1, 2) * 0.3,
+        tau=np.arange(2 * (n + pad)).reshape(-1, 2) * 0.4,
         sat=sat,
         solve_times=np.array([1e-4, 2e-4, 3e-4]),
         feet=feet,
@@ -135,7 +140,9 @@ def hand_made_run() -> tuple[SimpleNamespace, SimpleNamespace]:
 
 def test_metrics_of_a_hand_made_trace_have_their_closed_form_values() -> None:
     walk, trace = hand_made_run()
-    met = _result(walk, trace, "python", 0.0).metrics  # type: ignore[arg-type]
+    t0 = time.perf_counter()
+    res = _result(walk, trace, "python", t0)  # type: ignore[arg-type]
+    met = res.metrics
     assert met.zmp_offset_mean == pytest.approx(0.21 / 6, rel=1e-12)
     assert met.zmp_offset_rms == pytest.approx(math.sqrt(0.0139 / 6), rel=1e-12)
     assert met.zmp_offset_max == pytest.approx(0.1, rel=1e-12)
@@ -151,3 +158,71 @@ def test_metrics_of_a_hand_made_trace_have_their_closed_form_values() -> None:
     # at rest on the last foot: the capture point is inside the final soles
     assert met.stopped and met.success
     assert met.mpc_time_max == 3e-4 and met.mpc_time_median == 2e-4
+    assert met.mpc_time_p99 == pytest.approx(2.98e-4, rel=1e-12)  # linear interpolation
+    assert (met.mpc_solves, met.mpc_fallbacks, met.sim_time) == (3, 0, 0.08)
+    assert not met.fell and math.isnan(met.fall_time) and met.engine == "python"
+    assert 0.0 <= met.wall_time < 60.0
+    # the trajectories are the written samples, trimmed; the rest is echoed
+    n = trace.samples
+    for got, want in (
+        (res.t, trace.t[:n]),
+        (res.com, trace.com[:n]),
+        (res.cop, trace.cop[:n]),
+        (res.cop_offset, trace.cop_off[:n]),
+        (res.torque_cmd, trace.tau_cmd[:n]),
+        (res.torque, trace.tau[:n]),
+        (res.saturated, trace.sat[:n]),
+        (res.single, trace.single[:n]),
+        (res.stance, trace.stance[:n]),
+        (res.footsteps, trace.feet),
+        (res.plan_footsteps, walk.plan.footsteps),
+        (res.headings, np.zeros(3)),
+        (res.goal, walk.goal_xy),
+    ):
+        np.testing.assert_array_equal(got, want)
+    assert (res.u_max, res.foot_length, res.foot_width, res.planner) == (30.0, 0.2, 0.1, "hand")
+
+
+@pytest.mark.parametrize(
+    ("x", "goal", "stopped"),
+    [
+        # CoM 1 m off, momentum bringing the capture point back between the two soles:
+        # xi = (-0.4, -0.9) + (L_y, -L_x) / (m z_H omega) = (0.47, 0.0), inside neither sole
+        # but inside their hull
+        ([-1.0, -1.0, -72.0, 69.6], [-0.1, -0.5], True),
+        # the same CoM at rest: the capture point is the CoM, far outside
+        ([-1.0, -1.0, 0.0, 0.0], [-0.1, -0.5], False),
+    ],
+)
+def test_stopped_is_the_capture_point_in_the_final_soles(
+    x: list[float], goal: list[float], stopped: bool
+) -> None:
+    walk, trace = hand_made_run()
+    trace.x, walk.goal_xy = np.array(x), np.array(goal)
+    met = _result(walk, trace, "python", 0.0).metrics  # type: ignore[arg-type]
+    assert met.stopped is stopped and met.success is stopped
+    assert met.goal_error == pytest.approx(0.5, rel=1e-12)  # CoM (-0.4, -0.9)
+
+
+def test_a_fall_is_neither_stopped_nor_successful() -> None:
+    walk, trace = hand_made_run()
+    trace.fell, trace.fall_time = True, 0.05
+    met = _result(walk, trace, "python", 0.0).metrics  # type: ignore[arg-type]
+    assert met.fell and met.fall_time == 0.05
+    assert not met.stopped and not met.success and math.isnan(met.goal_error)
+
+
+def test_metrics_of_a_run_without_single_support_or_steps() -> None:
+    walk, trace = hand_made_run()
+    trace.single = np.zeros_like(trace.single)
+    trace.feet = trace.feet[:1]
+    trace.solve_times = np.zeros(0)
+    trace.fell, trace.fall_time = True, 0.0  # e.g. non-finite from the start
+    met = _result(walk, trace, "python", 0.0).metrics  # type: ignore[arg-type]
+    assert math.isnan(met.zmp_offset_mean) and math.isnan(met.zmp_offset_rms)
+    assert math.isnan(met.zmp_offset_max)
+    assert met.zmp_offset_phase_mean == () and met.zmp_offset_phase_max == ()
+    assert met.saturated_time == 0.0 and met.saturated_fraction == 0.0
+    assert met.footstep_dev_mean == 0.0 and met.footstep_dev_max == 0.0
+    assert met.steps_taken == 0
+    assert met.mpc_time_median == met.mpc_time_p99 == met.mpc_time_max == 0.0
