@@ -16,6 +16,7 @@ from scipy.linalg import expm
 
 from footfall.control import MPC, MPCWeights, build_mpc
 from footfall.control.mpc import CondensedMPC
+from footfall.errors import InputError
 from footfall.models.biped import BipedParams
 from tests.conftest import IVP_ATOL, IVP_RTOL
 
@@ -255,3 +256,43 @@ def test_unconstrained_optimum_minimises_the_written_out_cost(
     assert np.linalg.norm(sol.torques, axis=1).max() < ROBOT.u_max
     np.testing.assert_allclose(sol.torques.ravel(), z_ref[:-2], rtol=0, atol=OPT_TORQUE_ATOL)
     np.testing.assert_allclose(sol.next_footstep[:2], z_ref[-2:], rtol=0, atol=OPT_STEP_ATOL)
+
+
+def test_end_state_maps_and_blocking_are_exact(model: CondensedMPC) -> None:
+    """x_M = a_end x + b_end u from the hand-built ZOH, and integer tick counts per block."""
+    ad, bd = zoh_by_hand(model.control_dt)
+    for k_s in (0, 57, 99):
+        n_b = model.n_blocks(k_s)
+        np.testing.assert_allclose(
+            model.a_end[k_s], np.linalg.matrix_power(ad, model.n_ticks - k_s), rtol=0, atol=1e-12
+        )
+        u = np.random.default_rng(k_s).uniform(-20.0, 20.0, (n_b, 2))
+        x = np.zeros(4)
+        for b in tick_blocks(model, k_s):
+            x = ad @ x + bd @ u[b]
+        np.testing.assert_allclose(model.b_end[k_s] @ u.ravel(), x, rtol=1e-12, atol=1e-15)
+        assert model.block_ticks[k_s].dtype.kind == "i"
+    assert model.block_edges.dtype.kind == "i"
+    assert model.robot is ROBOT and model.weights == MPCWeights()
+
+
+def test_coarsest_control_rate_and_two_nodes_are_accepted() -> None:
+    """M = K - 1 ticks (one tick per block) and K = 2 (one block) are valid."""
+    robot = BipedParams(n_nodes=5)
+    assert build_mpc(robot, control_dt=robot.t_ss / 4).n_ticks == 4
+    assert build_mpc(robot, control_dt=0.02, n_nodes=2).n_blocks(0) == 1
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field", "value"),
+    [
+        ({"weights": "heavy"}, "weights", "heavy"),
+        ({"control_dt": -0.01}, "control_dt", -0.01),
+        ({"control_dt": 0.2}, "control_dt", 0.2),  # M = 2 < K - 1 = 4
+        ({"n_nodes": 1}, "n_nodes", 1),
+    ],
+)
+def test_build_mpc_errors_name_the_field(kwargs: dict, field: str, value: object) -> None:
+    with pytest.raises(InputError) as err:
+        build_mpc(BipedParams(n_nodes=5), **kwargs)
+    assert err.value.field == field and err.value.value == value
