@@ -258,8 +258,10 @@ def test_unconstrained_optimum_minimises_the_written_out_cost(
     np.testing.assert_allclose(sol.next_footstep[:2], z_ref[-2:], rtol=0, atol=OPT_STEP_ATOL)
 
 
-def test_end_state_maps_and_blocking_are_exact(model: CondensedMPC) -> None:
+def test_end_state_maps_and_blocking_are_exact() -> None:
     """x_M = a_end x + b_end u from the hand-built ZOH, and integer tick counts per block."""
+    # built here, not by the module fixture, so mutation testing attributes build_mpc to it
+    model = build_mpc(ROBOT, MPCWeights(), RATE_DT)
     ad, bd = zoh_by_hand(model.control_dt)
     for k_s in (0, 57, 99):
         n_b = model.n_blocks(k_s)
@@ -288,7 +290,7 @@ def test_coarsest_control_rate_and_two_nodes_are_accepted() -> None:
     [
         ({"weights": "heavy"}, "weights", "heavy"),
         ({"control_dt": -0.01}, "control_dt", -0.01),
-        ({"control_dt": 0.2}, "control_dt", 0.2),  # M = 2 < K - 1 = 4
+        ({"control_dt": 0.4 / 3}, "control_dt", 0.4 / 3),  # M = 3 < K - 1 = 4
         ({"n_nodes": 1}, "n_nodes", 1),
     ],
 )
