@@ -170,3 +170,40 @@ def test_bad_periods_are_rejected(alip: ALIP) -> None:
         alip.discretize(0.0)
     with pytest.raises(InputError, match="t_ds"):
         alip.reset_map(-0.1)
+
+
+def test_state_from_velocity_is_position_and_momentum(alip: ALIP) -> None:
+    """x = [c_x, c_y, -m z_H v_y, m z_H v_x] (eq. 5.1 with L = m z_H (-v_y, v_x))."""
+    mzh = alip.mass * alip.com_height
+    x = alip.state_from_velocity([0.01, -0.02], [0.4, -0.1])
+    np.testing.assert_allclose(x, [0.01, -0.02, 0.1 * mzh, 0.4 * mzh], rtol=1e-15)
+
+
+def test_state_from_velocity_checks_both_vectors(alip: ALIP) -> None:
+    for pos, vel, field in (([0.0, 0.0, 0.0], [0.0, 0.0], "pos"), ([0.0, 0.0], [1.0], "vel")):
+        with pytest.raises(InputError) as err:
+            alip.state_from_velocity(pos, vel)
+        assert err.value.field == field
+
+
+def test_batched_maps_keep_the_leading_axis(alip: ALIP) -> None:
+    """velocity, zmp and torque_for_zmp act on the last axis of a batch (N, .)."""
+    rng = np.random.default_rng(0)
+    xs = rng.normal(size=(3, 4))
+    np.testing.assert_allclose(alip.velocity(xs), [alip.velocity(x) for x in xs], rtol=1e-15)
+    us = rng.normal(size=(3, 2))
+    stance = np.array([1.0, 2.0])
+    np.testing.assert_allclose(alip.zmp(stance, us), [alip.zmp(stance, u) for u in us])
+    np.testing.assert_allclose(alip.torque_for_zmp(us), [alip.torque_for_zmp(u) for u in us])
+
+
+def test_parameters_are_stored_as_floats() -> None:
+    alip = ALIP(30, 1, g=10)
+    assert all(type(v) is float for v in (alip.mass, alip.com_height, alip.g))
+    assert alip.omega == pytest.approx(np.sqrt(10.0))
+
+
+def test_bad_double_support_names_t_ds(alip: ALIP) -> None:
+    with pytest.raises(InputError) as err:
+        alip.reset_map(0.0)
+    assert err.value.field == "t_ds"

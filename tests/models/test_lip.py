@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -75,3 +77,42 @@ def test_sample_step_includes_both_ends() -> None:
 def test_bad_height(z_c: float) -> None:
     with pytest.raises(InputError, match="z_c"):
         LIP(z_c)
+
+
+def test_orbital_energy_value_and_the_capture_state() -> None:
+    """E = v^2 / 2 - g / (2 z_c) (x - p)^2 (Kajita eq. 4.21) at a point, and E = 0 on the stable
+    manifold v = -(x - p) / Tc."""
+    lip = LIP(0.8)
+    e = lip.orbital_energy([0.1, -0.2], [0.5, 0.3], [0.0, -0.1])
+    np.testing.assert_allclose(
+        e, [0.125 - 9.81 / 1.6 * 0.01, 0.045 - 9.81 / 1.6 * 0.01], rtol=1e-14
+    )
+    x, p = np.array([0.3]), np.array([0.1])
+    assert lip.orbital_energy(x, -(x - p) / lip.Tc, p)[0] == pytest.approx(0.0, abs=1e-15)
+
+
+def test_sample_step_shorter_than_dt_is_its_two_ends() -> None:
+    t, pos, vel = LIP(0.8).sample_step([0.0], [0.1], [0.0], 0.05, 0.1)
+    np.testing.assert_array_equal(t, [0.0, 0.05])
+    assert pos.shape == vel.shape == (2, 1)
+
+
+def test_parameters_are_stored_as_floats() -> None:
+    lip = LIP(1, g=10)
+    assert type(lip.z_c) is float and type(lip.g) is float
+    assert lip.Tc == pytest.approx(np.sqrt(0.1))
+
+
+@pytest.mark.parametrize(
+    ("call", "field"),
+    [
+        (lambda: LIP(0.0), "z_c"),
+        (lambda: LIP(0.8, g=-9.81), "g"),
+        (lambda: LIP(0.8).sample_step([0.0], [0.0], [0.0], 0.0, 0.1), "t_sup"),
+        (lambda: LIP(0.8).sample_step([0.0], [0.0], [0.0], 0.4, float("nan")), "dt"),
+    ],
+)
+def test_input_errors_name_the_field(call: Callable[[], object], field: str) -> None:
+    with pytest.raises(InputError) as exc:
+        call()
+    assert exc.value.field == field
