@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Mutation testing (mutmut 3) of the modules users trust, each against only its relevant tests.
 # Slow and outside CI. Results and the survivors' analysis: benchmarks/MUTATION.md.
+# Needs the mutation extra: .venv/bin/pip install -e ".[dev,mutation]".
 #
 #   benchmarks/mutation.sh [module ...]     # default: every module below
 #
