@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -78,3 +78,12 @@ def instance_of(field: str, value: object, types: type | tuple[type, ...], expec
     function given the wrong type says which argument, instead of an AttributeError deep inside."""
     if not isinstance(value, types):
         raise InputError(field, type(value).__name__, expected)
+
+
+def check_fields(
+    obj: object, check: Callable[[str, object], object], names: Sequence[str], prefix: str = ""
+) -> None:
+    """Replace each named field of the frozen dataclass ``obj`` by ``check(prefix + name, value)``
+    (e.g. :func:`positive`), which raises :class:`InputError` naming the field."""
+    for name in names:
+        object.__setattr__(obj, name, check(prefix + name, getattr(obj, name)))

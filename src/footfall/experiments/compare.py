@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from footfall._validate import non_negative, positive
+from footfall._validate import check_fields, non_negative, positive
 from footfall.errors import InputError
 from footfall.planning.cache import PlanCache, cached_plan
 from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
@@ -67,8 +67,11 @@ class TrialSpec:
     control_rate: float = 500.0
 
     def __post_init__(self) -> None:
-        for name in ("push_max", "noise_pos", "noise_vel", "placement_error", "mismatch"):
-            object.__setattr__(self, name, non_negative(name, getattr(self, name)))
+        check_fields(
+            self,
+            non_negative,
+            ("push_max", "noise_pos", "noise_vel", "placement_error", "mismatch"),
+        )
         if self.mismatch >= 1.0:
             raise InputError("mismatch", self.mismatch, "a fraction in [0, 1)")
         object.__setattr__(self, "push_duration", positive("push_duration", self.push_duration))

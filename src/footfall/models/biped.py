@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike
 
 from footfall._geometry import convexity_defect, outward_halfspaces, signed_area
 from footfall._typing import FloatArray
-from footfall._validate import positive
+from footfall._validate import check_fields, positive
 from footfall.errors import InputError
 from footfall.models.alip import ALIP
 from footfall.models.lip import GRAVITY
@@ -159,19 +159,22 @@ class BipedParams:
     g: float = GRAVITY
 
     def __post_init__(self) -> None:
-        for name in (
-            "mass",
-            "com_height",
-            "t_ss",
-            "t_ds",
-            "u_max",
-            "stance_width",
-            "step_height_max",
-            "foot_length",
-            "foot_width",
-            "g",
-        ):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        check_fields(
+            self,
+            positive,
+            (
+                "mass",
+                "com_height",
+                "t_ss",
+                "t_ds",
+                "u_max",
+                "stance_width",
+                "step_height_max",
+                "foot_length",
+                "foot_width",
+                "g",
+            ),
+        )
         n = self.n_nodes
         if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 2 <= n <= MAX_NODES:
             raise InputError(

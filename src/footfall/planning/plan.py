@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from footfall._typing import FloatArray
-from footfall._validate import instance_of, non_negative, positive
+from footfall._validate import check_fields, instance_of, non_negative, positive
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.solvers import DEFAULT_SOLVER, KNOWN_BACKENDS
@@ -51,8 +51,9 @@ class PlannerWeights:
     step_matrix: tuple[float, float, float] = (1.0, 1.0, 1.0)
 
     def __post_init__(self) -> None:
-        for name in ("torque", "terminal", "heading", "step"):
-            object.__setattr__(self, name, non_negative(f"weights.{name}", getattr(self, name)))
+        check_fields(
+            self, non_negative, ("torque", "terminal", "heading", "step"), prefix="weights."
+        )
 
     def terminal_diag(self, robot: BipedParams) -> FloatArray:
         """Diagonal of the terminal norm for ``robot`` (see ``terminal_state``)."""

@@ -22,7 +22,7 @@ from enum import Enum
 import numpy as np
 
 from footfall._typing import FloatArray
-from footfall._validate import finite_vector, positive
+from footfall._validate import check_fields, finite_vector, positive
 from footfall.errors import InputError
 
 
@@ -122,22 +122,26 @@ class QuadrupedRobot:
     joint_limits: JointLimits = field(default_factory=JointLimits)
 
     def __post_init__(self) -> None:
-        for name in (
-            "body_length",
-            "body_width",
-            "body_height",
-            "hip_spacing_x",
-            "hip_spacing_y",
-            "thigh_length",
-            "shank_length",
-            "foot_radius",
-            "body_mass",
-            "thigh_mass",
-            "shank_mass",
-            "hip_mass",
-            "stance_height",
-        ):
-            object.__setattr__(self, name, positive(f"robot.{name}", getattr(self, name)))
+        check_fields(
+            self,
+            positive,
+            (
+                "body_length",
+                "body_width",
+                "body_height",
+                "hip_spacing_x",
+                "hip_spacing_y",
+                "thigh_length",
+                "shank_length",
+                "foot_radius",
+                "body_mass",
+                "thigh_mass",
+                "shank_mass",
+                "hip_mass",
+                "stance_height",
+            ),
+            prefix="robot.",
+        )
         if self.stance_height >= self.max_leg_length:
             raise InputError(
                 "robot.stance_height",

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from footfall._validate import non_negative, positive
+from footfall._validate import check_fields, non_negative, positive
 
 
 def fmt(*values: float | np.floating, digits: int = 6) -> str:
@@ -52,8 +52,12 @@ class SimSettings:
     armature: float = 0.05
 
     def __post_init__(self) -> None:
-        for name in ("timestep", "kp", "kv", "torque_limit", "friction", "impratio"):
-            object.__setattr__(self, name, positive(f"sim.{name}", getattr(self, name)))
+        check_fields(
+            self,
+            positive,
+            ("timestep", "kp", "kv", "torque_limit", "friction", "impratio"),
+            prefix="sim.",
+        )
         object.__setattr__(self, "armature", non_negative("sim.armature", self.armature))
 
 

@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from footfall._validate import non_negative
+from footfall._validate import check_fields, non_negative
 from footfall.errors import InputError
 
 
@@ -112,9 +112,8 @@ class BnbSettings:
     drain_timeout: float = 1.0
 
     def __post_init__(self) -> None:
-        for name in ("feas_tol", "redundant_tol", "row_tol", "rank_tol", "probe_min_drop",
-                     "drain_timeout", "link_min_drop"):  # fmt: skip
-            object.__setattr__(self, name, non_negative(f"bnb.{name}", getattr(self, name)))
+        check_fields(self, non_negative, ("feas_tol", "redundant_tol", "row_tol", "rank_tol", "probe_min_drop",
+                     "drain_timeout", "link_min_drop"), prefix="bnb.")  # fmt: skip
         for name in ("probe_after", "probe_budget"):  # inf: never / no budget
             value = getattr(self, name)
             if value != math.inf:
@@ -129,5 +128,4 @@ class BnbSettings:
                 raise InputError(f"bnb.{name}", getattr(self, name), "True or False")
         if self.map_depth < 1:
             raise InputError("bnb.map_depth", self.map_depth, "an integer >= 1")
-        for name in ("clarabel", "clarabel_retry"):
-            object.__setattr__(self, name, _pairs(name, getattr(self, name)))
+        check_fields(self, _pairs, ("clarabel", "clarabel_retry"))

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from footfall._typing import FloatArray
-from footfall._validate import non_negative, positive
+from footfall._validate import check_fields, non_negative, positive
 from footfall.errors import FootfallError, InputError
 from footfall.models.biped import Side
 from footfall.sim.biped import names as nm
@@ -135,18 +135,21 @@ class G1Model:
     impratio: float = 10.0
 
     def __post_init__(self) -> None:
-        for name in (
-            "stance_width",
-            "nominal_pelvis_height",
-            "servo_saturation",
-            "servo_damping_time",
-            "timestep",
-            "friction",
-            "impratio",
-        ):
-            object.__setattr__(self, name, positive(f"g1.{name}", getattr(self, name)))
-        for name in ("armature", "joint_damping"):
-            object.__setattr__(self, name, non_negative(f"g1.{name}", getattr(self, name)))
+        check_fields(
+            self,
+            positive,
+            (
+                "stance_width",
+                "nominal_pelvis_height",
+                "servo_saturation",
+                "servo_damping_time",
+                "timestep",
+                "friction",
+                "impratio",
+            ),
+            prefix="g1.",
+        )
+        check_fields(self, non_negative, ("armature", "joint_damping"), prefix="g1.")
 
     # ------------------------------------------------------------------ WalkerModel
     @property

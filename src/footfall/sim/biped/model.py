@@ -25,7 +25,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from footfall._typing import FloatArray
-from footfall._validate import non_negative, positive
+from footfall._validate import check_fields, non_negative, positive
 from footfall.control.adjusters import U_MAX_FOOT_SHARE
 from footfall.errors import FootfallError, InputError
 from footfall.models.biped import BipedParams, Side
@@ -185,24 +185,28 @@ class BipedModel:
     )
 
     def __post_init__(self) -> None:
-        for name in (
-            "pelvis_mass",
-            "torso_mass",
-            "torso_offset",
-            "hip_width",
-            "hip_link_mass",
-            "thigh_length",
-            "thigh_mass",
-            "shank_length",
-            "shank_mass",
-            "ankle_height",
-            "foot_mass",
-            "foot_length",
-            "foot_width",
-            "corner_radius",
-            "nominal_hip_height",
-        ):
-            object.__setattr__(self, name, positive(f"model.{name}", getattr(self, name)))
+        check_fields(
+            self,
+            positive,
+            (
+                "pelvis_mass",
+                "torso_mass",
+                "torso_offset",
+                "hip_width",
+                "hip_link_mass",
+                "thigh_length",
+                "thigh_mass",
+                "shank_length",
+                "shank_mass",
+                "ankle_height",
+                "foot_mass",
+                "foot_length",
+                "foot_width",
+                "corner_radius",
+                "nominal_hip_height",
+            ),
+            prefix="model.",
+        )
         object.__setattr__(self, "hip_drop", non_negative("model.hip_drop", self.hip_drop))
         for name in ("pelvis_size", "torso_size"):
             v = getattr(self, name)

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from footfall._validate import non_negative, positive
+from footfall._validate import check_fields, non_negative, positive
 from footfall.control.adjusters import STOP_STEPS
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
@@ -121,18 +121,20 @@ class WalkOptions:
     check_robot: bool = True
 
     def __post_init__(self) -> None:
-        for name in ("control_dt", "swing_clearance", "shift_time", "stop_time"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        for name in (
-            "settle_time",
-            "hold_time",
-            "com_gain",
-            "landing_margin",
-            "swing_side_gap",
-            "heel_strike",
-            "riser_tolerance",
-        ):
-            object.__setattr__(self, name, non_negative(name, getattr(self, name)))
+        check_fields(self, positive, ("control_dt", "swing_clearance", "shift_time", "stop_time"))
+        check_fields(
+            self,
+            non_negative,
+            (
+                "settle_time",
+                "hold_time",
+                "com_gain",
+                "landing_margin",
+                "swing_side_gap",
+                "heel_strike",
+                "riser_tolerance",
+            ),
+        )
         fb = non_negative("com_feedback", self.com_feedback)
         if fb > 1.0:
             raise InputError("com_feedback", self.com_feedback, "a share in [0, 1]")

@@ -56,7 +56,7 @@ from numpy.typing import NDArray
 
 from footfall._geometry import rot2
 from footfall._typing import FloatArray
-from footfall._validate import non_negative, positive
+from footfall._validate import check_fields, non_negative, positive
 from footfall.control.mpc import (
     MPC,
     SOLVERS,
@@ -126,10 +126,8 @@ class SimOptions:
         object.__setattr__(self, "control_rate", positive("control_rate", self.control_rate))
         if self.control_rate > MAX_CONTROL_RATE:
             raise InputError("control_rate", self.control_rate, f"at most {MAX_CONTROL_RATE:g} Hz")
-        for name in ("noise_pos", "noise_vel", "placement_error"):
-            object.__setattr__(self, name, non_negative(name, getattr(self, name)))
-        for name in ("mass_scale", "com_height_scale"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        check_fields(self, non_negative, ("noise_pos", "noise_vel", "placement_error"))
+        check_fields(self, positive, ("mass_scale", "com_height_scale"))
         for name in ("foot_length", "foot_width"):
             if getattr(self, name) is not None:
                 object.__setattr__(self, name, positive(name, getattr(self, name)))
