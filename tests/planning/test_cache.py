@@ -70,3 +70,14 @@ def test_an_edited_scene_of_the_same_name_is_planned_again(tmp_path: Path) -> No
     again = cached_plan(moved, "miqcqp", 3, cache=cache)
     assert "loaded from cache" not in again.message
     assert len(list(tmp_path.glob("plan-*.json"))) == 2
+
+
+def test_a_cache_file_that_is_not_json_is_planned_again(tmp_path: Path) -> None:
+    sc, cache = scene(SHORT_FLAT), PlanCache(tmp_path)
+    made = cached_plan(sc, "miqcqp", 3, cache=cache)
+    path = cache.path(plan_key(sc, "miqcqp", 3, PlannerOptions(), sc.robot))
+    path.write_text("{ not json")
+    again = cached_plan(sc, "miqcqp", 3, cache=cache)
+    assert "discarded" in again.message
+    np.testing.assert_allclose(again.footsteps, made.footsteps)
+    assert json.loads(path.read_text())["status"] == made.status.value

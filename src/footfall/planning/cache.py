@@ -144,15 +144,18 @@ def cached_plan(
 
     Only plans with footsteps are stored: a failed search is made again next time (it may have
     hit a time limit). A cached plan is re-checked before use (:func:`cache_mismatch`): one that
-    an edited or damaged file broke is discarded, planned again (the file is overwritten) and
-    the new plan's message says so.
+    an edited or damaged file broke (or that is no longer a valid plan file at all) is
+    discarded, planned again (the file is overwritten) and the new plan's message says so.
     """
     options = options or PlannerOptions()
     robot = robot if robot is not None else scene.robot
     key = plan_key(scene, planner, n_steps, options, robot)
     discarded = ""
     if cache is not None:
-        hit = cache.load(key, robot)
+        try:
+            hit = cache.load(key, robot)
+        except InputError as exc:  # a damaged file is a miss: plan again and overwrite it
+            hit, discarded = None, f" (cached plan {cache.path(key).name} discarded: {exc})"
         if hit is not None:
             problem = cache_mismatch(hit, scene, n_steps)
             if not problem:
