@@ -15,7 +15,6 @@ from footfall.cli._common import (
     parse_floats,
 )
 from footfall.errors import InputError
-from footfall.terrain.resolve import resolve_scene
 
 # --- bench (issue 5) ---
 bench_app = typer.Typer(help="Benchmarks.", no_args_is_help=True)
@@ -99,6 +98,7 @@ def bench_sim_cmd(
     )
     from footfall.planning import PlannerOptions, make_plan
     from footfall.planning.plan import check_planner_name
+    from footfall.terrain.resolve import resolve_scene
 
     check_planner_name(planner)
     k_list: list[int | None] = []

@@ -18,7 +18,6 @@ from footfall.cli._common import (
     parse_floats,
 )
 from footfall.errors import InputError
-from footfall.terrain.resolve import resolve_scene, resolve_scene_arguments
 
 
 # --- LIP walk (document 004) ---
@@ -105,6 +104,7 @@ def scenes_command(
     from rich.table import Table
 
     from footfall.terrain import builtin_scene, builtin_scene_names, scene_to_yaml
+    from footfall.terrain.resolve import resolve_scene
 
     if show is None:
         table = Table(title="Built-in scenes")
@@ -180,6 +180,7 @@ def plan(
     """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists."""
     from footfall.planning import PlannerOptions, check_plan, make_plan, plan_min_steps
     from footfall.planning.plan import check_planner_name
+    from footfall.terrain.resolve import resolve_scene_arguments
     from footfall.viz.plan_plot import plot_plan
 
     check_planner_name(planner)
@@ -242,6 +243,7 @@ def check_command(
     was made for. Exit 0: valid; 1: a constraint is violated (each printed with its footstep and
     amount); 2: bad input."""
     from footfall.planning import check_plan, load_plan
+    from footfall.terrain.resolve import resolve_scene_arguments
 
     sc = resolve_scene_arguments(scene_file, scene)
     if out is not None:

@@ -21,7 +21,6 @@ from footfall.cli._common import (
     output_folder,
 )
 from footfall.errors import InputError
-from footfall.terrain.resolve import resolve_scene, resolve_scene_arguments
 
 
 # --- demo ---
@@ -146,6 +145,7 @@ def simulate_command(
     from footfall.planning.plan import check_planner_name
     from footfall.sim import Push, SimOptions, simulate
     from footfall.sim.reduced.closed_loop import run_report
+    from footfall.terrain.resolve import resolve_scene
     from footfall.viz.sim_plots import save_sim_figures
 
     check_planner_name(planner)
@@ -230,6 +230,7 @@ def compare_command(
     heading_segments: int | None = typer.Option(None, help="--sim mujoco: " + _WALK_SEGMENTS_HELP),
 ) -> None:
     """Section 5.5: every planner through the same MPC and plant over seeded disturbed trials."""
+    from footfall.terrain.resolve import resolve_scene
 
     if sim not in ("reduced", "mujoco"):
         raise InputError("sim", sim, "reduced or mujoco")
@@ -390,6 +391,7 @@ def walk_cmd(
     of both feet's frames and every swing at most ``SWING_MAX`` (``plan_for_walk``), unless
     ``--document-reach``.
     """
+    from footfall.terrain.resolve import resolve_scene_arguments
 
     if video:
         # headless offscreen rendering; MuJoCo picks its GL backend when it is first imported
