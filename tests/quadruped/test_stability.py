@@ -187,3 +187,35 @@ def test_clip_convex_edge_cases() -> None:
     # squares sharing an edge meet in that edge
     shared = clip_convex(SQUARE, SQUARE + np.array([1.0, 0.0]))
     assert same_cycle(shared, np.array([[1.0, 0.0], [1.0, 1.0]]))
+
+
+def expected_text(call: Callable[[], object], field: str, *words: str) -> None:
+    """The error names ``field`` and its expected-value text holds each of ``words``: a user
+    reads these messages, so their content is part of the contract."""
+    with pytest.raises(InputError) as err:
+        call()
+    assert err.value.field == field
+    for word in words:
+        assert word in err.value.expected, (word, err.value.expected)
+        assert word in str(err.value)
+
+
+def test_error_messages_say_what_was_expected() -> None:
+    expected_text(lambda: support_polygon(np.zeros((0, 2))), "points", "(N, 2) or (N, 3)", "N >= 1")
+    expected_text(
+        lambda: zmp_from_com([0, 0, 1], [0, 0, -G], g=G),
+        "com_acc",
+        "vertical acceleration above -g",
+        "feet loaded",
+    )
+    expected_text(
+        lambda: zmp_from_momentum(1.0, [0, 0, 1], [0, 0, -G], [0, 0, 0], g=G),
+        "p_dot",
+        "M g + Pdot_z > 0",
+        "feet loaded",
+    )
+    expected_text(lambda: incentre([[0, 0], [1, 0]]), "triangle", "three 2-D vertices", "(3, 2)")
+    expected_text(lambda: incentre([[0, 0], [1, 1], [2, 2]]), "triangle", "non-degenerate triangle")
+    expected_text(
+        lambda: line_intersection([0, 0], [1, 0], [0, 1], [1, 1]), "lines", "two non-parallel lines"
+    )
