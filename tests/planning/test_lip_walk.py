@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
 from footfall.errors import InputError
-from footfall.planning import LipWalkParams, lip_example, lip_walk
+from footfall.planning import LipWalk, LipWalkParams, lip_example, lip_walk
 from tests.conftest import IVP_ATOL, IVP_RTOL
 
 #: the document's stop criterion
@@ -67,7 +69,30 @@ def test_sampled_path_is_continuous_at_switches(name: str) -> None:
 @pytest.mark.parametrize("name", EXAMPLES)
 def test_each_foothold_minimises_the_placement_cost(name: str) -> None:
     """Kajita eq. (4.58): checked with a numerical minimiser, not the closed form (4.59)."""
-    walk = lip_walk(lip_example(name))
+    assert_footholds_minimise_cost(lip_walk(lip_example(name)))
+
+
+def test_one_step_walk_with_its_own_stop_weights_minimises_the_cost() -> None:
+    """A single given step (the stop step's heading is then the only heading) and stop weights
+    that differ from the walking weights: the stop foothold must use ``a_stop``, ``b_stop``."""
+    params = LipWalkParams(
+        z_c=0.8, t_sup=0.7, sx=(0.2,), sy=(0.2,), theta=(0.4,), a=5.0, b=2.0, a_stop=3.0,
+        b_stop=0.25, vel0=(0.1, -0.05), g=9.8,
+    )  # fmt: skip
+    walk = lip_walk(params)
+    assert walk.footholds.shape == (2, 2)
+    assert_footholds_minimise_cost(walk)
+
+
+def test_lip_walk_refuses_anything_but_parameters() -> None:
+    with pytest.raises(InputError) as err:
+        lip_walk({"z_c": 0.8})  # type: ignore[arg-type]
+    assert err.value.field == "params"
+    assert err.value.value == "dict"
+    assert err.value.expected == "a LipWalkParams (see footfall.planning)"
+
+
+def assert_footholds_minimise_cost(walk: LipWalk) -> None:
     lip = walk.lip
     p = walk.params
     t_sup = p.t_sup
@@ -186,3 +211,147 @@ def test_written_json_is_strict(tmp_path) -> None:  # type: ignore[no-untyped-de
         "a": None,
         "b": [1.0, None],
     }
+
+
+def has_words(text: str, words: str) -> bool:
+    """``words`` occur in ``text`` as whole words (not glued to other letters or digits)."""
+    return re.search(rf"(?<!\w){re.escape(words)}(?!\w)", text) is not None
+
+
+#: z_c = 1 m, g = 4 m/s^2: T_c = sqrt(z_c / g) = 0.5 s exactly, so the support-time limit is
+#: 20 T_c = 10 s exactly (a mutant using z_c g, z_c / z_c or 1 / T_c moves it)
+LIMIT_ARGS = dict(z_c=1.0, g=4.0, sx=(0.0, 0.3), sy=(0.2, 0.2))
+LIMIT_T_SUP = 10.0  # s
+
+
+def test_support_time_limit_is_twenty_time_constants() -> None:
+    """``t_sup <= 20 T_c`` with ``T_c = sqrt(z_c / g)``: the limit itself is accepted, a hair
+    above it is refused, and the message gives the limit, T_c and its formula."""
+    assert LipWalkParams(t_sup=LIMIT_T_SUP, **LIMIT_ARGS).t_sup == LIMIT_T_SUP
+    above = LIMIT_T_SUP * (1.0 + 1e-9)
+    with pytest.raises(InputError) as err:
+        LipWalkParams(t_sup=above, **LIMIT_ARGS)
+    assert err.value.field == "t_sup"
+    assert err.value.value == above
+    text = err.value.expected
+    assert "at most 20 T_c = 10 s" in text
+    assert "T_c = sqrt(z_c / g) = 0.5 s" in text
+    assert "exp(T_sup / T_c)" in text and has_words(text, "to rounding")
+    # the limit scales with sqrt(z_c / g): T_c = 1 s at z_c = g = 4 admits 20 s, not 20.1 s
+    assert LipWalkParams(z_c=4.0, g=4.0, t_sup=20.0, sx=(0.0,), sy=(0.2,)).t_sup == 20.0
+    with pytest.raises(InputError, match="t_sup"):
+        LipWalkParams(z_c=4.0, g=4.0, t_sup=20.1, sx=(0.0,), sy=(0.2,))
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field", "value", "words"),
+    [
+        ({"z_c": -1.0}, "z_c", -1.0, "> 0"),
+        ({"t_sup": 0.0}, "t_sup", 0.0, "> 0"),
+        ({"g": 0.0}, "g", 0.0, "> 0"),
+        ({"g": float("inf")}, "g", float("inf"), "finite"),
+        ({"sy": (0.2, 0.2)}, "sy", [0.2, 0.2], "3 values, one per step like sx (got 2)"),
+        ({"theta": (0.0,) * 4}, "theta", [0.0] * 4, "3 values, one per step like sx (got 4)"),
+        ({"sy": (0.2, float("nan"), 0.2)}, "sy", None, "finite"),
+        ({"theta": (0.0, float("inf"), 0.0)}, "theta", None, "finite"),
+        ({"b": -0.5}, "b", -0.5, ">= 0"),
+        ({"a_stop": -0.5}, "a_stop", -0.5, ">= 0"),
+        ({"b_stop": -0.5}, "b_stop", -0.5, ">= 0"),
+        ({"a": 0.0, "b": 0.0}, "a, b", (0.0, 0.0), "weights not both zero"),
+        ({"a_stop": 0.0, "b_stop": 0.0}, "a_stop, b_stop", (0.0, 0.0), "weights not both zero"),
+        ({"vel0": (0.0, 0.0, 0.0)}, "vel0", None, "exactly 2 numbers"),
+        ({"foot0": (0.0,)}, "foot0", None, "exactly 2 numbers"),
+    ],
+)
+def test_bad_input_names_field_value_and_expectation(
+    kwargs: dict, field: str, value: object, words: str
+) -> None:
+    args: dict = dict(z_c=0.8, t_sup=0.8, sx=(0.0, 0.3, 0.0), sy=(0.2,) * 3)
+    args.update(kwargs)
+    with pytest.raises(InputError) as err:
+        LipWalkParams(**args)
+    assert err.value.field == field
+    if value is not None:
+        assert err.value.value == value
+    assert has_words(err.value.expected, words)
+
+
+def test_parameters_are_stored_as_floats_under_their_own_names() -> None:
+    """Integers and numpy scalars come back as Python floats in the field they were given for,
+    and one weight of a pair may be zero."""
+    p = LipWalkParams(
+        z_c=1,
+        t_sup=np.float32(0.5),
+        sx=[0, 1, 2],
+        sy=np.array([3, 4, 5]),
+        theta=(6, 7, 8),
+        a=0,
+        b=2,
+        com0=(9, 10),
+        vel0=[11, 12],
+        foot0=np.array([13, 14]),
+        a_stop=3,
+        b_stop=0,
+        g=4,
+    )
+    values = {
+        "z_c": 1.0,
+        "t_sup": 0.5,
+        "sx": (0.0, 1.0, 2.0),
+        "sy": (3.0, 4.0, 5.0),
+        "headings": (6.0, 7.0, 8.0),
+        "a": 0.0,
+        "b": 2.0,
+        "com0": (9.0, 10.0),
+        "vel0": (11.0, 12.0),
+        "foot0": (13.0, 14.0),
+        "a_stop": 3.0,
+        "b_stop": 0.0,
+        "g": 4.0,
+    }
+    for name, want in values.items():
+        got = getattr(p, name)
+        assert got == want, name
+        items = got if isinstance(got, tuple) else (got,)
+        assert all(type(v) is float for v in items), name
+    assert p.n_steps == 4
+    assert LipWalkParams(z_c=1.0, t_sup=0.5, sx=(0.0,), sy=(0.2,), a=1.0, b=0.0).b == 0.0
+    q = LipWalkParams(z_c=1.0, t_sup=0.5, sx=(0.0,), sy=(0.2,), a_stop=0.0, b_stop=1.0)
+    assert q.a_stop == 0.0 and q.headings == (0.0,)
+
+
+def test_com_trajectory_ends_at_the_final_state_on_its_last_sample() -> None:
+    """The time grid runs from 0 to the duration inclusive; the last sample is the end of the
+    stop step, by the LIP closed form x(T) = p + (x0 - p) cosh(T / T_c) + T_c v0 sinh(T / T_c)."""
+    walk = lip_walk(lip_example("straight"))
+    p = walk.params
+    n = walk.footholds.shape[0]
+    duration = n * p.t_sup
+    tc = np.sqrt(p.z_c / p.g)
+    c, s = np.cosh(p.t_sup / tc), np.sinh(p.t_sup / tc)
+    x0, v0, foot = walk.com_start[-1], walk.vel_start[-1], walk.footholds[-1]
+    end = foot + (x0 - foot) * c + tc * v0 * s
+    end_vel = (x0 - foot) * s / tc + v0 * c
+    for dt in (0.1, 0.04, 0.07):  # 0.07 does not divide the duration: the grid stops short
+        traj = walk.com_trajectory(dt)
+        count = int(np.floor(duration / dt + 1e-9)) + 1
+        assert traj["t"].size == count
+        np.testing.assert_allclose(traj["t"], dt * np.arange(count), atol=1e-12)
+        assert traj["step"][-1] == min(int(traj["t"][-1] / p.t_sup + 1e-9), n - 1)
+        if count - 1 == round(duration / dt):
+            assert traj["t"][-1] == pytest.approx(duration, abs=1e-12)
+            assert traj["step"][-1] == n - 1
+            np.testing.assert_allclose([traj["x"][-1], traj["y"][-1]], end, atol=1e-12)
+            np.testing.assert_allclose([traj["vx"][-1], traj["vy"][-1]], end_vel, atol=1e-12)
+    # a sample at a step switch belongs to the step that starts there
+    traj = walk.com_trajectory(0.1)
+    k = round(p.t_sup / 0.1)
+    assert traj["step"][k] == 1 and traj["step"][k - 1] == 0
+    np.testing.assert_allclose([traj["x"][k], traj["y"][k]], walk.com_start[1], atol=1e-12)
+    np.testing.assert_allclose([traj["vx"][k], traj["vy"][k]], walk.vel_start[1], atol=1e-12)
+    default = walk.com_trajectory()  # every 0.01 s
+    assert default["t"].size == round(duration / 0.01) + 1
+    np.testing.assert_allclose(np.diff(default["t"]), 0.01, atol=1e-12)
+    with pytest.raises(InputError) as err:
+        walk.com_trajectory(0.0)
+    assert err.value.field == "dt" and "> 0" in err.value.expected

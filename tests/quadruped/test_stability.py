@@ -4,6 +4,7 @@ name their field. Written to kill the mutmut survivors listed in benchmarks/MUTA
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 
 import numpy as np
@@ -187,3 +188,61 @@ def test_clip_convex_edge_cases() -> None:
     # squares sharing an edge meet in that edge
     shared = clip_convex(SQUARE, SQUARE + np.array([1.0, 0.0]))
     assert same_cycle(shared, np.array([[1.0, 0.0], [1.0, 1.0]]))
+
+
+def expected_text(call: Callable[[], object], field: str, *words: str) -> None:
+    """The error names ``field`` and its expected-value text holds each of ``words`` as whole
+    words: a user reads these messages, so their content is part of the contract."""
+    with pytest.raises(InputError) as err:
+        call()
+    assert err.value.field == field
+    for word in words:
+        pattern = rf"(?<!\w){re.escape(word)}(?!\w)"
+        assert re.search(pattern, err.value.expected), (word, err.value.expected)
+        assert re.search(pattern, str(err.value))
+
+
+def test_error_messages_say_what_was_expected() -> None:
+    expected_text(
+        lambda: support_polygon(np.zeros((0, 2))), "points", "an array", "(N, 2) or (N, 3), N >= 1"
+    )
+    expected_text(
+        lambda: zmp_from_com([0, 0, 1], [0, 0, -G], g=G),
+        "com_acc",
+        "vertical acceleration above -g",
+        "(feet loaded)",
+    )
+    expected_text(
+        lambda: zmp_from_momentum(1.0, [0, 0, 1], [0, 0, -G], [0, 0, 0], g=G),
+        "p_dot",
+        "M g + Pdot_z > 0",
+        "(feet loaded)",
+    )
+    expected_text(lambda: incentre([[0, 0], [1, 0]]), "triangle", "three 2-D vertices", "(3, 2)")
+    expected_text(lambda: incentre([[0, 0], [1, 1], [2, 2]]), "triangle", "non-degenerate triangle")
+    expected_text(
+        lambda: line_intersection([0, 0], [1, 0], [0, 1], [1, 1]), "lines", "two non-parallel lines"
+    )
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_support_polygon_of_feet_on_a_grid_is_qhull(seed: int) -> None:
+    """Feet sharing x or y coordinates (a stance rectangle, a grid), given in any order and with
+    repeats: the monotone chain needs its points sorted by x *then* y, and ties in x are the
+    common case for a quadruped."""
+    rng = np.random.default_rng(seed)
+    pts = rng.integers(0, 3, (8, 2)).astype(float) * 0.2
+    pts = np.vstack([pts, [[0.0, 0.0], [0.4, 0.4]]])  # never all collinear
+    ref = pts[ConvexHull(pts).vertices]
+    assert same_cycle(support_polygon(pts), ref)
+    stance = np.array([[0.3, -0.2], [-0.3, 0.2], [0.3, 0.2], [-0.3, -0.2], [0.3, -0.2]])
+    rect = np.array([[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]])
+    assert same_cycle(support_polygon(stance), rect)
+
+
+def test_clip_convex_of_polygons_touching_at_a_vertex_is_that_point() -> None:
+    """Closed polygons that meet in one point intersect in that point (vertices on a clip line
+    count as inside), returned once, not as three copies from Sutherland-Hodgman."""
+    touching = np.array([[1.0, 0.5], [2.0, 0.0], [2.0, 1.0]])
+    np.testing.assert_array_equal(clip_convex(touching, SQUARE), [[1.0, 0.5]])
+    np.testing.assert_array_equal(clip_convex(SQUARE, touching), [[1.0, 0.5]])
