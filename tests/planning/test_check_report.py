@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from footfall.errors import InputError
-from footfall.models.biped import ReachTrapezoid
+from footfall.models.biped import ReachTrapezoid, Side
 from footfall.planning import check_plan
 from footfall.planning.check import (
     ANGLE_TOL,
@@ -213,6 +213,8 @@ def test_start_heading_is_compared_not_added() -> None:
     turned = replace(plan, headings=_shifted(plan.headings, (0,), -1e-3))
     report = check_plan(turned, _start(sc, heading=sc.start.heading - 1e-3))
     assert "start" not in report.kinds(), report.summary()
+    report = check_plan(turned, _start(sc, heading=sc.start.heading - 1e-3 + NUDGE))
+    assert _found(report, "start") == [(0, pytest.approx(NUDGE, abs=1e-12))], report.summary()
 
 
 def test_alternation_steps_and_amounts() -> None:
@@ -284,6 +286,25 @@ def test_reach_in_both_frames_reports_each_frame() -> None:
             landing.message
             == f"{landing.amount:.2e} m outside the reach set in the landing foot's frame"
         )
+
+
+def test_reach_in_the_landing_foots_frame_uses_the_landing_heading() -> None:
+    """The turn: rotated by the heading of the footstep it lands on, steps 1 and 3 (right stance
+    foot) come closer to it sideways than the trapezoid's inner edge y = 0.12 m allows; the amount
+    is 0.12 m minus that sideways distance (mirrored for a left stance foot)."""
+    plan, sc = _base("turn")
+    assert np.allclose(plan.robot.reach.vertices[:2, 1], 0.12)
+    report = check_plan(replace(plan, reach_both_frames=True), sc)
+    want = []
+    for i in range(plan.n_steps):
+        dx, dy = plan.footsteps[i + 1, :2] - plan.footsteps[i, :2]
+        th = plan.headings[i + 1]
+        side = 1.0 if plan.sides[i] is Side.RIGHT else -1.0
+        gap = 0.12 - side * (-math.sin(th) * dx + math.cos(th) * dy)
+        if gap > GEOM_TOL:
+            want.append((i + 1, pytest.approx(gap, abs=1e-12)))
+    assert [s for s, _ in want] == [1, 3]
+    assert _found(report, "reach") == want, report.summary()
 
 
 def test_step_height_footstep_amount_and_tolerance_edge() -> None:
