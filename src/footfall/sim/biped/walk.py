@@ -34,6 +34,7 @@ point. Options are in :mod:`footfall.sim.biped.options`, the plant in
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -544,23 +545,11 @@ class BipedWalk:
         log = self.log.trimmed(k_end, self.dt)
         t_goal = self.t_walk0 + self.n_planned * self.t_step
         metrics = summarise(log, self.scene, self.plan, self.sim.params, t_goal)
+        # WalkLog's fields are WalkResult's measurements under the same names
+        measured = {f.name: getattr(log, f.name) for f in dataclasses.fields(log)}
         return WalkResult(
-            t=log.t,
-            phase=log.phase,
-            com=log.com,
-            com_ref=log.com_ref,
-            zmp_offset=log.zmp_offset,
-            zmp_planned=log.zmp_planned,
-            feet=log.feet,
-            landed=log.landed,
-            targets=log.targets,
-            planned=log.planned,
-            n_planned=log.n_planned,
-            fell=log.fell,
-            fall_time=log.fall_time,
+            **measured,
             metrics=metrics,
-            timing=log.timing,
-            sim_time=log.sim_time,
             video=video_path if self.video.writer is not None else None,
             video_note=self.video.note,
         )
