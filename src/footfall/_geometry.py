@@ -197,3 +197,35 @@ def clip_halfplane(poly: FloatArray, a: FloatArray, b: float, tol: float = 1e-12
     if len(kept) > 1 and float(np.linalg.norm(kept[0] - kept[-1])) <= tol:
         kept.pop()
     return np.array(kept, dtype=float).reshape(-1, 2)
+
+
+def rotation_log(r: FloatArray) -> FloatArray:
+    """Rotation vector (3,) [rad] (axis times angle in [0, pi]) of the rotation matrix ``r``."""
+    w = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
+    cos = max(-1.0, min(1.0, 0.5 * (float(r[0, 0] + r[1, 1] + r[2, 2]) - 1.0)))
+    angle = math.acos(cos)
+    if angle < 1e-9:
+        return 0.5 * w
+    if angle < math.pi - 1e-6:
+        return angle / (2.0 * math.sin(angle)) * w
+    # near a half turn: the axis is the dominant column of (r + I) / 2 = a a^T
+    b = 0.5 * (np.asarray(r, dtype=float) + np.eye(3))
+    k = int(np.argmax(np.diag(b)))
+    axis = b[:, k] / math.sqrt(max(b[k, k], 1e-300))
+    if float(axis @ w) < 0.0:
+        axis = -axis
+    return angle * axis / float(np.linalg.norm(axis))
+
+
+def rotation_exp(v: FloatArray) -> FloatArray:
+    """Rotation matrix (3, 3) of the rotation vector ``v`` (3,) [rad] (Rodrigues' formula)."""
+    x, y, z = (float(c) for c in v)
+    angle = math.sqrt(x * x + y * y + z * z)
+    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    if angle < 1e-12:
+        return np.eye(3) + k
+    return (
+        np.eye(3)
+        + (math.sin(angle) / angle) * k
+        + ((1.0 - math.cos(angle)) / (angle * angle)) * (k @ k)
+    )

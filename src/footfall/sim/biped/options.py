@@ -21,6 +21,8 @@ from footfall.terrain.scene import Scene
 #: landings fall short of their targets, and a heel landing on the edge of the tread above a
 #: step down tips the foot
 RISER_LANDING_TOLERANCE = 0.04
+#: the walk's whole-body controllers (``WalkOptions.controller``)
+CONTROLLERS = ("servo", "wbc")
 #: a plan's robot mass and CoM height may differ this much (relative) from the walker model's
 #: (:func:`~footfall.sim.biped.model.planner_params` measures them: 0.0 exactly)
 PLAN_ROBOT_RTOL = 0.01
@@ -31,8 +33,13 @@ class WalkOptions:
     """Options of the walking controller.
 
     Attributes:
+        controller: ``servo``: differential IK (``mink``) whose joint angles are the set points of
+            position servos, the stance ankle torque-driven with the ALIP torque; ``wbc``: the
+            whole-body inverse-dynamics QP (:mod:`footfall.sim.biped.wbc`) drives every joint by
+            torque, the ALIP torque being the stance foot's commanded centre of pressure.
         control_dt: control period (measurement, adjuster, reference, IK) [s]; a multiple of the
-            physics step.
+            physics step. The whole-body QP of ``wbc`` runs at every physics step (500 Hz) from
+            the measured state, with this period's references.
         ik_iterations: differential-IK QP solves per control tick.
         swing_clearance: height of the swing sole above the highest region it passes over [m].
         heel_strike: the swing sole turns toe-up by this angle [rad] about its lateral axis
@@ -98,6 +105,7 @@ class WalkOptions:
             is then another pendulum's. False walks such a plan on purpose (a mismatch study).
     """
 
+    controller: str = "servo"
     control_dt: float = 0.01
     ik_iterations: int = 2
     swing_clearance: float = 0.05
@@ -121,6 +129,8 @@ class WalkOptions:
     check_robot: bool = True
 
     def __post_init__(self) -> None:
+        if self.controller not in CONTROLLERS:
+            raise InputError("controller", self.controller, f"one of {', '.join(CONTROLLERS)}")
         check_fields(self, positive, ("control_dt", "swing_clearance", "shift_time", "stop_time"))
         check_fields(
             self,

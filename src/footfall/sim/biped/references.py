@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.linalg import expm
 
+from footfall._geometry import rotation_exp, rotation_log
 from footfall._typing import FloatArray
 from footfall.models.alip import ALIP
 from footfall.terrain.region import Region
@@ -234,12 +235,10 @@ def pitch_about_y(angle: float) -> FloatArray:
 
 
 def blend_rot(r0: FloatArray, r1: FloatArray, s: float) -> FloatArray:
-    """Rotation between ``r0`` (s = 0) and ``r1`` (s = 1) along the geodesic."""
-    from scipy.spatial.transform import Rotation, Slerp
-
+    """Rotation between ``r0`` (s = 0) and ``r1`` (s = 1) along the geodesic:
+    ``r0 exp(s log(r0^T r1))``."""
     if s <= 0.0:
         return r0
     if s >= 1.0:
         return r1
-    slerp = Slerp([0.0, 1.0], Rotation.from_matrix(np.stack([r0, r1])))
-    return np.asarray(slerp([s]).as_matrix()[0])
+    return np.asarray(r0 @ rotation_exp(s * rotation_log(r0.T @ r1)))

@@ -50,7 +50,7 @@ from footfall.control.adjusters import (
     extend_plan,
     sole_torque_limits,
 )
-from footfall.errors import InputError
+from footfall.errors import InputError, SolverError
 from footfall.models.biped import Side
 from footfall.planning.plan import FootstepPlan
 from footfall.sim.biped.ik import WholeBodyIK
@@ -81,6 +81,7 @@ from footfall.sim.biped.state import (
     Video,
     WalkLog,
 )
+from footfall.sim.biped.wbc import BipedWbc, CopTarget
 from footfall.terrain.edges import inset_riser_edges
 from footfall.terrain.scene import Scene
 
@@ -156,7 +157,12 @@ class BipedWalk:
         sim, scene, plan = self.sim, self.scene, self.plan
         start = scene.start
         sim.set_standing(start.left, start.right, start.heading)
-        self.ik = WholeBodyIK(sim)
+        self.wbc: BipedWbc | None = None
+        self.ik: WholeBodyIK | None = None
+        if self.opts.controller == "wbc":
+            self.wbc = BipedWbc(sim)
+        else:
+            self.ik = WholeBodyIK(sim)
         # the IK's nominal CoM offset: the standing CoM is where the model puts it, not at mid-feet
         self.com0, _, _ = sim.com_state()
         regions = {r.name: r for r in scene.terrain.regions}
@@ -180,6 +186,8 @@ class BipedWalk:
         self.height = CoMHeight(plan.footsteps, self.robot.com_height)
         self.z_stand = 0.5 * (start.left[2] + start.right[2]) + self.robot.com_height
         ctrl = np.array(sim.data.ctrl[sim.actuators], dtype=float)
+        if self.wbc is not None:
+            ctrl = np.zeros_like(ctrl)  # torques: nothing applied before the first tick
         self.act = ActuationState(
             ankle_mode={sd: False for sd in sim.sides},
             ctrl_prev=ctrl,
@@ -212,6 +220,9 @@ class BipedWalk:
         timing = self.log.timing
         t = float(self.log.t[k])
         c0 = time.perf_counter()
+        if self.wbc is not None:
+            # the torque controller needs this instant's model terms and contact forces
+            self.sim.mujoco.mj_forward(self.sim.model, self.sim.data)
         obs = self._observe(k)
         cmd = self._schedule(k, t, obs)
         self._measure(k, cmd, obs)
@@ -220,12 +231,16 @@ class BipedWalk:
             return False
         c1 = time.perf_counter()
         timing["control"] += c1 - c0
-        ctrl, servoed = self._whole_body(cmd, obs)
-        c2 = time.perf_counter()
-        timing["ik"] += c2 - c1
-        self._physics(t, ctrl, servoed)
-        c3 = time.perf_counter()
-        timing["physics"] += c3 - c2
+        if self.wbc is not None:
+            self._torque_physics(self.wbc, t, cmd, obs)
+            c3 = time.perf_counter()
+        else:
+            ctrl, servoed = self._whole_body(cmd, obs)
+            c2 = time.perf_counter()
+            timing["ik"] += c2 - c1
+            self._physics(t, ctrl, servoed)
+            c3 = time.perf_counter()
+            timing["physics"] += c3 - c2
         if self.video.frame(k, self.sim.data):
             timing["render"] += time.perf_counter() - c3
         return True
@@ -465,6 +480,7 @@ class BipedWalk:
         """Actuator commands (12,) (set points [rad], ankle torques [N m]) and which actuators
         are position servoed."""
         opts, sim = self.opts, self.sim
+        assert self.ik is not None
         stance_side = self.swing.stance
         com_cmd = cmd.com_ref.copy()
         ankle = self._ankle_commands(cmd, obs)
@@ -490,6 +506,54 @@ class BipedWalk:
         else:
             q_des = self.ik.solve(cmd.feet, com_cmd, cmd.yaw, self.dt, opts.ik_iterations)
         return self._actuator_commands(q_des, ankle, obs)
+
+    def _cop_target(self, cmd: Command, t_in: float) -> CopTarget | None:
+        """The whole-body QP's ground moment ``t_in`` [s] into the control period: the adjuster's
+        ALIP torque about the stance sole in single support (``ankle_torque``); in double
+        support zero about the contact point that ramps from the stance sole to the landed one
+        (the reset map's model, eq. 5.8); None outside the steps (the CoM tracks in 3-D)."""
+        if not (cmd.walking and self.opts.ankle_torque):
+            return None
+        stance = self.swing.stance
+        p0 = self.sim.sole(stance)[0]
+        if cmd.single:
+            return CopTarget((stance,), p0, self.act.ankle_u)
+        s = min(1.0, max(0.0, (cmd.tp + t_in - self.t_ss) / self.t_ds))
+        p1 = self.sim.sole(stance.other)[0]
+        return CopTarget(self.sim.sides, p0 + s * (p1 - p0), np.zeros(2))
+
+    def _torque_physics(self, wbc: BipedWbc, t: float, cmd: Command, obs: Observation) -> None:
+        """Step MuJoCo through one control period with the whole-body QP's joint torques
+        recomputed at every physics step from the measured state.
+
+        The feet in contact are the stance foot in single support and both otherwise. A QP
+        without a solution (a robot already falling) keeps the last torques and is counted in
+        ``timing["qp_failures"]``.
+        """
+        sim, timing = self.sim, self.log.timing
+        mj, m, d = sim.mujoco, sim.model, sim.data
+        step = float(m.opt.timestep)
+        sides = (self.swing.stance,) if cmd.single else sim.sides
+        wbc.command(cmd, self.dt)
+        com, vel, l_g = obs.com, obs.vel, obs.l_g
+        for j in range(self.substeps):
+            c0 = time.perf_counter()
+            if j > 0:
+                mj.mj_forward(m, d)
+                com, vel, l_g = sim.com_state()
+            cop = self._cop_target(cmd, j * step)
+            try:
+                tau = wbc.torques((j + 1) / self.substeps, sides, cop, com, vel, l_g)
+            except SolverError:
+                timing["qp_failures"] = timing.get("qp_failures", 0.0) + 1.0
+                tau = self.act.ctrl_prev
+            self.act.ctrl_prev = tau
+            c1 = time.perf_counter()
+            timing["ik"] += c1 - c0
+            d.xfrc_applied[sim.torso, :3] = self._push_force(t + j * step)
+            d.ctrl[sim.actuators] = tau
+            mj.mj_step(m, d)
+            timing["physics"] += time.perf_counter() - c1
 
     def _actuator_commands(
         self, q_des: FloatArray, ankle: dict[Side, FloatArray | None], obs: Observation
@@ -517,6 +581,14 @@ class BipedWalk:
         return ctrl, servoed
 
     # --------------------------------------------------------------------------- physics
+    def _push_force(self, t: float) -> FloatArray:
+        """Sum of the pushes' forces (3,) [N] active at ``t``."""
+        force = np.zeros(3)
+        for p in self.opts.pushes:
+            if p.active(t):
+                force += p.force
+        return force
+
     def _physics(self, t: float, ctrl: FloatArray, servoed: NDArray[np.bool_]) -> None:
         """Apply the pushes and step MuJoCo through one control period.
 
@@ -526,11 +598,7 @@ class BipedWalk:
         """
         sim, act = self.sim, self.act
         mj, m, d = sim.mujoco, sim.model, sim.data
-        push_force = np.zeros(3)
-        for p in self.opts.pushes:
-            if p.active(t):
-                push_force += p.force
-        d.xfrc_applied[sim.torso, :3] = push_force
+        d.xfrc_applied[sim.torso, :3] = self._push_force(t)
         ramp = servoed & act.pos_prev
         for j in range(self.substeps):
             w = (j + 1) / self.substeps
