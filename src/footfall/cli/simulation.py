@@ -187,6 +187,21 @@ def simulate_command(
 
 # --- compare (issue 4) ---
 #: help of the walks' ``--heading-segments`` (``walk``, ``compare --sim mujoco``)
+#: the walker's controller unless --controller says otherwise
+DEFAULT_CONTROLLER = "servo"
+_CONTROLLER_HELP = (
+    "wbc: whole-body inverse dynamics, every joint torque-driven, the ALIP ankle torque as the "
+    "commanded centre of pressure (500 Hz QP); servo: differential IK to joint position servos."
+)
+
+
+def _check_controller(controller: str) -> None:
+    from footfall.sim.biped.options import CONTROLLERS
+
+    if controller not in CONTROLLERS:
+        raise InputError("controller", controller, f"one of {', '.join(CONTROLLERS)}")
+
+
 _WALK_SEGMENTS_HELP = (
     "Heading segments L of the miqcqp / kinematic plans (eq. 5.12g-h); default: 64 for the "
     "robot-aware plans (with 16, straight plans step wide at theta = 0, a breakpoint of the 16; "
@@ -228,12 +243,16 @@ def compare_command(
         "`walk`); --document-reach: the document's problem (the reduced simulation always is).",
     ),
     heading_segments: int | None = typer.Option(None, help="--sim mujoco: " + _WALK_SEGMENTS_HELP),
+    controller: str = typer.Option(
+        DEFAULT_CONTROLLER, help="--sim mujoco: the walker's controller, " + _CONTROLLER_HELP
+    ),
 ) -> None:
     """Section 5.5: every planner through the same MPC and plant over seeded disturbed trials."""
     from footfall.terrain.resolve import resolve_scene
 
     if sim not in ("reduced", "mujoco"):
         raise InputError("sim", sim, "reduced or mujoco")
+    _check_controller(controller)
     n_steps = _steps_arg(steps)
     if sim == "mujoco":
         _compare_mujoco(
@@ -246,6 +265,7 @@ def compare_command(
             n_steps,
             robot_aware,
             heading_segments,
+            controller,
         )
         return
 
@@ -314,6 +334,7 @@ def _compare_mujoco(
     n_steps: int | dict[str, int] | None = None,
     robot_aware: bool = True,
     heading_segments: int | None = None,
+    controller: str = "servo",
 ) -> None:
     """``compare --sim mujoco``: the section 5.5 table from MuJoCo walks (issue 7)."""
     from footfall.experiments.compare_mujoco import (
@@ -347,9 +368,11 @@ def _compare_mujoco(
             progress=lambda line: status.update(line),
             robot_aware=robot_aware,
             heading_segments=heading_segments,
+            controller=controller,
         )
     table = compare_table(rows)
-    paths = write_mujoco_outputs(out, rows, table, describe(trials, force, PUSH_DURATION))
+    header = describe(trials, force, PUSH_DURATION) + f" Controller: {controller}."
+    paths = write_mujoco_outputs(out, rows, table, header)
     for line in summary_lines(table):
         console.print(line)
     console.print(f"wrote {', '.join(str(p) for p in paths)}")
@@ -381,6 +404,7 @@ def walk_cmd(
         "frames, swing bound); --document-reach: eq. (5.12f) in the stance foot's frame only.",
     ),
     heading_segments: int | None = typer.Option(None, help=_WALK_SEGMENTS_HELP),
+    controller: str = typer.Option(DEFAULT_CONTROLLER, help=_CONTROLLER_HELP),
 ) -> None:
     """Walk a footstep plan with the MuJoCo biped (document 000, section 5.5).
 
@@ -404,6 +428,7 @@ def walk_cmd(
     from footfall.viz.walk_plot import plot_walk
 
     check_planner_name(planner)
+    _check_controller(controller)
     if steps is not None and steps < 1:
         raise InputError("steps", steps, "an integer >= 1")
     push = non_negative("push", push)
@@ -425,8 +450,9 @@ def walk_cmd(
     if not plan.has_solution:
         console.print(f"{sc.name}: {planner} found no plan ({plan.status.value}). {plan.message}")
         raise typer.Exit(1)
-    pushes = (random_push(seed, push, plan, WalkOptions()),) if push > 0 else ()
-    opts = WalkOptions(pushes=pushes)
+    opts = WalkOptions(controller=controller)
+    pushes = (random_push(seed, push, plan, opts),) if push > 0 else ()
+    opts = WalkOptions(controller=controller, pushes=pushes)
     with console.status(f"walking {plan.n_steps} steps in MuJoCo ..."):
         res = walk(
             sc, plan, opts, model_params=model, video_path=out / "walk.mp4" if video else None

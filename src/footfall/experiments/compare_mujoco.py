@@ -57,6 +57,7 @@ def compare_mujoco(
     progress: Callable[[str], None] | None = None,
     robot_aware: bool = True,
     heading_segments: int | None = None,
+    controller: str = "servo",
 ) -> list[dict[str, Any]]:
     """Walk every scene x planner x seed in MuJoCo with a seeded push; one row per walk.
 
@@ -73,6 +74,7 @@ def compare_mujoco(
             (:func:`plan_for_walk`); False: the document's problem.
         heading_segments: L of the miqcqp and kinematic plans (:func:`plan_for_walk`; None: its
             default).
+        controller: the walker's whole-body controller (``WalkOptions.controller``).
 
     Returns:
         Rows of :func:`walk_row` plus ``plan_status`` and ``plan_time_s``; a scene/planner
@@ -100,10 +102,11 @@ def compare_mujoco(
                 rows.append({"scene": name, "planner": planner, "plan_status": plan.status.value})
                 continue
             for seed in seeds:
-                opts = WalkOptions()
+                opts = WalkOptions(controller=controller)
                 pushes = (random_push(seed, push, plan, opts),) if push > 0 else ()
-                res = walk(scene, plan, WalkOptions(pushes=pushes))
+                res = walk(scene, plan, WalkOptions(controller=controller, pushes=pushes))
                 row = walk_row(scene, planner, seed, push, res)
+                row["controller"] = controller
                 row["plan_status"] = plan.status.value
                 row["plan_time_s"] = plan_time
                 rows.append(row)

@@ -61,10 +61,7 @@ class MujocoWbcModel:
         self.nv = int(m.nv)
         self._mass = np.zeros((self.nv, self.nv))
         self._new_full_m = not hasattr(data, "qM")
-        self._jacp = np.zeros((3, self.nv))
-        self._jacr = np.zeros((3, self.nv))
-        self._jdp = np.zeros((3, self.nv))
-        self._jdr = np.zeros((3, self.nv))
+        self._jdot = np.zeros((6, self.nv))
 
     def set_torque_mode(self) -> None:
         """Make every actuator a motor: ``force = ctrl`` (clipped to its force range)."""
@@ -88,11 +85,10 @@ class MujocoWbcModel:
         angular) and its drift ``Jdot qd`` (6,)."""
         mj, m, d = self.mj, self.m, self.d
         pt = np.asarray(point, dtype=float).reshape(3, 1)
-        mj.mj_jac(m, d, self._jacp, self._jacr, pt, body)
-        mj.mj_jacDot(m, d, self._jdp, self._jdr, pt, body)
-        jac = np.vstack([self._jacp, self._jacr])
-        drift = np.concatenate([self._jdp @ d.qvel, self._jdr @ d.qvel])
-        return jac, drift
+        jac = np.empty((6, self.nv))
+        mj.mj_jac(m, d, jac[:3], jac[3:], pt, body)
+        mj.mj_jacDot(m, d, self._jdot[:3], self._jdot[3:], pt, body)
+        return jac, self._jdot @ d.qvel
 
     def contact(
         self,

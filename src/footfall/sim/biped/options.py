@@ -14,6 +14,7 @@ from footfall.errors import InputError
 from footfall.models.biped import BipedParams
 from footfall.planning.plan import FootstepPlan
 from footfall.sim.biped.model import BipedModel, WalkerModel, measure_model
+from footfall.sim.biped.wbc import WbcGains
 from footfall.sim.pushes import Push
 from footfall.terrain.scene import Scene
 
@@ -37,6 +38,7 @@ class WalkOptions:
             position servos, the stance ankle torque-driven with the ALIP torque; ``wbc``: the
             whole-body inverse-dynamics QP (:mod:`footfall.sim.biped.wbc`) drives every joint by
             torque, the ALIP torque being the stance foot's commanded centre of pressure.
+        wbc_gains: gains and weights of the ``wbc`` controller's tasks.
         control_dt: control period (measurement, adjuster, reference, IK) [s]; a multiple of the
             physics step. The whole-body QP of ``wbc`` runs at every physics step (500 Hz) from
             the measured state, with this period's references.
@@ -77,7 +79,14 @@ class WalkOptions:
         true_momentum: give the adjuster the true angular momentum about the stance point
             (``L_G + m (c - p) x v``, Gong & Grizzle; eq. 5.1's L) instead of
             ``m z_H (-v_y, v_x)`` from the CoM velocity: the swing leg and torso carry momentum
-            the CoM velocity does not show.
+            the CoM velocity does not show. None: True with ``servo``, False with ``wbc``. The
+            torque controller realises the ALIP exactly about the stance foot (the measured
+            ``dL/dt`` matches ``m g x + u`` to about 1 N m), but the legs' own momentum about the
+            CoM (``L_G_y`` about 1 kg m^2/s at every touchdown of our biped) makes the CoM move
+            slower than ``L / (m z_H)`` says: the MPC, told the true momentum, saturated the
+            ankle torque every step and the robot fell on stairs_slope_gap (0 of 2 walks);
+            told the CoM velocity, it walked 2 of 2 (benchmarks/RESULTS.md, "Whole-body
+            control").
         stop_on_fall: end the simulation when a fall is detected.
         landing_margin: the walker's MPC keeps each footstep this much further inside its region
             than the plan did (its ``region_margin``, half the sole length for
@@ -106,6 +115,7 @@ class WalkOptions:
     """
 
     controller: str = "servo"
+    wbc_gains: WbcGains = WbcGains()
     control_dt: float = 0.01
     ik_iterations: int = 2
     swing_clearance: float = 0.05
@@ -120,7 +130,7 @@ class WalkOptions:
     stop_steps: int = STOP_STEPS
     com_gain: float = 1.5
     ankle_torque: bool = True
-    true_momentum: bool = True
+    true_momentum: bool | None = None
     stop_on_fall: bool = True
     closed_loop_ik: bool = True
     landing_margin: float = 0.02
@@ -131,6 +141,8 @@ class WalkOptions:
     def __post_init__(self) -> None:
         if self.controller not in CONTROLLERS:
             raise InputError("controller", self.controller, f"one of {', '.join(CONTROLLERS)}")
+        if not isinstance(self.wbc_gains, WbcGains):
+            raise InputError("wbc_gains", self.wbc_gains, "a WbcGains")
         check_fields(self, positive, ("control_dt", "swing_clearance", "shift_time", "stop_time"))
         check_fields(
             self,
@@ -149,6 +161,8 @@ class WalkOptions:
         if fb > 1.0:
             raise InputError("com_feedback", self.com_feedback, "a share in [0, 1]")
         object.__setattr__(self, "com_feedback", fb)
+        if self.true_momentum is not None and not isinstance(self.true_momentum, bool):
+            raise InputError("true_momentum", self.true_momentum, "True, False or None")
         it = self.ik_iterations
         if isinstance(it, bool) or not isinstance(it, int) or it < 1:
             raise InputError("ik_iterations", it, "an integer >= 1")
@@ -157,6 +171,13 @@ class WalkOptions:
             if not isinstance(p, Push):
                 raise InputError(f"pushes[{i}]", p, "a Push")
         object.__setattr__(self, "pushes", pushes)
+
+    @property
+    def uses_true_momentum(self) -> bool:
+        """``true_momentum`` after the controller's default (see the attribute)."""
+        if self.true_momentum is None:
+            return self.controller == "servo"
+        return self.true_momentum
 
 
 def _check_plan_robot(robot: BipedParams, model: WalkerModel | None) -> None:

@@ -160,7 +160,7 @@ class BipedWalk:
         self.wbc: BipedWbc | None = None
         self.ik: WholeBodyIK | None = None
         if self.opts.controller == "wbc":
-            self.wbc = BipedWbc(sim)
+            self.wbc = BipedWbc(sim, self.opts.wbc_gains)
         else:
             self.ik = WholeBodyIK(sim)
         # the IK's nominal CoM offset: the standing CoM is where the model puts it, not at mid-feet
@@ -336,7 +336,7 @@ class BipedWalk:
         # measured ALIP state about the stance sole centre (eq. 5.1)
         r = obs.com - stance
         x_cv = alip.state_from_velocity(r[:2], obs.vel[:2])
-        if opts.true_momentum:
+        if opts.uses_true_momentum:
             l_c = obs.l_g + self.sim.mass * np.cross(r, obs.vel)
             x_meas = np.array([r[0], r[1], l_c[0], l_c[1]])
         else:

@@ -74,7 +74,7 @@ class WbcGains:
     momentum_kd: float = 10.0
     com_weight: float = 10.0
     cop_weight: float = 1e5
-    momentum_weight: float = 1.0
+    momentum_weight: float = 10.0
     torso_weight: float = 5.0
     swing_weight: float = 10.0
     posture_weight: float = 0.05
