@@ -200,21 +200,31 @@ def clip_halfplane(poly: FloatArray, a: FloatArray, b: float, tol: float = 1e-12
 
 
 def rotation_log(r: FloatArray) -> FloatArray:
-    """Rotation vector (3,) [rad] (axis times angle in [0, pi]) of the rotation matrix ``r``."""
+    """Rotation vector (3,) [rad] (axis times angle in [0, pi]) of the rotation matrix ``r``.
+
+    The angle is ``atan2(|w| / 2, (tr r - 1) / 2)`` with ``w`` the vector of ``r - r^T``
+    (accurate at every angle, unlike ``acos`` of the trace near 0 and pi); near a half turn,
+    where ``w`` vanishes, the axis comes from the symmetric part of ``r``.
+    """
     w = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
-    cos = max(-1.0, min(1.0, 0.5 * (float(r[0, 0] + r[1, 1] + r[2, 2]) - 1.0)))
-    angle = math.acos(cos)
+    s = 0.5 * math.sqrt(float(w @ w))  # sin(angle)
+    c = 0.5 * (float(r[0, 0] + r[1, 1] + r[2, 2]) - 1.0)  # cos(angle)
+    angle = math.atan2(s, c)
     if angle < 1e-9:
         return 0.5 * w
-    if angle < math.pi - 1e-6:
-        return angle / (2.0 * math.sin(angle)) * w
-    # near a half turn: the axis is the dominant column of (r + I) / 2 = a a^T
-    b = 0.5 * (np.asarray(r, dtype=float) + np.eye(3))
+    if c > -0.9:
+        return (angle / (2.0 * s)) * w
+    # near a half turn w is small: the axis a comes from the symmetric part of
+    # r = cos I + sin [a]x + (1 - cos) a a^T, i.e. a a^T = ((r + r^T) / 2 - cos I) / (1 - cos),
+    # and its sign from w = 2 sin a
+    rr = np.asarray(r, dtype=float)
+    b = (0.5 * (rr + rr.T) - c * np.eye(3)) / (1.0 - c)
     k = int(np.argmax(np.diag(b)))
-    axis = b[:, k] / math.sqrt(max(b[k, k], 1e-300))
+    axis = b[:, k] / math.sqrt(max(float(b[k, k]), 1e-300))
+    axis /= float(np.linalg.norm(axis))
     if float(axis @ w) < 0.0:
         axis = -axis
-    return angle * axis / float(np.linalg.norm(axis))
+    return angle * axis
 
 
 def rotation_exp(v: FloatArray) -> FloatArray:

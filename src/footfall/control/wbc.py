@@ -51,54 +51,21 @@ from typing import Any
 import numpy as np
 
 from footfall._typing import FloatArray
-from footfall.control._wbc_kernel import assemble
+from footfall.control._wbc_kernel import PYRAMID_SHARE, _tangents, assemble
 from footfall.errors import InputError, SolverError
 
-#: the inscribed friction pyramid: each tangential component at most mu / sqrt(2) of the normal
-PYRAMID_SHARE = 1.0 / math.sqrt(2.0)
 #: default regularisation weights of the accelerations [1/(m/s^2)^2], forces [1/N^2] and torques
 QACC_REGULARISATION = 1e-6
 FORCE_REGULARISATION = 1e-8
 TORQUE_REGULARISATION = 1e-7
 #: daqp exit flags that are a solution (1 optimal, 2 soft-optimal)
 DAQP_OK = (1, 2)
-#: daqp's stand-in for an infinite bound
-INFINITY = 1e30
-
-
-def skew(v: FloatArray) -> FloatArray:
-    """Cross-product matrix (3, 3): ``skew(a) @ b = a x b``."""
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-
-
-def skew_blocks(r: FloatArray) -> FloatArray:
-    """(3, 3k): the cross-product matrices of the rows of ``r`` (k, 3) side by side."""
-    k = r.shape[0]
-    s = np.zeros((3, k, 3))
-    s[0, :, 1], s[0, :, 2] = -r[:, 2], r[:, 1]
-    s[1, :, 0], s[1, :, 2] = r[:, 2], -r[:, 0]
-    s[2, :, 0], s[2, :, 1] = -r[:, 1], r[:, 0]
-    return s.reshape(3, 3 * k)
 
 
 def tangent_basis(normal: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Two unit tangents (3,) orthogonal to the unit ``normal`` and to each other."""
-    nx, ny, nz = (float(c) for c in normal)
-    if abs(nx) < 0.9:  # t1 = n x e_x
-        t1 = np.array([0.0, nz, -ny])
-    else:  # t1 = n x e_y
-        t1 = np.array([-nz, 0.0, nx])
-    t1 /= math.sqrt(float(t1 @ t1))
-    t2 = np.array([ny * t1[2] - nz * t1[1], nz * t1[0] - nx * t1[2], nx * t1[1] - ny * t1[0]])
-    return t1, t2
-
-
-def shift_wrench(origin: FloatArray, about: FloatArray) -> FloatArray:
-    """(6, 6) map of a wrench (force; moment about ``origin``) to the same wrench with its moment
-    about ``about``: ``m_about = m_origin + (origin - about) x F``."""
-    t = np.eye(6)
-    t[3:, :3] = skew(np.asarray(origin, dtype=float) - np.asarray(about, dtype=float))
-    return t
+    """The two unit tangents (3,) of the friction pyramid of a contact with unit ``normal``."""
+    t1, t2 = _tangents(np.asarray(normal, dtype=float))
+    return np.asarray(t1), np.asarray(t2)
 
 
 @dataclass(frozen=True)
@@ -129,14 +96,6 @@ class Contact:
     @property
     def n_points(self) -> int:
         return int(self.points.shape[0])
-
-    def wrench_map(self, about: FloatArray) -> FloatArray:
-        """(6, 3k): the wrench (force; moment about ``about``) of this contact's point forces."""
-        k = self.n_points
-        g = np.empty((6, 3 * k))
-        g[:3] = np.tile(np.eye(3), k)
-        g[3:] = skew_blocks(self.points - np.asarray(about, dtype=float))
-        return g
 
 
 @dataclass(frozen=True)
@@ -278,7 +237,7 @@ class WholeBodyController:
         if check:
             _check_problem(p)
         packed = _pack(p)
-        h_mat, g_vec, c_mat, lower, upper, n_eq, t_map = assemble(*packed, *self.eps)
+        h_mat, g_vec, c_mat, lower, upper, n_eq, t_map = assemble(*packed, *self.eps)  # type: ignore[call-arg]
         n = h_mat.shape[0]
         senses = np.zeros(lower.shape[0], dtype=np.int32)
         senses[:n_eq] = 5
@@ -290,8 +249,13 @@ class WholeBodyController:
             self._warm = None
             self.failures += 1
             raise SolverError(f"whole-body QP has no solution (daqp exit flag {flag})")
-        self._warm = (key, np.asarray(info["lam"]) != 0.0)
         x = np.asarray(x)
+        if not np.all(np.isfinite(x)):
+            # only non-finite data (an unchecked problem) gets here: no solution to return
+            self._warm = None
+            self.failures += 1
+            raise SolverError("whole-body QP returned non-finite values (non-finite input?)")
+        self._warm = (key, np.asarray(info["lam"]) != 0.0)
         forces = {}
         o = nv
         for c in p.contacts:
@@ -331,17 +295,17 @@ def _pack(p: WbcProblem) -> tuple[Any, ...]:
         m_rhs[r0:r1] = t.acceleration - t.drift
         m_w[r0:r1] = _weights(t.weight, r1 - r0, t.name)
         r0 = r1
-    rw = sum(t.target.shape[0] for t in p.wrench_tasks)
+    rw = sum(wt.target.shape[0] for wt in p.wrench_tasks)
     w_rows, w_about = np.empty((rw, 6)), np.empty((rw, 3))
     w_target, w_weight, w_mask = np.empty(rw), np.empty(rw), np.zeros((rw, nc))
     names = [c.name for c in p.contacts]
     r0 = 0
-    for t in p.wrench_tasks:
-        r1 = r0 + t.target.shape[0]
-        w_rows[r0:r1], w_about[r0:r1], w_target[r0:r1] = t.rows, t.about, t.target
-        w_weight[r0:r1] = _weights(t.weight, r1 - r0, t.name)
+    for wt in p.wrench_tasks:
+        r1 = r0 + wt.target.shape[0]
+        w_rows[r0:r1], w_about[r0:r1], w_target[r0:r1] = wt.rows, wt.about, wt.target
+        w_weight[r0:r1] = _weights(wt.weight, r1 - r0, wt.name)
         for i, nm in enumerate(names):
-            if t.contacts is None or nm in t.contacts:
+            if wt.contacts is None or nm in wt.contacts:
                 w_mask[r0:r1, i] = 1.0
         r0 = r1
     return (
@@ -376,8 +340,9 @@ def _check_problem(p: WbcProblem) -> None:
     _shape("mass_matrix", p.mass_matrix, (nv, nv))
     _shape("bias", p.bias, (nv,))
     na = np.asarray(p.actuated).shape[0]
-    _shape("torque_min", p.torque_min, (na,))
-    _shape("torque_max", p.torque_max, (na,))
+    # a torque without a limit is +-inf (MujocoWbcModel gives it so), never NaN
+    _shape("torque_min", p.torque_min, (na,), allow_inf=True)
+    _shape("torque_max", p.torque_max, (na,), allow_inf=True)
     if np.any(np.asarray(p.torque_min) > np.asarray(p.torque_max)):
         raise InputError("torque_min", p.torque_min, "<= torque_max")
     act = np.asarray(p.actuated)
@@ -393,38 +358,44 @@ def _check_problem(p: WbcProblem) -> None:
         _shape(f"contact {c.name}.normal", c.normal, (3,))
         if c.points.ndim != 2 or c.points.shape[1] != 3 or c.points.shape[0] < 1:
             raise InputError(f"contact {c.name}.points", c.points.shape, "(k, 3) with k >= 1")
+        _shape(f"contact {c.name}.points", c.points, c.points.shape)
         if not math.isfinite(c.friction) or c.friction <= 0:
             raise InputError(f"contact {c.name}.friction", c.friction, "a positive number")
         if abs(float(np.linalg.norm(c.normal)) - 1.0) > 1e-6:
             raise InputError(f"contact {c.name}.normal", c.normal.tolist(), "a unit vector")
     for t in p.motion_tasks:
         r = t.acceleration.shape[0] if np.ndim(t.acceleration) == 1 else -1
+        _shape(f"task {t.name}.acceleration", t.acceleration, (r,))
         _shape(f"task {t.name}.jacobian", t.jacobian, (r, nv))
         _shape(f"task {t.name}.drift", t.drift, (r,))
-    for t in p.wrench_tasks:
-        r = t.target.shape[0] if np.ndim(t.target) == 1 else -1
-        _shape(f"task {t.name}.rows", t.rows, (r, 6))
-        _shape(f"task {t.name}.about", t.about, (3,))
-        unknown = set(t.contacts or ()) - set(names)
+    for wt in p.wrench_tasks:
+        r = wt.target.shape[0] if np.ndim(wt.target) == 1 else -1
+        _shape(f"task {wt.name}.target", wt.target, (r,))
+        _shape(f"task {wt.name}.rows", wt.rows, (r, 6))
+        _shape(f"task {wt.name}.about", wt.about, (3,))
+        unknown = set(wt.contacts or ()) - set(names)
         if unknown:
-            raise InputError(f"task {t.name}.contacts", sorted(unknown), f"names among {names}")
+            raise InputError(f"task {wt.name}.contacts", sorted(unknown), f"names among {names}")
 
 
-def _shape(name: str, a: FloatArray, shape: tuple[int, ...]) -> None:
+def _shape(name: str, a: FloatArray, shape: tuple[int, ...], allow_inf: bool = False) -> None:
+    """Raise :class:`InputError` naming ``name`` unless ``a`` has ``shape`` and finite values
+    (``allow_inf``: +-inf allowed, NaN never)."""
     arr = np.asarray(a)
     if arr.shape != shape:
         raise InputError(name, arr.shape, f"shape {shape}")
-    if not np.all(np.isfinite(arr)):
+    bad = np.isnan(arr) if allow_inf else ~np.isfinite(arr)
+    if np.any(bad):
         raise InputError(name, "non-finite values", "finite numbers")
 
 
 __all__ = [
+    "PYRAMID_SHARE",
     "Contact",
     "MotionTask",
     "WbcProblem",
     "WbcSolution",
     "WholeBodyController",
     "WrenchTask",
-    "skew",
     "tangent_basis",
 ]

@@ -4,7 +4,7 @@ of what it is asked to walk."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -115,7 +115,7 @@ class WalkOptions:
     """
 
     controller: str = "servo"
-    wbc_gains: WbcGains = WbcGains()
+    wbc_gains: WbcGains = field(default_factory=WbcGains)
     control_dt: float = 0.01
     ik_iterations: int = 2
     swing_clearance: float = 0.05
