@@ -40,6 +40,8 @@ class WalkResult:
         timing: wall-clock seconds per part: ``control`` (measurement, adjuster, references),
             ``ik``, ``physics``, ``render``.
         sim_time: simulated time [s].
+        controller: the controller's own account (``wbc``: :class:`~footfall.sim.biped.wbc.WbcTally`,
+            torques, friction and centres of pressure against their limits; ``servo``: IK failures).
         video: path of the MP4 or None; video_note says why there is none.
     """
 
@@ -59,6 +61,7 @@ class WalkResult:
     metrics: WalkMetrics
     timing: dict[str, float]
     sim_time: float
+    controller: dict[str, Any]
     video: Path | None = None
     video_note: str = ""
 
@@ -76,6 +79,7 @@ class WalkResult:
                 "commanded": self.targets,
                 "landed": self.landed,
             },
+            "controller": self.controller,
             "video": str(self.video) if self.video else None,
             "video_note": self.video_note,
         }

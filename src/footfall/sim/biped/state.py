@@ -149,6 +149,7 @@ class WalkLog:
     fell: bool = False
     fall_time: float = math.nan
     sim_time: float = 0.0
+    controller: dict[str, Any] = field(default_factory=dict)
 
     @classmethod
     def empty(cls, n_ticks: int, dt: float, plan: FootstepPlan, n_planned: int) -> WalkLog:

@@ -528,7 +528,7 @@ class BipedWalk:
 
         The feet in contact are the stance foot in single support and both otherwise. A QP
         without a solution (a robot already falling) keeps the last torques and is counted in
-        ``timing["qp_failures"]``.
+        the controller's tally (``WalkResult.controller``).
         """
         sim, timing = self.sim, self.log.timing
         mj, m, d = sim.mujoco, sim.model, sim.data
@@ -544,8 +544,7 @@ class BipedWalk:
             cop = self._cop_target(cmd, j * step)
             try:
                 tau = wbc.torques((j + 1) / self.substeps, sides, cop, com, vel, l_g)
-            except SolverError:
-                timing["qp_failures"] = timing.get("qp_failures", 0.0) + 1.0
+            except SolverError:  # counted in the tally
                 tau = self.act.ctrl_prev
             self.act.ctrl_prev = tau
             c1 = time.perf_counter()
@@ -610,6 +609,10 @@ class BipedWalk:
     def _result(self, k_end: int, wall: float, video_path: Path | None) -> WalkResult:
         """The measurements of the first ``k_end`` ticks and their summary."""
         self.log.timing["total"] = wall
+        if self.wbc is not None:
+            self.log.controller = {"name": "wbc", **self.wbc.tally.to_dict()}
+        elif self.ik is not None:
+            self.log.controller = {"name": "servo", "ik_failures": self.ik.failures}
         log = self.log.trimmed(k_end, self.dt)
         t_goal = self.t_walk0 + self.n_planned * self.t_step
         metrics = summarise(log, self.scene, self.plan, self.sim.params, t_goal)

@@ -24,6 +24,7 @@ Tasks (:class:`WbcGains` holds the gains and weights):
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,13 +40,15 @@ from footfall.control.wbc import (
     WholeBodyController,
     WrenchTask,
 )
-from footfall.errors import InputError
+from footfall.errors import InputError, SolverError
 from footfall.models.biped import Side
 from footfall.sim.biped import names as nm
 from footfall.sim.biped.plant import BipedSim
 from footfall.sim.biped.state import Command
 from footfall.sim.wbc_model import MujocoWbcModel
 
+#: a corner carrying at least this normal force [N] counts in the friction share
+LOADED_CORNER = 1.0
 #: a reference that moves more than this between two commands [m] restarts there (no velocity)
 REFERENCE_JUMP = 0.05
 #: rows of a wrench (force; moment) that select the force, the moment, the horizontal moment
@@ -105,6 +108,53 @@ def yaw_rotation(yaw: float) -> FloatArray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+@dataclass
+class WbcTally:
+    """What the whole-body QPs of a walk commanded, checked against their limits at every
+    physics step: the largest torque as a share of its limit, the largest tangential force as a
+    share of Coulomb's cone ``mu f_n`` over corners carrying at least ``LOADED_CORNER`` (the QP
+    keeps it inside the inscribed pyramid: at most 1) and the largest ``|f_t| - mu f_n`` [N] over
+    all corners (<= 0 up to the solver's tolerance), the smallest corner normal force [N] (>= 0:
+    every centre of pressure inside its sole's corners), and the QPs solved and failed."""
+
+    solves: int = 0
+    failures: int = 0
+    max_torque_share: float = 0.0
+    max_friction_share: float = 0.0
+    max_friction_excess: float = -math.inf
+    min_corner_force: float = math.inf
+
+    def add(self, sol: WbcSolution, problem: WbcProblem) -> None:
+        """Count one solution of ``problem``."""
+        self.solves += 1
+        lim = np.maximum(np.abs(problem.torque_min), np.abs(problem.torque_max))
+        share = np.abs(sol.torque) / np.where(np.isfinite(lim), lim, np.inf)
+        self.max_torque_share = max(self.max_torque_share, float(np.max(share, initial=0.0)))
+        for c in problem.contacts:
+            f = sol.forces[c.name]
+            fn = f @ c.normal
+            ft = np.linalg.norm(f - fn[:, None] * c.normal, axis=1)
+            self.min_corner_force = min(self.min_corner_force, float(np.min(fn)))
+            self.max_friction_excess = max(
+                self.max_friction_excess, float(np.max(ft - c.friction * fn, initial=-np.inf))
+            )
+            loaded = fn > LOADED_CORNER
+            if np.any(loaded):
+                ratio = ft[loaded] / (c.friction * fn[loaded])
+                self.max_friction_share = max(self.max_friction_share, float(np.max(ratio)))
+
+    def to_dict(self) -> dict[str, float | int]:
+        """JSON-ready numbers (walk.json's ``controller``)."""
+        return {
+            "qp_solves": self.solves,
+            "qp_failures": self.failures,
+            "max_torque_share": self.max_torque_share,
+            "max_friction_share": self.max_friction_share,
+            "max_friction_excess_N": self.max_friction_excess if self.solves else math.nan,
+            "min_corner_force_N": self.min_corner_force if self.solves else math.nan,
+        }
+
+
 class BipedWbc:
     """Whole-body torque control of a :class:`BipedSim` (our biped or the G1).
 
@@ -145,6 +195,7 @@ class BipedWbc:
         self._vel: dict[str, FloatArray] = {}
         self.last: WbcSolution | None = None
         self.last_problem: WbcProblem | None = None
+        self.tally = WbcTally()
 
     # ------------------------------------------------------------------------ references
     def command(self, cmd: Command, dt: float) -> None:
@@ -268,8 +319,13 @@ class BipedWbc:
             wrench_tasks=tuple(wrench),
         )
         # the arrays are built here from the model, so the shape checks are skipped
-        self.last = sol = self.qp.solve(problem, check=False)
+        try:
+            self.last = sol = self.qp.solve(problem, check=False)
+        except SolverError:
+            self.tally.failures += 1
+            raise
         self.last_problem = problem
+        self.tally.add(sol, problem)
         return sol.torque
 
     def _swing_task(self, side: Side, rot_ref: FloatArray, share: float) -> MotionTask:
