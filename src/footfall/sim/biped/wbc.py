@@ -124,24 +124,22 @@ class WbcTally:
     max_friction_excess: float = -math.inf
     min_corner_force: float = math.inf
 
-    def add(self, sol: WbcSolution, problem: WbcProblem) -> None:
-        """Count one solution of ``problem``."""
+    def add(self, sol: WbcSolution, problem: WbcProblem, torque_limit: FloatArray) -> None:
+        """Count one solution of ``problem``; ``torque_limit`` (na,) [N m] > 0 (inf: none)."""
         self.solves += 1
-        lim = np.maximum(np.abs(problem.torque_min), np.abs(problem.torque_max))
-        share = np.abs(sol.torque) / np.where(np.isfinite(lim), lim, np.inf)
-        self.max_torque_share = max(self.max_torque_share, float(np.max(share, initial=0.0)))
+        share = float(np.max(np.abs(sol.torque) / torque_limit, initial=0.0))
+        self.max_torque_share = max(self.max_torque_share, share)
         for c in problem.contacts:
             f = sol.forces[c.name]
             fn = f @ c.normal
-            ft = np.linalg.norm(f - fn[:, None] * c.normal, axis=1)
-            self.min_corner_force = min(self.min_corner_force, float(np.min(fn)))
-            self.max_friction_excess = max(
-                self.max_friction_excess, float(np.max(ft - c.friction * fn, initial=-np.inf))
-            )
+            ft = np.sqrt(np.maximum(np.einsum("ij,ij->i", f, f) - fn * fn, 0.0))
+            mu_fn = c.friction * fn
+            self.min_corner_force = min(self.min_corner_force, float(fn.min()))
+            self.max_friction_excess = max(self.max_friction_excess, float((ft - mu_fn).max()))
             loaded = fn > LOADED_CORNER
-            if np.any(loaded):
-                ratio = ft[loaded] / (c.friction * fn[loaded])
-                self.max_friction_share = max(self.max_friction_share, float(np.max(ratio)))
+            if loaded.any():
+                ratio = float((ft[loaded] / mu_fn[loaded]).max())
+                self.max_friction_share = max(self.max_friction_share, ratio)
 
     def to_dict(self) -> dict[str, float | int]:
         """JSON-ready numbers (walk.json's ``controller``)."""
@@ -196,6 +194,9 @@ class BipedWbc:
         self.last: WbcSolution | None = None
         self.last_problem: WbcProblem | None = None
         self.tally = WbcTally()
+        self._torque_limit = np.maximum(
+            np.abs(self.model.torque_min), np.abs(self.model.torque_max)
+        )
 
     # ------------------------------------------------------------------------ references
     def command(self, cmd: Command, dt: float) -> None:
@@ -325,7 +326,7 @@ class BipedWbc:
             self.tally.failures += 1
             raise
         self.last_problem = problem
-        self.tally.add(sol, problem)
+        self.tally.add(sol, problem, self._torque_limit)
         return sol.torque
 
     def _swing_task(self, side: Side, rot_ref: FloatArray, share: float) -> MotionTask:
