@@ -38,7 +38,8 @@ class WalkResult:
         fall_time: when [s] (NaN if none).
         metrics: summary numbers (:func:`~footfall.sim.biped.metrics.summarise`).
         timing: wall-clock seconds per part: ``control`` (measurement, adjuster, references),
-            ``ik``, ``physics``, ``render``.
+            ``ik`` (``servo``) or ``model`` (MuJoCo's model terms, Jacobians and the tasks) and
+            ``qp`` (the whole-body QP) for ``wbc``, ``physics``, ``render``, ``total``.
         sim_time: simulated time [s].
         controller: the controller's own account (``wbc``: :class:`~footfall.sim.biped.wbc.WbcTally`,
             torques, friction and centres of pressure against their limits; ``servo``: IK failures).

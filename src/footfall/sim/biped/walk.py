@@ -611,6 +611,9 @@ class BipedWalk:
         self.log.timing["total"] = wall
         if self.wbc is not None:
             self.log.controller = {"name": "wbc", **self.wbc.tally.to_dict()}
+            # the whole-body time splits into model terms and tasks, and the QP
+            self.log.timing["qp"] = self.wbc.qp_time
+            self.log.timing["model"] = self.log.timing.pop("ik") - self.wbc.qp_time
         elif self.ik is not None:
             self.log.controller = {"name": "servo", "ik_failures": self.ik.failures}
         log = self.log.trimmed(k_end, self.dt)

@@ -25,6 +25,7 @@ Tasks (:class:`WbcGains` holds the gains and weights):
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -194,6 +195,8 @@ class BipedWbc:
         self.last: WbcSolution | None = None
         self.last_problem: WbcProblem | None = None
         self.tally = WbcTally()
+        #: wall time spent in the QP solver (pack, assemble, daqp) [s]
+        self.qp_time = 0.0
         self._torque_limit = np.maximum(
             np.abs(self.model.torque_min), np.abs(self.model.torque_max)
         )
@@ -320,11 +323,14 @@ class BipedWbc:
             wrench_tasks=tuple(wrench),
         )
         # the arrays are built here from the model, so the shape checks are skipped
+        t0 = time.perf_counter()
         try:
             self.last = sol = self.qp.solve(problem, check=False)
         except SolverError:
             self.tally.failures += 1
             raise
+        finally:
+            self.qp_time += time.perf_counter() - t0
         self.last_problem = problem
         self.tally.add(sol, problem, self._torque_limit)
         return sol.torque

@@ -1,0 +1,136 @@
+"""Push recovery of the MuJoCo biped: success against push impulse, per scene and controller.
+
+Run (from the repository root, about 10-20 minutes on 2 cores)::
+
+    OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_pushes.py \\
+        --controllers wbc,servo --impulses 4,6,8,10,12,15 --seeds 10 --out out/pushes
+
+Every walk follows the scene's miqcqp plan (``plan_for_walk``, cached in ``OUT/plans``) with one
+horizontal push of ``impulse / PUSH_DURATION`` newtons for ``PUSH_DURATION`` seconds, in a seeded
+direction at a seeded single support (:func:`footfall.sim.biped.plans.random_push`): seed ``s``
+gives both controllers the same push. Success = the goal reached without a fall. Per scene,
+controller and impulse the table gives the successes, the rate with its Wilson 95 % interval, and
+the impulse at which the success rate crosses 50 % (linear interpolation between the levels
+around it; "> max" when it never falls that low). Rows go to ``OUT/pushes.csv``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import os
+import time
+from multiprocessing import Pool
+from pathlib import Path
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+#: the scenes and their step counts (the walks' smallest N with 64 heading segments, except the
+#: 20 steps of flat_long)
+SCENES = {"flat_long": 20, "discrete_steps": 15, "stairs_slope_gap": 16}
+
+
+def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """Wilson score interval of a binomial proportion k / n."""
+    if n == 0:
+        return (math.nan, math.nan)
+    p = k / n
+    den = 1.0 + z * z / n
+    mid = (p + z * z / (2 * n)) / den
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
+    return (max(0.0, mid - half), min(1.0, mid + half))
+
+
+def crossing(levels: list[float], rates: list[float], level: float = 0.5) -> str:
+    """The impulse where the success rate first falls below ``level`` (linear interpolation)."""
+    if rates and rates[0] < level:
+        return f"< {levels[0]:g}"
+    for i in range(len(levels) - 1):
+        x0, r0, x1, r1 = levels[i], rates[i], levels[i + 1], rates[i + 1]
+        if r0 >= level > r1:
+            return f"{x0 + (r0 - level) / (r0 - r1) * (x1 - x0):.1f}"
+    return f"> {levels[-1]:g}"
+
+
+def _walk(job: tuple[str, str, float, int, str]) -> dict[str, object]:
+    from footfall.sim.biped.options import WalkOptions
+    from footfall.sim.biped.plans import PUSH_DURATION, plan_for_walk, random_push
+    from footfall.sim.biped.walk import walk
+    from footfall.terrain.scene import builtin_scene
+
+    scene_name, controller, impulse, seed, cache = job
+    scene = builtin_scene(scene_name)
+    plan = plan_for_walk(scene, "miqcqp", SCENES[scene_name], 600.0, Path(cache))
+    opts = WalkOptions(controller=controller)
+    push = random_push(seed, impulse / PUSH_DURATION, plan, opts)
+    t0 = time.perf_counter()
+    res = walk(scene, plan, WalkOptions(controller=controller, pushes=(push,)))
+    m = res.metrics
+    return {
+        "scene": scene_name,
+        "controller": controller,
+        "impulse_Ns": impulse,
+        "seed": seed,
+        "success": bool(m.reached_goal and not m.fell),
+        "fell": bool(m.fell),
+        "fall_time_s": res.fall_time,
+        "zmp_mean_m": m.zmp.mean,
+        "wall_s": time.perf_counter() - t0,
+        "sim_s": res.sim_time,
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--controllers", default="wbc,servo")
+    ap.add_argument("--scenes", default=",".join(SCENES))
+    ap.add_argument("--impulses", default="4,6,8,10,12,15", help="push impulses [N s]")
+    ap.add_argument("--seeds", type=int, default=10, help="walks per scene, controller, impulse")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--out", type=Path, default=Path("out/pushes"))
+    a = ap.parse_args()
+    levels = sorted(float(x) for x in a.impulses.split(","))
+    scenes = a.scenes.split(",")
+    controllers = a.controllers.split(",")
+    a.out.mkdir(parents=True, exist_ok=True)
+    cache = str(a.out / "plans")
+    jobs = [
+        (sc, ctl, imp, seed, cache)
+        for sc in scenes
+        for ctl in controllers
+        for imp in levels
+        for seed in range(a.seeds)
+    ]
+    # plan once per scene before the pool (the cache then serves every worker)
+    for sc in scenes:
+        _walk((sc, controllers[0], levels[0], 0, cache))
+    with Pool(a.workers) as pool:
+        rows = pool.map(_walk, jobs, chunksize=1)
+    with (a.out / "pushes.csv").open("w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    print("| scene | controller | " + " | ".join(f"{x:g} N s" for x in levels) + " | 50 % at |")
+    print("|---|---|" + "---|" * len(levels) + "---|")
+    for sc in scenes:
+        for ctl in controllers:
+            cells, rates = [], []
+            for imp in levels:
+                rs = [
+                    r
+                    for r in rows
+                    if (r["scene"], r["controller"], r["impulse_Ns"]) == (sc, ctl, imp)
+                ]
+                k = sum(bool(r["success"]) for r in rs)
+                lo, hi = wilson(k, len(rs))
+                rates.append(k / len(rs))
+                cells.append(f"{k}/{len(rs)} [{100 * lo:.0f}-{100 * hi:.0f} %]")
+            print(f"| {sc} | {ctl} | " + " | ".join(cells) + f" | {crossing(levels, rates)} N s |")
+    wall = sum(float(r["wall_s"]) for r in rows)
+    sim = sum(float(r["sim_s"]) for r in rows)
+    print(f"\n{len(rows)} walks, {sim / wall:.1f}x real time per walk (mean over workers)")
+
+
+if __name__ == "__main__":
+    main()
