@@ -3,7 +3,7 @@
 Run (from the repository root, about 10-20 minutes on 2 cores)::
 
     OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_pushes.py \\
-        --controllers wbc,servo --impulses 4,6,8,10,12,15 --seeds 10 --out out/pushes
+        --controllers wbc,servo --impulses 4,6,8,10,12,15 --seeds 10 --seed-start 0 --out out/pushes
 
 Every walk follows the scene's miqcqp plan (``plan_for_walk``, cached in ``OUT/plans``) with one
 horizontal push of ``impulse / PUSH_DURATION`` newtons for ``PUSH_DURATION`` seconds, in a seeded
@@ -87,6 +87,7 @@ def main() -> None:
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--impulses", default="4,6,8,10,12,15", help="push impulses [N s]")
     ap.add_argument("--seeds", type=int, default=10, help="walks per scene, controller, impulse")
+    ap.add_argument("--seed-start", type=int, default=0, help="first seed (held-out seeds)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", type=Path, default=Path("out/pushes"))
     a = ap.parse_args()
@@ -100,7 +101,7 @@ def main() -> None:
         for sc in scenes
         for ctl in controllers
         for imp in levels
-        for seed in range(a.seeds)
+        for seed in range(a.seed_start, a.seed_start + a.seeds)
     ]
     # plan once per scene before the pool (the cache then serves every worker)
     for sc in scenes:
