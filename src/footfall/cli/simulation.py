@@ -188,7 +188,7 @@ def simulate_command(
 # --- compare (issue 4) ---
 #: help of the walks' ``--heading-segments`` (``walk``, ``compare --sim mujoco``)
 #: the walker's controller unless --controller says otherwise
-DEFAULT_CONTROLLER = "servo"
+DEFAULT_CONTROLLER = "wbc"
 _CONTROLLER_HELP = (
     "wbc: whole-body inverse dynamics, every joint torque-driven, the ALIP ankle torque as the "
     "commanded centre of pressure (500 Hz QP); servo: differential IK to joint position servos."
@@ -334,7 +334,7 @@ def _compare_mujoco(
     n_steps: int | dict[str, int] | None = None,
     robot_aware: bool = True,
     heading_segments: int | None = None,
-    controller: str = "servo",
+    controller: str = DEFAULT_CONTROLLER,
 ) -> None:
     """``compare --sim mujoco``: the section 5.5 table from MuJoCo walks (issue 7)."""
     from footfall.experiments.compare_mujoco import (

@@ -57,7 +57,7 @@ def compare_mujoco(
     progress: Callable[[str], None] | None = None,
     robot_aware: bool = True,
     heading_segments: int | None = None,
-    controller: str = "servo",
+    controller: str = "wbc",
 ) -> list[dict[str, Any]]:
     """Walk every scene x planner x seed in MuJoCo with a seeded push; one row per walk.
 

@@ -73,11 +73,12 @@ def test_every_qp_respects_torques_friction_and_the_sole(wbc_walk) -> None:  # t
     assert res.to_dict()["controller"] == c
 
 
-def test_servo_walks_report_their_controller() -> None:
-    opts = WalkOptions()
-    assert opts.controller == "servo" and opts.uses_true_momentum
-    assert not WalkOptions(controller="wbc").uses_true_momentum
+def test_the_controller_chooses_the_momentum_fed_to_the_mpc() -> None:
+    assert WalkOptions().controller == "wbc"
+    assert not WalkOptions().uses_true_momentum
+    assert WalkOptions(controller="servo").uses_true_momentum
     assert WalkOptions(controller="wbc", true_momentum=True).uses_true_momentum
+    assert not WalkOptions(controller="servo", true_momentum=False).uses_true_momentum
 
 
 @pytest.mark.parametrize(

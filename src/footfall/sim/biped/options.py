@@ -34,10 +34,12 @@ class WalkOptions:
     """Options of the walking controller.
 
     Attributes:
-        controller: ``servo``: differential IK (``mink``) whose joint angles are the set points of
-            position servos, the stance ankle torque-driven with the ALIP torque; ``wbc``: the
-            whole-body inverse-dynamics QP (:mod:`footfall.sim.biped.wbc`) drives every joint by
-            torque, the ALIP torque being the stance foot's commanded centre of pressure.
+        controller: ``wbc`` (the default): the whole-body inverse-dynamics QP
+            (:mod:`footfall.sim.biped.wbc`) drives every joint by torque, the ALIP torque being
+            the stance foot's commanded centre of pressure; ``servo``: differential IK (``mink``)
+            whose joint angles are the set points of position servos, the stance ankle
+            torque-driven with the ALIP torque. ``wbc`` walked 4 N s pushes on discrete_steps and
+            stairs_slope_gap far more often (benchmarks/RESULTS.md, "Whole-body control").
         wbc_gains: gains and weights of the ``wbc`` controller's tasks.
         control_dt: control period (measurement, adjuster, reference, IK) [s]; a multiple of the
             physics step. The whole-body QP of ``wbc`` runs at every physics step (500 Hz) from
@@ -114,7 +116,7 @@ class WalkOptions:
             is then another pendulum's. False walks such a plan on purpose (a mismatch study).
     """
 
-    controller: str = "servo"
+    controller: str = "wbc"
     wbc_gains: WbcGains = field(default_factory=WbcGains)
     control_dt: float = 0.01
     ik_iterations: int = 2
