@@ -73,9 +73,7 @@ class WbcGains:
     slope is 0.84 (the servo walker's: 0.85) and 49 of 50 on both; at 1e4 the slope falls to
     0.35 (the CoP no longer follows the planner) and at 3e3 the robot falls on every stairs walk.
     ``cop_share`` moves the QP's contact points toward the sole centre (a CoP margin; 0.85 walked
-    fewer pushes than 1). ``zmp_feedback``: when the walk commands no CoP (standing, the shift
-    and the stop) the CoM's tracking acceleration commands one, its ZMP; without it the G1 tipped
-    over its foot in the final stop (the moment was left to the body's rotation).
+    fewer pushes than 1).
     """
 
     com_kp: float = 100.0
@@ -90,15 +88,13 @@ class WbcGains:
     com_weight: float = 10.0
     cop_weight: float = 3e4
     cop_share: float = 1.0
-    zmp_feedback: bool = True
     momentum_weight: float = 10.0
     torso_weight: float = 5.0
     swing_weight: float = 10.0
     posture_weight: float = 0.05
 
     def __post_init__(self) -> None:
-        numbers = tuple(k for k in self.__dataclass_fields__ if k != "zmp_feedback")
-        check_fields(self, non_negative, numbers, prefix="wbc.")
+        check_fields(self, non_negative, tuple(self.__dataclass_fields__), prefix="wbc.")
         if not 0.0 < self.cop_share <= 1.0:
             raise InputError("wbc.cop_share", self.cop_share, "a share in (0, 1]")
 
@@ -289,16 +285,6 @@ class BipedWbc:
         c_ref, v_ref = self._ref("com", share)
         a_com = g.com_kp * (c_ref - com) + g.com_kd * (v_ref - vel)
         com_w = np.full(3, g.com_weight / mass**2)
-        if cop is None and contacts and g.zmp_feedback:
-            # standing (the shift, the stop): the CoM's own tracking sets the centre of pressure,
-            # the ZMP of the desired acceleration, p = c - z / (g + a_z) a_xy (a pendulum about
-            # p accelerates its CoM by a): the moment then agrees with the force instead of being
-            # left to the body's rotation
-            ground = float(np.mean([c.points[:, 2].mean() for c in contacts]))
-            height = float(com[2]) - ground
-            lean = height / (a_com[2] - self.gravity[2]) * a_com[:2]
-            point = np.array([com[0] - lean[0], com[1] - lean[1], ground])
-            cop = CopTarget(contact_sides, point, np.zeros(2))
         if cop is not None:
             com_w[:2] = 0.0  # the pendulum moves the CoM horizontally
             wrench.append(
