@@ -404,7 +404,9 @@ def walk_cmd(
         "frames, swing bound); --document-reach: eq. (5.12f) in the stance foot's frame only.",
     ),
     heading_segments: int | None = typer.Option(None, help=_WALK_SEGMENTS_HELP),
-    controller: str = typer.Option(DEFAULT_CONTROLLER, help=_CONTROLLER_HELP),
+    controller: str | None = typer.Option(
+        None, help=_CONTROLLER_HELP + " Default: the robot's (biped: wbc, g1: servo)."
+    ),
 ) -> None:
     """Walk a footstep plan with the MuJoCo biped (document 000, section 5.5).
 
@@ -422,12 +424,14 @@ def walk_cmd(
         os.environ.setdefault("MUJOCO_GL", "egl")
     from footfall.planning.plan import check_planner_name
     from footfall.sim.biped.options import WalkOptions
-    from footfall.sim.biped.plans import plan_for_walk, random_push, robot_model
+    from footfall.sim.biped.plans import ROBOT_CONTROLLERS, plan_for_walk, random_push, robot_model
     from footfall.sim.biped.result import walk_report
     from footfall.sim.biped.walk import walk
     from footfall.viz.walk_plot import plot_walk
 
     check_planner_name(planner)
+    if controller is None:
+        controller = ROBOT_CONTROLLERS.get(robot, DEFAULT_CONTROLLER)
     _check_controller(controller)
     if steps is not None and steps < 1:
         raise InputError("steps", steps, "an integer >= 1")
@@ -457,7 +461,10 @@ def walk_cmd(
         res = walk(
             sc, plan, opts, model_params=model, video_path=out / "walk.mp4" if video else None
         )
-    write_json(out / "walk.json", walk_report(sc.name, planner, robot, plan, pushes, res))
+    write_json(
+        out / "walk.json",
+        {**walk_report(sc.name, planner, robot, plan, pushes, res), "controller": controller},
+    )
     plot_walk(res, sc, out / "walk.png", title=f"{sc.name}, {planner}, {robot}")
     m = res.metrics
     console.print(

@@ -109,3 +109,11 @@ def test_cli_walk_rejects_an_unknown_controller(tmp_path) -> None:  # type: igno
     assert res.exception.field == "controller"
     assert "servo, wbc" in str(res.exception)
     assert not (tmp_path / "plan.json").exists()
+
+
+def test_every_robot_has_a_default_controller() -> None:
+    from footfall.sim.biped.options import CONTROLLERS
+    from footfall.sim.biped.plans import ROBOT_CONTROLLERS, ROBOTS
+
+    assert set(ROBOT_CONTROLLERS) == set(ROBOTS)
+    assert set(ROBOT_CONTROLLERS.values()) <= set(CONTROLLERS)

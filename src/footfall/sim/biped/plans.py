@@ -40,6 +40,13 @@ PUSH_DURATION = 0.1
 PUSH_WINDOW = (0.3, 0.7)
 
 
+#: the controller each walker model walks best with (``footfall walk --controller``'s default):
+#: measured (benchmarks/RESULTS.md, "Whole-body control"), our biped walks 4 N s pushes far more
+#: often with the whole-body QP; the G1 reaches flat_long's goal only with its servos (with the
+#: QP it falls in the final stop) and falls on the steps with either
+ROBOT_CONTROLLERS = {"biped": "wbc", "g1": "servo"}
+
+
 def robot_model(name: str) -> WalkerModel:
     """The walker model called ``name`` (one of :data:`ROBOTS`), with its default settings.
 
