@@ -7,6 +7,7 @@ from dataclasses import replace
 
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
+from footfall.planning.bounds import StepsBound, reachable_steps_bound
 from footfall.planning.diagnose import min_steps_lower_bound
 from footfall.planning.plan import (
     FootstepPlan,
@@ -16,8 +17,10 @@ from footfall.planning.plan import (
 )
 from footfall.terrain.scene import Scene
 
-#: how many footsteps beyond the geometric lower bound ``--min-steps`` tries by default
+#: how many footsteps beyond the lower bound ``--min-steps`` tries by default
 MIN_STEPS_SPAN = 10
+#: how far beyond the distance bound the reachable-set bound looks when no ``n_max`` is given
+BOUND_HORIZON = 40
 
 
 def make_plan(
@@ -69,12 +72,27 @@ def make_plan(
     return plan_footsteps(scene, robot, n_steps, options)
 
 
-def _search_note(found: int, start: int, tried: list[dict[str, object]]) -> str:
-    """What a smallest-N search proved: the N below ``found`` that were proven infeasible and the
-    N that were not decided (time limit, error), in which case ``found`` may not be the smallest."""
+def _skipped_note(skipped: dict[str, object] | None) -> str:
+    if not skipped:
+        return ""
+    first, last = skipped["from"], skipped["to"]
+    which = f"N = {first}" if first == last else f"N = {first}..{last}"
+    return f"; {which} ruled out without a solve ({skipped['reason']})"
+
+
+def _search_note(
+    found: int,
+    start: int,
+    tried: list[dict[str, object]],
+    skipped: dict[str, object] | None = None,
+) -> str:
+    """What a smallest-N search proved: the N below ``found`` that the reachable-set bound ruled
+    out without a solve, those the solver proved infeasible, and the N that were not decided (time
+    limit, error), in which case ``found`` may not be the smallest."""
     proven = [t["n_steps"] for t in tried if t["status"] == "infeasible"]
     open_ = [f"{t['n_steps']} ({t['status']})" for t in tried if t["status"] != "infeasible"]
     note = f"first N with a plan: {found} (searched from the lower bound {start}"
+    note += _skipped_note(skipped)
     if proven:
         # proven for the planner's model (conservative linear reach): see the plans' messages
         note += f"; proven infeasible: N = {', '.join(map(str, proven))} for the planner's model"
@@ -95,17 +113,28 @@ def plan_min_steps(
 ) -> FootstepPlan:
     """The plan with the smallest number of footsteps N that has a solution.
 
-    Tries N upward from a geometric lower bound (distance and heading change). Each try that ends
-    without a plan is recorded in the returned plan's ``stats["tried"]`` with its status.
+    Tries N upward from a lower bound: the larger of the distance and heading bound
+    (:func:`~footfall.planning.diagnose.min_steps_lower_bound`) and the reachable-set bound of
+    :func:`~footfall.planning.bounds.reachable_steps_bound`, which rules N out from the model's own
+    reach, heading-rate, step-height, region and swing rows without a solve (a valid lower bound:
+    no N it skips has a plan in the planner's model). The N it skips are recorded in the returned
+    plan's ``stats["skipped"]`` (``from``, ``to``, ``reason``); each try that ends without a plan in
+    ``stats["tried"]`` with its status. Up to ``n_max`` (default: the bound + ``MIN_STEPS_SPAN``).
     """
     if planner == "reactive":
         raise InputError("planner", planner, "miqcqp or kinematic (reactive has no N to search)")
     robot = robot or scene.robot
     options = options or PlannerOptions()
-    start = min_steps_lower_bound(scene, robot, options.swing_max)
+    distance = min_steps_lower_bound(scene, robot, options.swing_max)
+    if n_max is not None and n_max < distance:
+        raise InputError("n_max", n_max, f"at least the lower bound {distance}")
+    horizon = n_max if n_max is not None else distance + BOUND_HORIZON
+    bound = reachable_steps_bound(scene, robot, options, horizon)
+    start = max(distance, bound.n_steps)
+    skipped = _skipped(distance, start, bound)
     n_max = n_max if n_max is not None else start + MIN_STEPS_SPAN
-    if n_max < start:
-        raise InputError("n_max", n_max, f"at least the lower bound {start}")
+    if start > n_max:
+        return _ruled_out(planner, robot, options, distance, n_max, skipped)
     tried: list[dict[str, object]] = []
     plan: FootstepPlan | None = None
     for n in range(start, n_max + 1):
@@ -115,11 +144,43 @@ def plan_min_steps(
         if plan.has_solution:
             stats = dict(plan.stats)
             stats["tried"] = tried
-            return replace(
-                plan, stats=stats, message=plan.message + "; " + _search_note(n, start, tried)
-            )
+            stats["skipped"] = skipped
+            note = _search_note(n, start, tried, skipped)
+            return replace(plan, stats=stats, message=plan.message + "; " + note)
         tried.append({"n_steps": n, "status": plan.status.value})
     assert plan is not None
     return replace(
-        plan, message=plan.message + f"; no plan for N = {start}..{n_max}", stats={"tried": tried}
+        plan,
+        message=plan.message + f"; no plan for N = {start}..{n_max}" + _skipped_note(skipped),
+        stats={"tried": tried, "skipped": skipped},
     )
+
+
+def _skipped(distance: int, start: int, bound: StepsBound) -> dict[str, object] | None:
+    """The N the reachable-set bound rules out above the distance bound, with its reason."""
+    if start <= distance:
+        return None
+    return {"from": distance, "to": start - 1, "reason": bound.reason}
+
+
+def _ruled_out(
+    planner: str,
+    robot: BipedParams,
+    options: PlannerOptions,
+    distance: int,
+    n_max: int,
+    skipped: dict[str, object] | None,
+) -> FootstepPlan:
+    """The result of a search whose every N the bounds rule out: infeasible without a solve."""
+    from footfall.solvers import SolveStatus
+
+    skipped = skipped or {"from": distance, "to": n_max, "reason": "distance and heading"}
+    skipped = {**skipped, "to": n_max}
+    message = (
+        f"infeasible in the planner's model for N = {distance}..{n_max} (and, by distance and "
+        f"heading, below): {skipped['reason']}"
+    )
+    plan = FootstepPlan.empty(
+        planner, SolveStatus.INFEASIBLE, robot, message, solver=options.solver
+    )
+    return replace(plan, stats={"tried": [], "skipped": skipped})
