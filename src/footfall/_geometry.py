@@ -294,13 +294,18 @@ def clip_rows(poly: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
 
 
 def distance_to_convex(x: FloatArray, poly: FloatArray) -> float:
-    """Euclidean distance [m] from ``x`` (2,) to a convex CCW polygon, segment or point (0
-    inside); infinite for an empty one."""
+    """Euclidean distance [m] from ``x`` (2,) to a convex CCW polygon (V, 2), segment or point
+    (0 inside); infinite for an empty one. Degenerate (zero-area) polygons are measured by their
+    edges, so a sliver never gives NaN."""
     v = np.asarray(poly, dtype=float)
     if v.shape[0] == 0:
         return math.inf
     if v.shape[0] == 1:
         return float(np.linalg.norm(x - v[0]))
-    if v.shape[0] == 2:
-        return point_segment_distance(x, v[0], v[1])
-    return point_polygon_distance(x, v)
+    nxt = np.roll(v, -1, axis=0)
+    edges = nxt - v
+    # CCW: inside every edge's left side (cross product >= 0) when the polygon has an area
+    cross = edges[:, 0] * (x[1] - v[:, 1]) - edges[:, 1] * (x[0] - v[:, 0])
+    if v.shape[0] >= 3 and signed_area(v) > 0.0 and np.all(cross >= 0.0):
+        return 0.0
+    return float(min(point_segment_distance(x, a, b) for a, b in zip(v, nxt, strict=True)))

@@ -106,9 +106,10 @@ def _rows_polygon(a: FloatArray, b: FloatArray) -> FloatArray:
 def _rows_of(poly: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Outward rows ``a q <= b`` (V, 2), (V,) of a convex CCW polygon with at least 3 vertices."""
     edges = np.roll(poly, -1, axis=0) - poly
-    normals = np.stack([edges[:, 1], -edges[:, 0]], axis=1)
-    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    return normals, np.einsum("ij,ij->i", normals, poly)
+    length = np.linalg.norm(edges, axis=1)
+    keep = length > 1e-12  # a repeated vertex has no edge (and no normal) to cut by
+    normals = np.stack([edges[keep, 1], -edges[keep, 0]], axis=1) / length[keep, None]
+    return normals, np.einsum("ij,ij->i", normals, poly[keep])
 
 
 def _segment_reach(robot: BipedParams, side: Side, phi_a: float, phi_b: float) -> FloatArray:
