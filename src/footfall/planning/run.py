@@ -5,6 +5,8 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import replace
+from functools import partial
+from typing import Protocol
 
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
@@ -17,6 +19,7 @@ from footfall.planning.plan import (
     check_planning_arguments,
     result_meta,
 )
+from footfall.solvers.base import SolveProgress
 from footfall.terrain.scene import Scene
 
 #: how many footsteps beyond the lower bound ``--min-steps`` tries by default
@@ -33,6 +36,7 @@ def make_plan(
     n_steps: int | None = None,
     options: PlannerOptions | None = None,
     robot: BipedParams | None = None,
+    solve_progress: Callable[[SolveProgress], None] | None = None,
 ) -> FootstepPlan:
     """Plan with the named planner (``miqcqp``, ``kinematic`` or ``reactive``).
 
@@ -44,6 +48,9 @@ def make_plan(
             planners means the smallest feasible N (:func:`plan_min_steps`).
         options: planner options.
         robot: robot parameters (default ``scene.robot``).
+        solve_progress: called about once a second during a ``bnb`` solve of a given N
+            (``SolverOptions.progress``); the smallest-N search reports through
+            :func:`plan_min_steps`'s ``monitor`` instead.
     """
     check_planning_arguments(scene, robot, options)
     check_planner_name(planner)
@@ -70,10 +77,25 @@ def make_plan(
     if planner == "kinematic":
         from footfall.planning.kinematic import plan_kinematic
 
-        return plan_kinematic(scene, robot, n_steps, options)
+        return plan_kinematic(scene, robot, n_steps, options, solve_progress)
     from footfall.planning.miqcqp import plan_footsteps
 
-    return plan_footsteps(scene, robot, n_steps, options)
+    return plan_footsteps(scene, robot, n_steps, options, solve_progress)
+
+
+class SearchMonitor(Protocol):
+    """What a smallest-N search reports while it runs (:func:`plan_min_steps`'s ``monitor``)."""
+
+    def skipped(self, first: int, last: int, reason: str) -> None:
+        """N = ``first``..``last`` are ruled out by the reachable-set bound, without a solve."""
+
+    def solving(self, n_steps: int, progress: SolveProgress, model: str = "") -> None:
+        """The solve of N = ``n_steps`` is at ``progress`` (about once a second); ``model`` names
+        what is solved (``kinematic relaxation`` before the planner's own model)."""
+
+    def tried(self, n_steps: int, plan: FootstepPlan, seconds: float, proof: str) -> None:
+        """N = ``n_steps`` ended with ``plan`` after ``seconds`` [s]; ``proof`` says which model
+        decided it (``solver`` or ``kinematic relaxation``)."""
 
 
 def _skipped_note(skipped: dict[str, object] | None) -> str:
@@ -114,6 +136,7 @@ def plan_min_steps(
     robot: BipedParams | None = None,
     n_max: int | None = None,
     progress: Callable[[int, FootstepPlan], None] | None = None,
+    monitor: SearchMonitor | None = None,
 ) -> FootstepPlan:
     """The plan with the smallest number of footsteps N that has a solution.
 
@@ -124,6 +147,8 @@ def plan_min_steps(
     no N it skips has a plan in the planner's model). The N it skips are recorded in the returned
     plan's ``stats["skipped"]`` (``from``, ``to``, ``reason``); each try that ends without a plan in
     ``stats["tried"]`` with its status. Up to ``n_max`` (default: the bound + ``MIN_STEPS_SPAN``).
+    ``progress(n, plan)`` is called after each N tried; ``monitor`` (a :class:`SearchMonitor`)
+    also hears of the skipped N and of the solves while they run.
     """
     if planner == "reactive":
         raise InputError("planner", planner, "miqcqp or kinematic (reactive has no N to search)")
@@ -137,6 +162,8 @@ def plan_min_steps(
     start = max(distance, bound.n_steps)
     skipped = _skipped(distance, start, bound)
     n_max = n_max if n_max is not None else start + MIN_STEPS_SPAN
+    if monitor is not None and skipped is not None:
+        monitor.skipped(distance, min(start - 1, n_max), bound.reason)
     if start > n_max:
         return _ruled_out(planner, robot, options, distance, n_max, skipped)
     tried: list[dict[str, object]] = []
@@ -144,13 +171,18 @@ def plan_min_steps(
     for n in range(start, n_max + 1):
         t0 = time.perf_counter()
         proof = "solver"
-        plan = _kinematic_proof(scene, robot, n, options) if planner == "miqcqp" else None
+        plan = None
+        if planner == "miqcqp":
+            hook = _hook(monitor, n, "kinematic relaxation")
+            plan = _kinematic_proof(scene, robot, n, options, hook)
         if plan is not None:
             proof = "kinematic relaxation"
         else:
-            plan = make_plan(scene, planner, n, options, robot)
+            plan = make_plan(scene, planner, n, options, robot, _hook(monitor, n, planner))
         if progress is not None:
             progress(n, plan)
+        if monitor is not None:
+            monitor.tried(n, plan, time.perf_counter() - t0, proof)
         if plan.has_solution:
             stats = dict(plan.stats)
             stats["tried"] = tried
@@ -169,8 +201,19 @@ def plan_min_steps(
     )
 
 
+def _hook(
+    monitor: SearchMonitor | None, n_steps: int, model: str
+) -> Callable[[SolveProgress], None] | None:
+    """The solver progress hook that reports to ``monitor`` as the solve of ``model`` at N."""
+    return None if monitor is None else partial(monitor.solving, n_steps, model=model)
+
+
 def _kinematic_proof(
-    scene: Scene, robot: BipedParams, n_steps: int, options: PlannerOptions
+    scene: Scene,
+    robot: BipedParams,
+    n_steps: int,
+    options: PlannerOptions,
+    solve_progress: Callable[[SolveProgress], None] | None = None,
 ) -> FootstepPlan | None:
     """An infeasible plan if the MIQCQP's rows *without* the ALIP dynamics, torque bound and
     their objective terms (the kinematic planner's model, ``dynamics=False``) are proven to have
@@ -190,7 +233,9 @@ def _kinematic_proof(
     else:
         # a feasibility question: any incumbent answers it (a gap of 1 stops at the first one,
         # the objective being a sum of squares, >= 0)
-        feasibility = replace(options.solver_options(), gap=FEASIBILITY_GAP)
+        feasibility = replace(
+            options.solver_options(), gap=FEASIBILITY_GAP, progress=solve_progress
+        )
         result = solve(kin.problem, options.solver, feasibility)
         result_status, meta = result.status, result_meta(result)
         meta.pop("status")
