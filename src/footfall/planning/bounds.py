@@ -70,8 +70,10 @@ from footfall.terrain.scene import Scene
 SLACK = 1e-4
 #: slack [rad] on the heading rows (rate, segment membership)
 ANGLE_SLACK = 1e-6
-#: most heading buckets (a bucket is a run of consecutive segments; fewer buckets: faster, weaker)
-MAX_BUCKETS = 32
+#: most heading buckets (a bucket is a run of consecutive segments; fewer buckets: faster, weaker;
+#: 16 buckets of 22.5 deg gave the same bounds as 32 on the built-in scenes but one, in half the
+#: time)
+MAX_BUCKETS = 16
 #: half-width [m] of the square every polygon given by rows alone is cut from (reach sets and
 #: regions are bounded, so this only has to be larger than any of them)
 _BOX = 1e4

@@ -28,6 +28,8 @@ MIN_STEPS_SPAN = 10
 BOUND_HORIZON = 40
 #: relative gap of the kinematic feasibility solves (:func:`_kinematic_proof`): stop at any plan
 FEASIBILITY_GAP = 1.0
+#: most seconds a kinematic feasibility solve may take (it only pays when it proves quickly)
+KINEMATIC_CHECK_LIMIT = 30.0
 
 
 def make_plan(
@@ -147,6 +149,8 @@ def plan_min_steps(
     no N it skips has a plan in the planner's model). The N it skips are recorded in the returned
     plan's ``stats["skipped"]`` (``from``, ``to``, ``reason``); each try that ends without a plan in
     ``stats["tried"]`` with its status. Up to ``n_max`` (default: the bound + ``MIN_STEPS_SPAN``).
+    For the ``miqcqp`` planner each N is first put to its rows without the ALIP dynamics
+    (:func:`_kinematic_proof`), until that check first fails to prove an N infeasible.
     ``progress(n, plan)`` is called after each N tried; ``monitor`` (a :class:`SearchMonitor`)
     also hears of the skipped N and of the solves while they run.
     """
@@ -168,13 +172,17 @@ def plan_min_steps(
         return _ruled_out(planner, robot, options, distance, n_max, skipped)
     tried: list[dict[str, object]] = []
     plan: FootstepPlan | None = None
+    # the kinematic check runs until it first fails to prove an N infeasible: larger N have
+    # more room, so it would keep failing (a cost, never a wrong answer: the solver decides)
+    precheck = planner == "miqcqp"
     for n in range(start, n_max + 1):
         t0 = time.perf_counter()
         proof = "solver"
         plan = None
-        if planner == "miqcqp":
+        if precheck:
             hook = _hook(monitor, n, "kinematic relaxation")
             plan = _kinematic_proof(scene, robot, n, options, hook)
+            precheck = plan is not None
         if plan is not None:
             proof = "kinematic relaxation"
         else:
@@ -234,7 +242,10 @@ def _kinematic_proof(
         # a feasibility question: any incumbent answers it (a gap of 1 stops at the first one,
         # the objective being a sum of squares, >= 0)
         feasibility = replace(
-            options.solver_options(), gap=FEASIBILITY_GAP, progress=solve_progress
+            options.solver_options(),
+            gap=FEASIBILITY_GAP,
+            time_limit=min(options.time_limit, KINEMATIC_CHECK_LIMIT),
+            progress=solve_progress,
         )
         result = solve(kin.problem, options.solver, feasibility)
         result_status, meta = result.status, result_meta(result)
