@@ -29,7 +29,7 @@ from footfall.planning.bounds import (
 from footfall.planning.diagnose import min_steps_lower_bound
 from footfall.solvers import SolveStatus
 from footfall.terrain import builtin_scene, load_scene
-from tests.planning.scenes import TWO_STONES
+from tests.planning.scenes import SHORT_FLAT, TWO_STONES
 
 #: geometry helpers agree with brute force to this [m]
 GEOM_TOL = 1e-9
@@ -266,3 +266,19 @@ def test_bound_never_exceeds_a_feasible_n_on_random_stones(
     plan = make_plan(sc, "kinematic", bound.n_steps + 1, options)
     if plan.has_solution:
         _check_plan_in_sets(sc, options, plan)
+
+
+def test_kinematic_relaxation_proves_n_infeasible_before_the_miqcqp() -> None:
+    # both reach frames on SHORT_FLAT: the bound allows N = 3, the rows without dynamics do not
+    sc = load_scene(SHORT_FLAT)
+    options = PlannerOptions(reach_both_frames=True, time_limit=60.0)
+    assert reachable_steps_bound(sc, sc.robot, options, 10).n_steps == 3
+    plan = plan_min_steps(sc, "miqcqp", options)
+    assert plan.has_solution and plan.n_steps == 4
+    (tried,) = plan.stats["tried"]
+    assert tried["n_steps"] == 3 and tried["status"] == "infeasible"
+    assert tried["proof"] == "kinematic relaxation" and tried["seconds"] >= 0.0
+    assert "proven infeasible: N = 3" in plan.message
+    # the full model agrees: N = 3 has no plan
+    full = make_plan(sc, "miqcqp", 3, options)
+    assert full.status is SolveStatus.INFEASIBLE
