@@ -282,14 +282,15 @@ def clip_rows(poly: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
             continue
         if not inside.any():
             return np.zeros((0, 2))
-        q, sq = np.roll(p, -1, axis=0), np.roll(s, -1)
-        cross = ((s < 0.0) & (sq > 0.0)) | ((s > 0.0) & (sq < 0.0))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = np.where(cross, s / np.where(cross, s - sq, 1.0), 0.0)
-        hits = p + t[:, None] * (q - p)
-        # vertex j (if kept) comes before the crossing on edge j -> j+1
-        both = np.stack([p, hits], axis=1).reshape(-1, 2)
-        p = both[np.stack([inside, cross], axis=1).reshape(-1)]
+        nxt = np.arange(1, p.shape[0] + 1)
+        nxt[-1] = 0
+        # edge e -> e+1 crosses the line where its ends lie strictly on opposite sides
+        edge = np.flatnonzero(s * s[nxt] < 0.0)
+        t = s[edge] / (s[edge] - s[nxt[edge]])
+        hits = p[edge] + t[:, None] * (p[nxt[edge]] - p[edge])
+        # vertex e (if kept) comes before the crossing on edge e -> e+1: order by 2e, 2e + 1
+        keys = np.concatenate([2 * np.flatnonzero(inside), 2 * edge + 1])
+        p = np.vstack([p[inside], hits])[np.argsort(keys)]
     return p
 
 

@@ -267,30 +267,20 @@ def _next_sets(
         step_b = s.step[side][b]
         if step_b is None:
             continue
-        plain = None if both else minkowski_sum(piece, step_b)
+        # without the landing frame the step set does not depend on the next bucket: the cuts
+        # into the regions are made once and shared by every bucket b2 within reach of b
+        plain = None if both else _cuts(s, robot, r, minkowski_sum(piece, step_b))
         for b2 in range(n_b):
             if _gap(s.lo[b], s.hi[b], s.lo[b2], s.hi[b2]) > robot.theta_max + ANGLE_SLACK:
                 continue
-            moved = plain
-            if moved is None:
+            cuts = plain
+            if cuts is None:
                 step = _both_frames_step(s, side, b, b2)
                 if step is None:
                     continue
-                moved = minkowski_sum(piece, step)
-            lo_m, hi_m = moved.min(axis=0), moved.max(axis=0)
-            for r2, (a, rhs) in enumerate(s.region_rows):
-                poly = s.region_poly[r2]
-                if poly.shape[0] == 0:
-                    continue
-                if _gap(*s.z_range[r], *s.z_range[r2]) > robot.step_height_max + SLACK:
-                    continue
-                if np.any(poly.min(axis=0) > hi_m + SLACK) or np.any(
-                    poly.max(axis=0) < lo_m - SLACK
-                ):
-                    continue
-                cut = clip_rows(moved, a, rhs)
-                if cut.shape[0]:
-                    gathered.setdefault((b2, r2), []).append(cut)
+                cuts = _cuts(s, robot, r, minkowski_sum(piece, step))
+            for r2, cut in cuts:
+                gathered.setdefault((b2, r2), []).append(cut)
     out: _Sets = {}
     for key, parts in gathered.items():
         hull = convex_hull(np.vstack(parts))
@@ -301,6 +291,25 @@ def _next_sets(
                 continue
             hull = convex_hull(np.vstack(kept))
         out[key] = hull
+    return out
+
+
+def _cuts(s: _Setup, robot: BipedParams, r: int, moved: FloatArray) -> list[tuple[int, FloatArray]]:
+    """The non-empty parts ``(r2, moved ∩ region r2)`` of the regions a footstep in region ``r``
+    can step to (height ranges within ``step_height_max``)."""
+    lo_m, hi_m = moved.min(axis=0), moved.max(axis=0)
+    out = []
+    for r2, (a, rhs) in enumerate(s.region_rows):
+        poly = s.region_poly[r2]
+        if poly.shape[0] == 0:
+            continue
+        if _gap(*s.z_range[r], *s.z_range[r2]) > robot.step_height_max + SLACK:
+            continue
+        if np.any(poly.min(axis=0) > hi_m + SLACK) or np.any(poly.max(axis=0) < lo_m - SLACK):
+            continue
+        cut = clip_rows(moved, a, rhs)
+        if cut.shape[0]:
+            out.append((r2, cut))
     return out
 
 
