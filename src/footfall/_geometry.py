@@ -16,6 +16,8 @@ from footfall.errors import InputError
 
 #: turning angles smaller than this [rad] count as straight (collinear vertices are allowed)
 ANGLE_TOL = 1e-9
+#: polygon edges shorter than this [m] have no reliable direction (near-repeated vertices)
+EDGE_TOL = 1e-9
 
 
 def rot2(theta: float) -> FloatArray:
@@ -305,8 +307,12 @@ def distance_to_convex(x: FloatArray, poly: FloatArray) -> float:
         return float(np.linalg.norm(x - v[0]))
     nxt = np.roll(v, -1, axis=0)
     edges = nxt - v
-    # CCW: inside every edge's left side (cross product >= 0) when the polygon has an area
-    cross = edges[:, 0] * (x[1] - v[:, 1]) - edges[:, 1] * (x[0] - v[:, 0])
-    if v.shape[0] >= 3 and signed_area(v) > 0.0 and np.all(cross >= 0.0):
+    length = np.linalg.norm(edges, axis=1)
+    # CCW: inside when on the left of every edge (signed distance >= -EDGE_TOL) and the polygon
+    # has an area; edges shorter than EDGE_TOL (near-repeated vertices) have no reliable
+    # direction and are left out (their neighbours bound the polygon there)
+    real = length > EDGE_TOL
+    cross = edges[real, 0] * (x[1] - v[real, 1]) - edges[real, 1] * (x[0] - v[real, 0])
+    if real.sum() >= 3 and signed_area(v) > 0.0 and np.all(cross >= -EDGE_TOL * length[real]):
         return 0.0
     return float(min(point_segment_distance(x, a, b) for a, b in zip(v, nxt, strict=True)))

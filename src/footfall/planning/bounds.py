@@ -53,6 +53,7 @@ from functools import partial
 import numpy as np
 
 from footfall._geometry import (
+    EDGE_TOL,
     clip_rows,
     convex_hull,
     distance_to_convex,
@@ -109,7 +110,9 @@ def _rows_of(poly: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Outward rows ``a q <= b`` (V, 2), (V,) of a convex CCW polygon with at least 3 vertices."""
     edges = np.roll(poly, -1, axis=0) - poly
     length = np.linalg.norm(edges, axis=1)
-    keep = length > 1e-12  # a repeated vertex has no edge (and no normal) to cut by
+    # a (near-)repeated vertex has no reliable edge direction to cut by; leaving its row out
+    # keeps a superset (the other rows of a convex polygon still bound it)
+    keep = length > EDGE_TOL
     normals = np.stack([edges[keep, 1], -edges[keep, 0]], axis=1) / length[keep, None]
     return normals, np.einsum("ij,ij->i", normals, poly[keep])
 

@@ -117,13 +117,17 @@ def _search_note(
     """What a smallest-N search proved: the N below ``found`` that the reachable-set bound ruled
     out without a solve, those the solver proved infeasible, and the N that were not decided (time
     limit, error), in which case ``found`` may not be the smallest."""
-    proven = [t["n_steps"] for t in tried if t["status"] == "infeasible"]
+    proven = [
+        f"{t['n_steps']}" + (f" ({t['proof']})" if t.get("proof", "solver") != "solver" else "")
+        for t in tried
+        if t["status"] == "infeasible"
+    ]
     open_ = [f"{t['n_steps']} ({t['status']})" for t in tried if t["status"] != "infeasible"]
     note = f"first N with a plan: {found} (searched from the lower bound {start}"
     note += _skipped_note(skipped)
     if proven:
         # proven for the planner's model (conservative linear reach): see the plans' messages
-        note += f"; proven infeasible: N = {', '.join(map(str, proven))} for the planner's model"
+        note += f"; proven infeasible: N = {', '.join(proven)} for the planner's model"
     if open_:
         return (
             note + f"; not decided: N = {', '.join(open_)}, so a plan with fewer steps may exist)"
