@@ -16,6 +16,8 @@ from footfall.errors import InputError
 
 #: turning angles smaller than this [rad] count as straight (collinear vertices are allowed)
 ANGLE_TOL = 1e-9
+#: polygon edges shorter than this [m] have no reliable direction (near-repeated vertices)
+EDGE_TOL = 1e-9
 
 
 def rot2(theta: float) -> FloatArray:
@@ -239,3 +241,120 @@ def rotation_exp(v: FloatArray) -> FloatArray:
         + (math.sin(angle) / angle) * k
         + ((1.0 - math.cos(angle)) / (angle * angle)) * (k @ k)
     )
+
+
+def convex_hull(points: ArrayLike) -> FloatArray:
+    """Convex hull (V, 2) of ``points`` (M, 2) [m], CCW. Degenerate inputs give 1 (a point) or 2
+    (a segment) vertices.
+
+    Qhull (scipy) for the general case; Andrew's monotone chain when Qhull refuses (fewer than
+    three points, all collinear).
+    """
+    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    if pts.shape[0] >= 3:
+        from scipy.spatial import ConvexHull, QhullError
+
+        try:
+            return pts[ConvexHull(pts).vertices]  # CCW in 2-D
+        except QhullError:
+            pass
+    return _monotone_chain(pts)
+
+
+def _monotone_chain(points: FloatArray) -> FloatArray:
+    """Convex hull of ``points`` (M, 2) by Andrew's monotone chain, CCW, collinear points dropped."""
+    pts = np.unique(points, axis=0)
+    if pts.shape[0] <= 2:
+        return pts
+
+    def cross(o: FloatArray, a: FloatArray, b: FloatArray) -> float:
+        return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
+
+    lower: list[FloatArray] = []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0.0:
+            lower.pop()
+        lower.append(p)
+    upper: list[FloatArray] = []
+    for p in pts[::-1]:
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0.0:
+            upper.pop()
+        upper.append(p)
+    hull = np.array(lower[:-1] + upper[:-1], dtype=float).reshape(-1, 2)
+    return hull if hull.shape[0] >= 2 else pts[[0, -1]]
+
+
+def minkowski_sum(p: FloatArray, q: FloatArray) -> FloatArray:
+    """Minkowski sum ``{a + b : a in p, b in q}`` (V, 2) of two convex CCW polygons (points and
+    segments allowed).
+
+    Two polygons: their edges merged by angle, each polygon's walk starting at its lowest (then
+    leftmost) vertex, where the edge angles increase from 0 to 2 pi. Otherwise the hull of the
+    pairwise vertex sums.
+    """
+    p, q = np.asarray(p, dtype=float), np.asarray(q, dtype=float)
+    if p.shape[0] < 3 or q.shape[0] < 3:
+        return convex_hull((p[:, None, :] + q[None, :, :]).reshape(-1, 2))
+    edges, origin = [], np.zeros(2)
+    for poly in (p, q):
+        start = int(np.lexsort((poly[:, 0], poly[:, 1]))[0])
+        poly = np.roll(poly, -start, axis=0)
+        origin = origin + poly[0]
+        edges.append(np.roll(poly, -1, axis=0) - poly)
+    e = np.vstack(edges)
+    angle = np.arctan2(e[:, 1], e[:, 0]) % (2.0 * math.pi)
+    e = e[np.argsort(angle, kind="stable")]
+    return origin + np.vstack([np.zeros(2), np.cumsum(e[:-1], axis=0)])
+
+
+def clip_rows(poly: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+    """Part of a convex polygon (V, 2) (or point, or segment) with ``a q <= b`` for every row of
+    ``a`` (R, 2) and ``b`` (R,); (0, 2) when empty. Vectorised Sutherland-Hodgman per row."""
+    p = np.asarray(poly, dtype=float)
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    if p.shape[0] == 0:
+        return p
+    # only the rows that cut off a vertex need clipping (the others keep the whole polygon)
+    cutting = np.flatnonzero(np.max(p @ a.T - b, axis=0) > 0.0)
+    for j in cutting:
+        if p.shape[0] == 0:
+            break
+        s = p @ a[j] - b[j]
+        inside = s <= 0.0
+        if inside.all():
+            continue
+        if not inside.any():
+            return np.zeros((0, 2))
+        nxt = np.arange(1, p.shape[0] + 1)
+        nxt[-1] = 0
+        # edge e -> e+1 crosses the line where its ends lie strictly on opposite sides
+        edge = np.flatnonzero(s * s[nxt] < 0.0)
+        t = s[edge] / (s[edge] - s[nxt[edge]])
+        hits = p[edge] + t[:, None] * (p[nxt[edge]] - p[edge])
+        # vertex e (if kept) comes before the crossing on edge e -> e+1: order by 2e, 2e + 1
+        keys = np.concatenate([2 * np.flatnonzero(inside), 2 * edge + 1])
+        p = np.vstack([p[inside], hits])[np.argsort(keys)]
+    return p
+
+
+def distance_to_convex(x: FloatArray, poly: FloatArray) -> float:
+    """Euclidean distance [m] from ``x`` (2,) to a convex CCW polygon (V, 2), segment or point
+    (0 inside); infinite for an empty one. Degenerate (zero-area) polygons are measured by their
+    edges, so a sliver never gives NaN."""
+    v = np.asarray(poly, dtype=float)
+    if v.shape[0] == 0:
+        return math.inf
+    if v.shape[0] == 1:
+        return float(np.linalg.norm(x - v[0]))
+    nxt = np.roll(v, -1, axis=0)
+    edges = nxt - v
+    length = np.linalg.norm(edges, axis=1)
+    # CCW: inside when on the left of every edge (signed distance >= -EDGE_TOL) and the polygon
+    # has an area; edges shorter than EDGE_TOL (near-repeated vertices) have no reliable
+    # direction and are left out (their neighbours bound the polygon there)
+    real = length > EDGE_TOL
+    cross = edges[real, 0] * (x[1] - v[real, 1]) - edges[real, 1] * (x[0] - v[real, 0])
+    if real.sum() >= 3 and signed_area(v) > 0.0 and np.all(cross >= -EDGE_TOL * length[real]):
+        return 0.0
+    return float(min(point_segment_distance(x, a, b) for a, b in zip(v, nxt, strict=True)))

@@ -64,6 +64,10 @@ def test_min_steps_note_says_what_was_proven() -> None:
         and "smallest" not in undecided.split(";")[-1].split(",")[0]
     )
     assert "fewer steps may exist" in undecided
+    skipped = {"from": 6, "to": 7, "reason": "no footstep N - 1 can be the goal foot"}
+    both = _search_note(10, 8, [{"n_steps": 8, "status": "infeasible"}], skipped)
+    assert "N = 6..7 ruled out without a solve (no footstep N - 1 can be the goal foot)" in both
+    assert "proven infeasible: N = 8" in both
 
 
 def test_a_plan_with_a_nan_footstep_is_refused_at_construction() -> None:

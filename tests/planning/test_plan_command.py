@@ -45,7 +45,15 @@ def test_smallest_n_search(tmp_path: Path) -> None:
     assert res.returncode == 0, res.stderr
     data = json.loads((tmp_path / "plan.json").read_text())
     assert len(data["footsteps"]) - 1 == 3
-    assert data["stats"]["tried"] == [{"n_steps": 2, "status": "infeasible"}]
+    # N = 2 (the distance bound) is ruled out by the reachable sets, without a solve ...
+    assert data["stats"]["tried"] == []
+    assert data["stats"]["skipped"]["from"] == 2 and data["stats"]["skipped"]["to"] == 2
+    assert "N = 2 ruled out without a solve" in data["message"]
+    # ... and rightly so: the solver proves it infeasible
+    from footfall.planning import make_plan
+    from footfall.terrain import load_scene
+
+    assert make_plan(load_scene(scene_file), "miqcqp", 2).status.value == "infeasible"
 
 
 def test_swing_bound_is_planned_checked_and_recorded(tmp_path: Path) -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -17,6 +18,7 @@ from footfall.cli._common import (
     output_folder,
     parse_floats,
 )
+from footfall.cli._progress import ProgressLog
 from footfall.errors import InputError
 
 
@@ -176,8 +178,20 @@ def plan(
         "less conservative (longer steps allowed) and the problem larger.",
     ),
     out: Path = typer.Option(Path("out/plan"), help="Output folder for plan.json and plan.png."),
+    quiet: bool = typer.Option(
+        False, "--quiet", help="No progress lines or status line (the result is still printed)."
+    ),
+    log_json: Path | None = typer.Option(
+        None,
+        "--log-json",
+        help="Write the progress as JSON lines to this file (one object per N tried or skipped, "
+        "and while a solve runs, at most one every 5 s), with or without a terminal.",
+    ),
 ) -> None:
-    """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists."""
+    """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists.
+
+    Progress: a status line in a terminal; without one, a plain line on stderr per N tried and at
+    most every 5 s while a solve runs."""
     from footfall.planning import PlannerOptions, check_plan, make_plan, plan_min_steps
     from footfall.planning.plan import check_planner_name
     from footfall.terrain.resolve import resolve_scene_arguments
@@ -199,15 +213,13 @@ def plan(
         heading_segments=heading_segments,
     )
     robot_params = None if robot is None else _walker_params(robot, sc.robot)
-    with console.status(f"planning {sc.name} with {planner} ...") as status:
-
-        def progress(n: int, result: Any) -> None:
-            status.update(f"planning {sc.name} with {planner}: N = {n} -> {result.status.value}")
-
+    with ProgressLog(f"{sc.name} with {planner}", quiet, log_json) as log:
         if planner != "reactive" and (min_steps or steps is None):
-            result = plan_min_steps(sc, planner, options, progress=progress, robot=robot_params)
+            result = plan_min_steps(sc, planner, options, robot=robot_params, monitor=log)
         else:
-            result = make_plan(sc, planner, steps, options, robot_params)
+            hook = partial(log.solving, steps, model=planner)
+            result = make_plan(sc, planner, steps, options, robot_params, solve_progress=hook)
+        log.done(result)
     payload = result.to_dict(sc.name)
     checked = True
     if result.has_solution:

@@ -10,12 +10,16 @@ reports the torque violation).
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Callable
+
 import numpy as np
 
 from footfall.models.biped import BipedParams
 from footfall.planning.miqcqp import build_footstep_problem, extract_plan
 from footfall.planning.plan import FootstepPlan, PlannerOptions, result_meta
 from footfall.solvers import SolveStatus, solve
+from footfall.solvers.base import SolveProgress
 from footfall.solvers.problem import fix_variables
 from footfall.terrain.scene import Scene
 
@@ -25,14 +29,16 @@ def plan_kinematic(
     robot: BipedParams | None = None,
     n_steps: int = 8,
     options: PlannerOptions | None = None,
+    solve_progress: Callable[[SolveProgress], None] | None = None,
 ) -> FootstepPlan:
-    """Plan footsteps without dynamics, then attach the least-torque ALIP trajectory."""
+    """Plan footsteps without dynamics, then attach the least-torque ALIP trajectory
+    (``solve_progress``: see :func:`footfall.planning.miqcqp.plan_footsteps`)."""
     from dataclasses import replace
 
     from footfall.planning.diagnose import diagnose_infeasible, geometric_infeasibility
 
     options = options or PlannerOptions()
-    solver_opts = options.solver_options()
+    solver_opts = dataclasses.replace(options.solver_options(), progress=solve_progress)
     kin = build_footstep_problem(scene, robot, n_steps, options, dynamics=False)
     early = geometric_infeasibility(
         scene, kin.robot, n_steps, options.region_margin, options.swing_max

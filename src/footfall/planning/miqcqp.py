@@ -48,7 +48,8 @@ its node relaxations).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -67,6 +68,7 @@ from footfall.planning.plan import (
     wrap_near,
 )
 from footfall.solvers import ProblemBuilder, SolveStatus, solve
+from footfall.solvers.base import SolveProgress
 from footfall.solvers.problem import MIQCQP
 from footfall.terrain.scene import Scene
 
@@ -537,8 +539,12 @@ def plan_footsteps(
     robot: BipedParams | None = None,
     n_steps: int = 8,
     options: PlannerOptions | None = None,
+    solve_progress: Callable[[SolveProgress], None] | None = None,
 ) -> FootstepPlan:
     """Plan ``n_steps`` footsteps with the full-horizon MIQCQP (document 000, section 5.3).
+
+    ``solve_progress`` is called about once a second while the ``bnb`` backend searches
+    (``SolverOptions.progress``).
 
     Returns:
         A :class:`FootstepPlan`; its status says whether it is optimal (within the gap), a
@@ -566,7 +572,8 @@ def plan_footsteps(
             _model_infeasible(scene, fp.robot, n_steps, options),
             solver=options.solver,
         )
-    result = solve(fp.problem, options.solver, options.solver_options())
+    solver_options = replace(options.solver_options(), progress=solve_progress)
+    result = solve(fp.problem, options.solver, solver_options)
     meta = result_meta(result)
     if result.x is None:
         if result.status is SolveStatus.INFEASIBLE:

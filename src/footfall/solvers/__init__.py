@@ -13,7 +13,7 @@ import importlib.util
 from collections.abc import Callable
 
 from footfall.errors import InputError, SolverUnavailableError
-from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
+from footfall.solvers.base import SolveProgress, SolverOptions, SolverResult, SolveStatus
 from footfall.solvers.problem import MIQCQP, ProblemBuilder
 
 #: every backend footfall knows: name -> (python module to import, pip hint)
@@ -64,6 +64,7 @@ __all__ = [
     "KNOWN_BACKENDS",
     "MIQCQP",
     "ProblemBuilder",
+    "SolveProgress",
     "SolveStatus",
     "SolverOptions",
     "SolverResult",

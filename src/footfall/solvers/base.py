@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Any
@@ -28,6 +29,25 @@ class SolveStatus(str, Enum):
 
 
 @dataclass(frozen=True)
+class SolveProgress:
+    """Where a running branch and bound is (``SolverOptions.progress``).
+
+    Attributes:
+        nodes: node relaxations solved so far.
+        seconds: wall time since the solve started [s].
+        incumbent: objective of the best solution found, None before the first one.
+        bound: proven lower bound on the optimum (the best open node's bound).
+        gap: relative gap between them (inf without an incumbent).
+    """
+
+    nodes: int
+    seconds: float
+    incumbent: float | None
+    bound: float
+    gap: float
+
+
+@dataclass(frozen=True)
 class SolverOptions:
     """Options every backend understands.
 
@@ -43,6 +63,9 @@ class SolverOptions:
         initial_solution: optional full variable vector used as a warm start (MIP start).
         bnb: settings of the ``bnb`` backend (:class:`footfall.solvers.settings.BnbSettings`; the
             other backends ignore them).
+        progress: called with a :class:`SolveProgress` about once a second while ``bnb``
+            searches (in the calling process; the other backends do not call it). Not part of
+            the options' identity (it changes no result).
     """
 
     time_limit: float = 60.0
@@ -53,6 +76,7 @@ class SolverOptions:
     seed: int = 0
     initial_solution: NDArray[np.float64] | None = field(default=None, compare=False)
     bnb: BnbSettings = field(default_factory=BnbSettings)
+    progress: Callable[[SolveProgress], None] | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "time_limit", positive("time_limit", self.time_limit))

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from footfall._typing import FloatArray
-from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
+from footfall.solvers.base import SolveProgress, SolverOptions, SolverResult, SolveStatus
 from footfall.solvers.bnb import probing
 from footfall.solvers.bnb.branching import _branch, _choice, _dive, _finish, _Node, _root_allowed
 from footfall.solvers.bnb.model import _Structure
@@ -29,6 +29,8 @@ from footfall.solvers.bnb.workers import _Workers
 from footfall.solvers.problem import MIQCQP
 
 NAME = "bnb"
+#: least time [s] between two calls of ``SolverOptions.progress``
+PROGRESS_PERIOD = 1.0
 
 
 def solve(problem: MIQCQP, options: SolverOptions) -> SolverResult:
@@ -104,6 +106,8 @@ class _Search:
         self.workers = 0
         #: (nodes, seconds, incumbent or None, best bound) every 25 nodes
         self.trace: list[tuple[int, float, float | None, float]] = []
+        #: when ``options.progress`` was last called (the first call comes after one period)
+        self.reported_at = start
         if options.initial_solution is not None:
             x0 = np.asarray(options.initial_solution, dtype=float)
             if x0.shape == (self.problem.n,):
@@ -232,7 +236,9 @@ class _Search:
 
     def subsearch(self) -> _Search:
         """A new search over the same structure, options and relaxation, not started."""
-        return _Search(self.s, self.options, self.start, self.relax)
+        # a sub-search reports nothing: its nodes are not the search's
+        options = dataclasses.replace(self.options, progress=None)
+        return _Search(self.s, options, self.start, self.relax)
 
     def loop(self, pool: _Workers | None) -> bool:
         """The best-first loop over the open nodes, serial or with ``pool`` (without a dive);
@@ -256,10 +262,17 @@ class _Search:
         return False
 
     def _record(self, top: float) -> None:
-        """Append ``(nodes, seconds, incumbent, bound)`` to the trace every 25 nodes."""
+        """Append ``(nodes, seconds, incumbent, bound)`` to the trace every 25 nodes; report
+        progress (``options.progress``) at most every ``PROGRESS_PERIOD``."""
         if not self.trace or self.nodes >= self.trace[-1][0] + 25:
             inc = self.inc_obj if math.isfinite(self.inc_obj) else None  # JSON-safe
             self.trace.append((self.nodes, time.perf_counter() - self.start, inc, top))
+        hook = self.options.progress
+        now = time.perf_counter()
+        if hook is not None and now >= self.reported_at + PROGRESS_PERIOD:
+            self.reported_at = now
+            inc = self.inc_obj if math.isfinite(self.inc_obj) else None
+            hook(SolveProgress(self.nodes, now - self.start, inc, top, self.gap_of(top)))
 
     def _take_two(self) -> list[tuple[tuple[tuple[int, ...], ...], _Node]]:
         """Up to two node problems to solve next, with their parents: the children of the best

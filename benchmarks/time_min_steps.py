@@ -1,0 +1,43 @@
+"""Time the MuJoCo walk's smallest-N search from a cold cache (issue 20).
+
+``footfall walk --scene SCENE --planner miqcqp`` plans through
+:func:`footfall.sim.biped.plans.plan_for_walk` without ``--steps``: the smallest-N search with the
+walk's options (both reach frames, swing bound, half a sole of region margin, riser insets). This
+runs that search without a cache and prints one JSON line: wall time [s], the N found, its
+objective and every N tried (status, which model decided it, seconds).
+
+    OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python benchmarks/time_min_steps.py discrete_steps 64
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+
+from footfall.sim.biped.plans import plan_for_walk
+from footfall.terrain import builtin_scene
+
+
+def main() -> None:
+    scene, segments = sys.argv[1], int(sys.argv[2])
+    t0 = time.perf_counter()
+    plan = plan_for_walk(builtin_scene(scene), "miqcqp", heading_segments=segments, cache_dir=None)
+    print(
+        json.dumps(
+            {
+                "scene": scene,
+                "L": segments,
+                "time": time.perf_counter() - t0,
+                "N": plan.n_steps,
+                "status": plan.status.value,
+                "objective": plan.objective,
+                "tried": plan.stats.get("tried"),
+                "skipped": plan.stats.get("skipped"),
+            }
+        )
+    )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,435 @@
+"""A lower bound on the footsteps N of the MIQCQP planner's model, from reachable sets (no solve).
+
+The smallest-N search (:func:`footfall.planning.plan_min_steps`) used to prove every N from the
+distance bound up infeasible with a branch and bound, minutes per N. :func:`reachable_steps_bound`
+rules most of those N out by geometry alone, from the very rows of the planner's model
+(:mod:`footfall.planning.miqcqp`), relaxed so that what remains is a set propagation:
+
+* footstep 0 is the stance foot ``p_0``; the last two footsteps are the goal feet at the goal
+  heading (``_add_goal``);
+* every footstep ``i >= 1`` lies in one region's polygon moved in by ``region_margin``
+  (eq. 5.12i-j, 5.18) and on its plane (eq. 5.15-5.17), so its height lies in that region's
+  height range; ``|z_{i+1} - z_i| <= step_height_max``;
+* the heading ``theta_i`` lies in one segment ``[phi_l, phi_{l+1}]`` of
+  ``[theta_0 - pi, theta_0 + pi]`` (eq. 5.12j-k, 5.14) and ``|theta_{i+1} - theta_i| <=
+  theta_max`` (eq. 5.12e);
+* the step ``p_{i+1} - p_i`` lies in the reach set of eq. (5.12f) as the model imposes it: for
+  ``i = 0`` the trapezoid turned by ``theta_0``; for ``i >= 1`` the linear rows of the active
+  segment, ``P_l = Rot(phi_l) T' ∩ Rot(phi_{l+1}) T'`` (``T'``: the trapezoid with its positive
+  bounds shrunk by ``cos(pi / L)``), which do not depend on ``theta_i`` inside the segment; with
+  ``reach_both_frames`` also ``P`` of the landing foot's segment;
+* with ``swing_max``, ``p_{i+1} - p_{i-1}`` lies in the inscribed ``SWING_SIDES``-gon.
+
+The ALIP dynamics, torque bound, sin/cos rows and objective are dropped. Headings are tracked in
+*buckets* of consecutive segments (at most ``MAX_BUCKETS``; each a union of whole segments), and
+for each footstep ``i``, bucket ``b`` and region ``r`` a convex polygon ``S_i[b, r]`` is kept that
+contains every position ``p_i`` any sequence of footsteps 0..i satisfying the rows above can have
+with ``theta_i`` in ``b`` and ``p_i`` in ``r``:
+
+    S_{i+1}[b', r'] ⊇ hull( ∪_{b ~ b', r ~ r'} (S_i[b, r] ⊕ step(b, b')) ∩ region(r') ),
+
+with ``b ~ b'`` when the buckets come within ``theta_max`` of each other, ``r ~ r'`` when their
+height ranges come within ``step_height_max``, ``step(b, b')`` the hull of the ``P_l`` of the
+segments of ``b`` (intersected with those of ``b'`` under ``reach_both_frames``), and then cut by
+the swing polygon around the footstep ``i - 1`` sets. Each operation (convex hull, Minkowski sum,
+intersection with rows loosened by ``SLACK``) only enlarges a set, so by induction each ``S_i``
+contains every position the model allows.
+
+A plan with N footsteps puts footstep N - 1 on its goal foot at the goal heading, so N is ruled out
+unless that foot lies in some ``S_{N-1}[b, r]`` with ``b`` holding the goal heading (and the last
+step, its region and its swing pass the same rows). The smallest N that is not ruled out is
+therefore a valid lower bound on every N the planner's model can solve: the search may start
+there without skipping any feasible N. It is a bound for the *planner's model* (its conservative
+linear reach), exactly what the search proves infeasible.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from functools import partial
+
+import numpy as np
+
+from footfall._geometry import (
+    EDGE_TOL,
+    clip_rows,
+    convex_hull,
+    distance_to_convex,
+    minkowski_sum,
+    rot2,
+)
+from footfall._typing import FloatArray
+from footfall.models.biped import BipedParams, Side
+from footfall.planning.miqcqp import SWING_SIDES
+from footfall.planning.plan import PlannerOptions, goal_feet, wrap_near
+from footfall.terrain.scene import Scene
+
+#: slack [m] added to every row the sets are cut by, and to every membership test: the sets stay
+#: supersets of the model's despite rounding, and of plans a solver accepts within its tolerances
+SLACK = 1e-4
+#: slack [rad] on the heading rows (rate, segment membership)
+ANGLE_SLACK = 1e-6
+#: most heading buckets (a bucket is a run of consecutive segments; fewer buckets: faster, weaker;
+#: 16 buckets of 22.5 deg gave the same bounds as 32 on the built-in scenes but one, in half the
+#: time)
+MAX_BUCKETS = 16
+#: half-width [m] of the square every polygon given by rows alone is cut from (reach sets and
+#: regions are bounded, so this only has to be larger than any of them)
+_BOX = 1e4
+
+
+@dataclass(frozen=True)
+class StepsBound:
+    """A lower bound on the footsteps N of the planner's model (:func:`reachable_steps_bound`).
+
+    Attributes:
+        n_steps: the smallest N not ruled out; ``horizon + 1`` when every N up to ``horizon`` is.
+        horizon: the largest N examined.
+        reason: one sentence saying what rules out the N below ``n_steps``.
+    """
+
+    n_steps: int
+    horizon: int
+    reason: str
+
+    @property
+    def exhausted(self) -> bool:
+        """Whether every N up to ``horizon`` was ruled out."""
+        return self.n_steps > self.horizon
+
+
+def _rows_polygon(a: FloatArray, b: FloatArray) -> FloatArray:
+    """The polygon ``{q : a q <= b + SLACK}`` (V, 2), (0, 2) when empty; must be bounded."""
+    box = _BOX * np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+    return convex_hull(clip_rows(box, a, b + SLACK)) if len(a) else box
+
+
+def _rows_of(poly: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Outward rows ``a q <= b`` (V, 2), (V,) of a convex CCW polygon with at least 3 vertices."""
+    edges = np.roll(poly, -1, axis=0) - poly
+    length = np.linalg.norm(edges, axis=1)
+    # a (near-)repeated vertex has no reliable edge direction to cut by; leaving its row out
+    # keeps a superset (the other rows of a convex polygon still bound it)
+    keep = length > EDGE_TOL
+    normals = np.stack([edges[keep, 1], -edges[keep, 0]], axis=1) / length[keep, None]
+    return normals, np.einsum("ij,ij->i", normals, poly[keep])
+
+
+def _segment_reach(robot: BipedParams, side: Side, phi_a: float, phi_b: float) -> FloatArray:
+    """``P_l`` (V, 2) [m]: the steps the linear reach rows of eq. (5.12f) allow from a ``side``
+    stance foot whose heading lies in the segment ``[phi_a, phi_b]`` (miqcqp ``_add_reach``)."""
+    g, h = robot.reach.halfspaces(side)
+    half = 0.5 * (phi_b - phi_a)
+    h_eff = np.where(h > 0.0, h * math.cos(half), h)
+    rows = np.vstack([g @ rot2(phi_a).T, g @ rot2(phi_b).T])
+    return _rows_polygon(rows, np.concatenate([h_eff, h_eff]))
+
+
+@dataclass(frozen=True)
+class _Setup:
+    """The rows of the model that the propagation uses (see the module docstring)."""
+
+    sides: tuple[Side, ...]
+    theta0: float
+    #: bucket b holds headings [lo[b], hi[b]] [rad]
+    lo: FloatArray
+    hi: FloatArray
+    #: step polygons per side and bucket (None: empty)
+    step: dict[Side, list[FloatArray | None]]
+    #: first step (footstep 0 -> 1) per side of footstep 0: the trapezoid turned by theta_0
+    first: FloatArray
+    #: region rows (with margin and slack), polygons and height ranges [m]
+    region_rows: list[tuple[FloatArray, FloatArray]]
+    region_poly: list[FloatArray]
+    z_range: list[tuple[float, float]]
+    swing: FloatArray | None
+    p0: FloatArray
+    z0: float
+    swing_from: FloatArray
+    theta_goal: float
+    feet: dict[Side, FloatArray]
+    #: memo of :func:`_both_frames_step`
+    pair_steps: dict[tuple[Side, int, int], FloatArray | None] = field(default_factory=dict)
+
+
+def _setup(scene: Scene, robot: BipedParams, options: PlannerOptions, horizon: int) -> _Setup:
+    start = scene.start
+    theta0 = float(start.heading)
+    n_seg = options.heading_segments
+    breaks = theta0 - math.pi + 2.0 * math.pi * np.arange(n_seg + 1) / n_seg
+    firsts, lasts = _bucket_segments(n_seg)
+    step: dict[Side, list[FloatArray | None]] = {}
+    for side in (Side.LEFT, Side.RIGHT):
+        buckets: list[FloatArray | None] = []
+        for f, last in zip(firsts, lasts, strict=True):
+            parts = [_segment_reach(robot, side, breaks[k], breaks[k + 1]) for k in range(f, last)]
+            parts = [q for q in parts if q.shape[0] > 0]
+            buckets.append(convex_hull(np.vstack(parts)) if parts else None)
+        step[side] = buckets
+    g, h = robot.reach.halfspaces(start.stance)
+    first = _rows_polygon(g @ rot2(theta0).T, h)
+    rows, polys, zr = [], [], []
+    for region in scene.terrain:
+        a, b = region.halfspaces()
+        b_eff = b - options.region_margin + SLACK
+        rows.append((a, b_eff))
+        poly = _rows_polygon(a, b - options.region_margin)
+        polys.append(poly)
+        z = np.asarray(region.height_at(poly)) if poly.shape[0] else np.zeros(0)
+        zr.append((float(z.min()), float(z.max())) if z.size else (math.inf, -math.inf))
+    swing = None
+    if options.swing_max is not None:
+        phis = 2.0 * math.pi * np.arange(SWING_SIDES) / SWING_SIDES
+        normals = np.stack([np.cos(phis), np.sin(phis)], axis=1)
+        rhs = np.full(SWING_SIDES, options.swing_max * math.cos(math.pi / SWING_SIDES))
+        swing = _rows_polygon(normals, rhs)
+    sides = [start.stance]
+    for _ in range(horizon + 1):
+        sides.append(sides[-1].other)
+    theta_goal = wrap_near(float(scene.goal.heading), theta0)
+    p0 = np.asarray(start.foot(start.stance), dtype=float)
+    return _Setup(
+        sides=tuple(sides),
+        theta0=theta0,
+        lo=np.array([breaks[f] for f in firsts]),
+        hi=np.array([breaks[last] for last in lasts]),
+        step=step,
+        first=first,
+        region_rows=rows,
+        region_poly=polys,
+        z_range=zr,
+        swing=swing,
+        p0=p0[:2],
+        z0=float(p0[2]),
+        swing_from=np.asarray(start.foot(sides[1]), dtype=float)[:2],
+        theta_goal=theta_goal,
+        feet=goal_feet(robot, scene.goal.position[:2], theta_goal),
+    )
+
+
+def _gap(lo_a: float, hi_a: float, lo_b: float, hi_b: float) -> float:
+    """Distance between the intervals [lo_a, hi_a] and [lo_b, hi_b] (0 when they overlap)."""
+    return max(lo_b - hi_a, lo_a - hi_b, 0.0)
+
+
+def _near(poly: FloatArray, x: FloatArray) -> bool:
+    return distance_to_convex(x, poly) <= SLACK
+
+
+_Sets = dict[tuple[int, int], FloatArray]
+
+
+def _first_sets(s: _Setup, robot: BipedParams, both: bool) -> _Sets:
+    """``S_1``: footstep 1 from the fixed stance foot at heading theta_0."""
+    theta0 = s.theta0
+    side = s.sides[0]
+    out: _Sets = {}
+    for b in range(len(s.lo)):
+        if _gap(theta0, theta0, s.lo[b], s.hi[b]) > robot.theta_max + ANGLE_SLACK:
+            continue
+        step = s.first
+        if both:
+            other = s.step[side][b]
+            if other is None:
+                continue
+            # a degenerate set has no rows to cut by: keep the larger step (still a superset)
+            step = clip_rows(step, *_rows_of(other)) if other.shape[0] >= 3 else step
+        if step.shape[0] == 0:
+            continue
+        reach = s.p0 + step
+        if s.swing is not None:
+            reach = clip_rows(reach, *_shifted_rows(s.swing, s.swing_from))
+        for r, (a, rhs) in enumerate(s.region_rows):
+            if _gap(s.z0, s.z0, *s.z_range[r]) > robot.step_height_max + SLACK:
+                continue
+            piece = clip_rows(reach, a, rhs)
+            if piece.shape[0]:
+                out[(b, r)] = convex_hull(piece)
+    return out
+
+
+def _shifted_rows(poly: FloatArray, shift: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Rows (with ``SLACK``) of the convex polygon ``poly + shift``."""
+    a, b = _rows_of(poly)
+    return a, b + a @ shift + SLACK
+
+
+def _next_sets(
+    s: _Setup, robot: BipedParams, both: bool, i: int, cur: _Sets, before: list[FloatArray]
+) -> _Sets:
+    """``S_{i+1}`` from ``S_i`` (``cur``) and the footstep ``i - 1`` sets ``before`` (per region)."""
+    side = s.sides[i]
+    n_b = len(s.lo)
+    swing_rows = (
+        [_rows_of(minkowski_sum(p, s.swing)) for p in before] if s.swing is not None else []
+    )
+    gathered: dict[tuple[int, int], list[FloatArray]] = {}
+    for (b, r), piece in cur.items():
+        step_b = s.step[side][b]
+        if step_b is None:
+            continue
+        # without the landing frame the step set does not depend on the next bucket: the cuts
+        # into the regions are made once and shared by every bucket b2 within reach of b
+        plain = None if both else _cuts(s, robot, r, minkowski_sum(piece, step_b))
+        for b2 in range(n_b):
+            if _gap(s.lo[b], s.hi[b], s.lo[b2], s.hi[b2]) > robot.theta_max + ANGLE_SLACK:
+                continue
+            cuts = plain
+            if cuts is None:
+                step = _both_frames_step(s, side, b, b2)
+                if step is None:
+                    continue
+                cuts = _cuts(s, robot, r, minkowski_sum(piece, step))
+            for r2, cut in cuts:
+                gathered.setdefault((b2, r2), []).append(cut)
+    out: _Sets = {}
+    for key, parts in gathered.items():
+        hull = convex_hull(np.vstack(parts))
+        if swing_rows:
+            kept = [clip_rows(hull, a, rhs + SLACK) for a, rhs in swing_rows]
+            kept = [k for k in kept if k.shape[0]]
+            if not kept:
+                continue
+            hull = convex_hull(np.vstack(kept))
+        out[key] = hull
+    return out
+
+
+def _cuts(s: _Setup, robot: BipedParams, r: int, moved: FloatArray) -> list[tuple[int, FloatArray]]:
+    """The non-empty parts ``(r2, moved ∩ region r2)`` of the regions a footstep in region ``r``
+    can step to (height ranges within ``step_height_max``)."""
+    lo_m, hi_m = moved.min(axis=0), moved.max(axis=0)
+    out = []
+    for r2, (a, rhs) in enumerate(s.region_rows):
+        poly = s.region_poly[r2]
+        if poly.shape[0] == 0:
+            continue
+        if _gap(*s.z_range[r], *s.z_range[r2]) > robot.step_height_max + SLACK:
+            continue
+        if np.any(poly.min(axis=0) > hi_m + SLACK) or np.any(poly.max(axis=0) < lo_m - SLACK):
+            continue
+        cut = clip_rows(moved, a, rhs)
+        if cut.shape[0]:
+            out.append((r2, cut))
+    return out
+
+
+def _both_frames_step(s: _Setup, side: Side, b: int, b2: int) -> FloatArray | None:
+    """The steps from a ``side`` stance foot with heading in bucket ``b`` that also lie in the
+    reach set of the landing heading's bucket ``b2`` (``reach_both_frames``); memoised."""
+    key = (side, b, b2)
+    if key not in s.pair_steps:
+        step_b, step_2 = s.step[side][b], s.step[side][b2]
+        step = None
+        if step_b is not None and step_2 is not None:
+            # a degenerate set has no rows to cut by: keep the larger step_b (still a superset)
+            cut = clip_rows(step_b, *_rows_of(step_2)) if step_2.shape[0] >= 3 else step_b
+            step = cut if cut.shape[0] else None
+        s.pair_steps[key] = step
+    return s.pair_steps[key]
+
+
+def _per_region(sets: _Sets) -> list[FloatArray]:
+    """The union over heading buckets of each region's set, as one hull per region."""
+    parts: dict[int, list[FloatArray]] = {}
+    for (_, r), piece in sets.items():
+        parts.setdefault(r, []).append(piece)
+    return [convex_hull(np.vstack(p)) for p in parts.values()]
+
+
+def _goal_reached(
+    s: _Setup, robot: BipedParams, sets: _Sets, before: list[FloatArray], n: int
+) -> bool:
+    """Whether footstep N - 1 (``sets``) can be the goal foot and footstep N the other (N = n)."""
+    side_a, side_b = s.sides[n - 1], s.sides[n]
+    g_a, g_b = s.feet[side_a], s.feet[side_b]
+    tg = s.theta_goal
+    regions_b = [r for r, poly in enumerate(s.region_poly) if poly.shape[0] and _near(poly, g_b)]
+    if s.swing is not None and not any(_near(minkowski_sum(p, s.swing), g_b) for p in before):
+        return False
+    for (b, r), piece in sets.items():
+        if not s.lo[b] - ANGLE_SLACK <= tg <= s.hi[b] + ANGLE_SLACK or not _near(piece, g_a):
+            continue
+        step = s.step[side_a][b]
+        if step is None or not _near(step, g_b - g_a):
+            continue
+        if any(
+            _gap(*s.z_range[r], *s.z_range[r2]) <= robot.step_height_max + SLACK for r2 in regions_b
+        ):
+            return True
+    return False
+
+
+def footstep_sets(
+    scene: Scene, robot: BipedParams, options: PlannerOptions, horizon: int
+) -> Iterator[tuple[int, _Sets, Callable[[int], bool]]]:
+    """The reachable sets of footsteps 1, 2, ..., ``horizon - 1`` (module docstring).
+
+    Yields:
+        ``(i, sets, goal)``: ``sets[(b, r)]`` is the convex polygon (V, 2) [m] holding every
+        position of footstep ``i`` with its heading in bucket ``b`` (``bucket_bounds``) and its
+        region ``scene.terrain[r]``; ``goal(n)`` (for ``n = i + 1``) says whether footstep
+        ``n - 1 = i`` can be the goal foot of a plan with ``n`` footsteps.
+    """
+    s = _setup(scene, robot, options, horizon)
+    both = options.reach_both_frames
+    history: list[list[FloatArray]] = [[s.p0[None, :]]]
+    sets = _first_sets(s, robot, both)
+    for i in range(1, horizon):
+        before = history[-1]
+        yield i, sets, partial(_goal_reached, s, robot, sets, before)
+        if not sets:
+            return
+        history.append(_per_region(sets))
+        sets = _next_sets(s, robot, both, i, sets, history[-2])
+
+
+def bucket_bounds(options: PlannerOptions, theta0: float) -> tuple[FloatArray, FloatArray]:
+    """Heading intervals ``[lo[b], hi[b]]`` [rad] of the buckets of :func:`footstep_sets` for a
+    start heading ``theta0`` [rad]: runs of consecutive segments of eq. (5.12g-h)."""
+    n_seg = options.heading_segments
+    breaks = theta0 - math.pi + 2.0 * math.pi * np.arange(n_seg + 1) / n_seg
+    firsts, lasts = _bucket_segments(n_seg)
+    return breaks[firsts], breaks[lasts]
+
+
+def _bucket_segments(n_seg: int) -> tuple[list[int], list[int]]:
+    """First and one-past-last segment of each heading bucket (at most ``MAX_BUCKETS``)."""
+    per = math.ceil(n_seg / MAX_BUCKETS)
+    firsts = list(range(0, n_seg, per))
+    return firsts, [min(f + per, n_seg) for f in firsts]
+
+
+def reachable_steps_bound(
+    scene: Scene, robot: BipedParams, options: PlannerOptions, horizon: int
+) -> StepsBound:
+    """The smallest N in 2..``horizon`` that the reachable sets do not rule out (module
+    docstring), or ``horizon + 1`` if they rule out all of them.
+
+    Args:
+        scene: terrain, start and goal.
+        robot: the planner's robot parameters (reach, theta_max, step_height_max, stance width).
+        options: the planner options whose rows are used: ``heading_segments`` (L),
+            ``region_margin``, ``reach_both_frames``, ``swing_max``.
+        horizon: the largest N to examine (the work grows linearly with it).
+
+    Returns:
+        A :class:`StepsBound`; every N below ``n_steps`` has no plan in the planner's model.
+    """
+    what = (
+        f"reachable sets from the reach rows of eq. 5.12f with L = {options.heading_segments} "
+        "heading segments, the heading rate (5.12e), the step height and the regions"
+        + (f" {options.region_margin:g} m inside" if options.region_margin > 0 else "")
+        + (f", swings of at most {options.swing_max:g} m" if options.swing_max is not None else "")
+    )
+    for i, sets, goal in footstep_sets(scene, robot, options, horizon):
+        n = i + 1  # footstep N - 1 = i must be the goal foot
+        if not sets:
+            return StepsBound(horizon + 1, horizon, f"no footstep {i} can be placed: {what}")
+        if goal(n):
+            return StepsBound(n, horizon, f"no footstep N - 1 can be the goal foot: {what}")
+    return StepsBound(
+        horizon + 1, horizon, f"no footstep N - 1 <= {horizon - 1} can be the goal foot: {what}"
+    )
