@@ -103,3 +103,26 @@ def test_a_solve_reports_its_progress_to_the_hook(monkeypatch: pytest.MonkeyPatc
     for p in seen:  # the bound never passes the optimum; an incumbent is never below it
         assert p.bound <= plan.objective * (1 + 1e-6)
         assert p.incumbent is None or p.incumbent >= plan.objective * (1 - 1e-6)
+
+
+def test_walk_logs_its_smallest_n_search_and_records_its_controller(tmp_path: Path) -> None:
+    pytest.importorskip("mujoco")
+    log = tmp_path / "progress.jsonl"
+    out = tmp_path / "out"
+    res = subprocess.run(
+        [
+            *(sys.executable, "-m", "footfall", "walk", "--scene", "flat", "--no-video"),
+            *("--out", str(out), "--log-json", str(log)),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert res.returncode == 0, res.stderr
+    # a line per N tried, on stderr (a pipe, no terminal), and the JSON lines of the same search
+    assert any(" optimal in " in line for line in res.stderr.splitlines() if line.startswith("["))
+    records = [json.loads(line) for line in log.read_text().splitlines()]
+    assert records[0]["event"] == "start" and records[-1]["event"] == "done"
+    walked = json.loads((out / "walk.json").read_text())
+    assert records[-1]["n_steps"] == walked["plan"]["n_steps"]
+    assert walked["controller"]["name"] == "wbc"  # the biped's default controller

@@ -20,6 +20,7 @@ from footfall.cli._common import (
     console,
     output_folder,
 )
+from footfall.cli._progress import ProgressLog
 from footfall.errors import InputError
 
 
@@ -407,6 +408,14 @@ def walk_cmd(
     controller: str | None = typer.Option(
         None, help=_CONTROLLER_HELP + " Default: the robot's (biped: wbc, g1: servo)."
     ),
+    quiet: bool = typer.Option(
+        False, "--quiet", help="No planning progress lines or status line (results still print)."
+    ),
+    log_json: Path | None = typer.Option(
+        None,
+        "--log-json",
+        help="Write the planning progress as JSON lines to this file (as `footfall plan`).",
+    ),
 ) -> None:
     """Walk a footstep plan with the MuJoCo biped (document 000, section 5.5).
 
@@ -439,7 +448,7 @@ def walk_cmd(
     model = robot_model(robot)
     sc = resolve_scene_arguments(scene_file, scene)
     output_folder(out)
-    with console.status(f"planning {sc.name} with {planner} for the {robot} ..."):
+    with ProgressLog(f"{sc.name} with {planner} for the {robot}", quiet, log_json) as log:
         plan = plan_for_walk(
             sc,
             planner,
@@ -449,7 +458,9 @@ def walk_cmd(
             model=model,
             robot_aware=robot_aware,
             heading_segments=heading_segments,
+            monitor=log,
         )
+        log.done(plan)
     write_json(out / "plan.json", plan.to_dict(sc.name))
     if not plan.has_solution:
         console.print(f"{sc.name}: {planner} found no plan ({plan.status.value}). {plan.message}")
@@ -461,10 +472,8 @@ def walk_cmd(
         res = walk(
             sc, plan, opts, model_params=model, video_path=out / "walk.mp4" if video else None
         )
-    write_json(
-        out / "walk.json",
-        {**walk_report(sc.name, planner, robot, plan, pushes, res), "controller": controller},
-    )
+    # walk.json's "controller" (from the result) names the controller and holds its tally
+    write_json(out / "walk.json", walk_report(sc.name, planner, robot, plan, pushes, res))
     plot_walk(res, sc, out / "walk.png", title=f"{sc.name}, {planner}, {robot}")
     m = res.metrics
     console.print(

@@ -28,7 +28,7 @@ from footfall.errors import InputError
 from footfall.models.biped import BipedParams
 from footfall.planning.check import check_plan
 from footfall.planning.plan import FootstepPlan, PlannerOptions
-from footfall.planning.run import make_plan
+from footfall.planning.run import SearchMonitor, make_plan
 from footfall.terrain.scene import Scene, robot_to_dict, scene_to_dict
 
 #: version of the key's layout and of the file format; bumping it makes every old entry a miss
@@ -139,8 +139,10 @@ def cached_plan(
     options: PlannerOptions | None = None,
     robot: BipedParams | None = None,
     cache: PlanCache | None = None,
+    monitor: SearchMonitor | None = None,
 ) -> FootstepPlan:
-    """:func:`footfall.planning.make_plan`, served from ``cache`` when it holds the plan.
+    """:func:`footfall.planning.make_plan`, served from ``cache`` when it holds the plan
+    (``monitor`` hears of a smallest-N search that runs, :func:`~footfall.planning.run.plan_min_steps`).
 
     Only plans with footsteps are stored: a failed search is made again next time (it may have
     hit a time limit). A cached plan is re-checked before use (:func:`cache_mismatch`): one that
@@ -161,7 +163,7 @@ def cached_plan(
             if not problem:
                 return hit
             discarded = f" (cached plan {cache.path(key).name} discarded: {problem}; planned again)"
-    plan = make_plan(scene, planner, n_steps, options, robot)
+    plan = make_plan(scene, planner, n_steps, options, robot, monitor=monitor)
     if cache is not None and plan.has_solution:
         cache.save(key, plan, scene.name)
     if discarded:

@@ -39,6 +39,7 @@ def make_plan(
     options: PlannerOptions | None = None,
     robot: BipedParams | None = None,
     solve_progress: Callable[[SolveProgress], None] | None = None,
+    monitor: SearchMonitor | None = None,
 ) -> FootstepPlan:
     """Plan with the named planner (``miqcqp``, ``kinematic`` or ``reactive``).
 
@@ -53,6 +54,8 @@ def make_plan(
         solve_progress: called about once a second during a ``bnb`` solve of a given N
             (``SolverOptions.progress``); the smallest-N search reports through
             :func:`plan_min_steps`'s ``monitor`` instead.
+        monitor: the smallest-N search's reporter (``n_steps`` None), see
+            :func:`plan_min_steps`.
     """
     check_planning_arguments(scene, robot, options)
     check_planner_name(planner)
@@ -75,7 +78,7 @@ def make_plan(
             scene, robot, max_steps=n_steps or 40, region_margin=options.region_margin
         )
     if n_steps is None:
-        return plan_min_steps(scene, planner, options, robot)
+        return plan_min_steps(scene, planner, options, robot, monitor=monitor)
     if planner == "kinematic":
         from footfall.planning.kinematic import plan_kinematic
 

@@ -19,6 +19,7 @@ from footfall._validate import non_negative
 from footfall.errors import InputError
 from footfall.planning.cache import PlanCache, cached_plan
 from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
+from footfall.planning.run import SearchMonitor
 from footfall.sim.biped.model import (
     SWING_MAX,
     WALK_HEADING_SEGMENTS,
@@ -73,6 +74,7 @@ def plan_for_walk(
     model: WalkerModel | None = None,
     robot_aware: bool = True,
     heading_segments: int | None = None,
+    monitor: SearchMonitor | None = None,
 ) -> FootstepPlan:
     """The plan of ``scene`` for the MuJoCo biped or another walker model (robot parameters from
     :func:`planner_params`).
@@ -95,6 +97,9 @@ def plan_for_walk(
     (stairs_slope_gap N = 16: to y = 0.39 m). 64 segments (5.6 deg) lose at most 4 cm of width
     there (0.329 m forward at 0.16 m); the plans take longer (stairs_slope_gap N = 16: 38 s
     instead of 4 s).
+
+    ``monitor`` hears of a smallest-N search (``n_steps`` None) while it runs
+    (:func:`footfall.planning.run.plan_min_steps`; ``footfall walk`` prints its lines).
 
     With ``cache_dir`` the plan is kept in that folder's plan cache (:mod:`footfall.planning.cache`)
     and reused while the scene's contents (its regions after the riser insets, start, goal), the
@@ -124,6 +129,7 @@ def plan_for_walk(
         opts,
         robot,
         PlanCache(cache_dir) if cache_dir is not None else None,
+        monitor,
     )
 
 
