@@ -293,7 +293,7 @@ def _pack(p: WbcProblem) -> tuple[Any, ...]:
         r1 = r0 + t.acceleration.shape[0]
         m_jac[r0:r1] = t.jacobian
         m_rhs[r0:r1] = t.acceleration - t.drift
-        m_w[r0:r1] = _weights(t.weight, r1 - r0, t.name)
+        m_w[r0:r1] = t.weight
         r0 = r1
     rw = sum(wt.target.shape[0] for wt in p.wrench_tasks)
     w_rows, w_about = np.empty((rw, 6)), np.empty((rw, 3))
@@ -303,7 +303,7 @@ def _pack(p: WbcProblem) -> tuple[Any, ...]:
     for wt in p.wrench_tasks:
         r1 = r0 + wt.target.shape[0]
         w_rows[r0:r1], w_about[r0:r1], w_target[r0:r1] = wt.rows, wt.about, wt.target
-        w_weight[r0:r1] = _weights(wt.weight, r1 - r0, wt.name)
+        w_weight[r0:r1] = wt.weight
         for i, nm in enumerate(names):
             if wt.contacts is None or nm in wt.contacts:
                 w_mask[r0:r1, i] = 1.0
@@ -365,11 +365,13 @@ def _check_problem(p: WbcProblem) -> None:
             raise InputError(f"contact {c.name}.normal", c.normal.tolist(), "a unit vector")
     for t in p.motion_tasks:
         r = t.acceleration.shape[0] if np.ndim(t.acceleration) == 1 else -1
+        _weights(t.weight, r, t.name)
         _shape(f"task {t.name}.acceleration", t.acceleration, (r,))
         _shape(f"task {t.name}.jacobian", t.jacobian, (r, nv))
         _shape(f"task {t.name}.drift", t.drift, (r,))
     for wt in p.wrench_tasks:
         r = wt.target.shape[0] if np.ndim(wt.target) == 1 else -1
+        _weights(wt.weight, r, wt.name)
         _shape(f"task {wt.name}.target", wt.target, (r,))
         _shape(f"task {wt.name}.rows", wt.rows, (r, 6))
         _shape(f"task {wt.name}.about", wt.about, (3,))

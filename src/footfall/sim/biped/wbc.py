@@ -149,10 +149,9 @@ class WbcTally:
             mu_fn = c.friction * fn
             self.min_corner_force = min(self.min_corner_force, float(fn.min()))
             self.max_friction_excess = max(self.max_friction_excess, float((ft - mu_fn).max()))
-            loaded = fn > LOADED_CORNER
-            if loaded.any():
-                ratio = float((ft[loaded] / mu_fn[loaded]).max())
-                self.max_friction_share = max(self.max_friction_share, ratio)
+            # tangential share of the cone on corners carrying at least LOADED_CORNER
+            ratio = np.where(fn > LOADED_CORNER, ft / np.maximum(mu_fn, 1e-12), 0.0)
+            self.max_friction_share = max(self.max_friction_share, float(ratio.max()))
 
     def to_dict(self) -> dict[str, float | int]:
         """JSON-ready numbers (walk.json's ``controller``)."""
