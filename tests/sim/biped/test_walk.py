@@ -395,7 +395,7 @@ def test_plan_for_walk_plans_on_the_riser_inset_regions(monkeypatch: pytest.Monk
 
     seen = {}
 
-    def capture(scene, planner, n_steps, options, robot):  # type: ignore[no-untyped-def]
+    def capture(scene, planner, n_steps, options, robot, monitor=None):  # type: ignore[no-untyped-def]
         seen["scene"], seen["options"] = scene, options
         raise RuntimeError("captured")
 
