@@ -77,6 +77,6 @@ def main() -> None:
 
 
 # the command modules register their commands on ``app`` when imported
-from footfall.cli import bench, planning, simulation  # noqa: E402
+from footfall.cli import bench, planning, simulation, study  # noqa: E402
 
-__all__ = ["app", "bench", "main", "planning", "simulation"]
+__all__ = ["app", "bench", "main", "planning", "simulation", "study"]

@@ -1,0 +1,310 @@
+"""Run a study: plan every (scene, planner, step mode) once, then walk the trials on an executor.
+
+Plans are deterministic, so each is made once and cached in ``DIR/plans``
+(:mod:`footfall.planning.cache`). The reactive planner walks to the goal; its N is the "equal N"
+of the horizon planners. A horizon planner's smallest-N plan that already has that N serves both
+modes (the same walk, one row flagged ``smallest_n`` and ``equal_n``).
+
+Executors: ``local`` (this process for one worker, else a process pool) and ``ray`` (a local
+``ray.init`` with ``workers`` CPUs, or an existing cluster at ``address``). Rows are stored as they
+arrive (:class:`~footfall.experiments.study.store.TrialStore`); trials already in the folder are
+skipped, so an interrupted study resumes where it stopped.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from footfall.errors import InputError
+from footfall.experiments.study.design import Disturbance, StudyDesign
+from footfall.experiments.study.store import TrialStore
+from footfall.experiments.study.trials import Trial, run_trial, trial_key
+from footfall.planning.plan import FootstepPlan
+from footfall.terrain.scene import Scene, builtin_scene
+
+#: the executors of ``footfall study --executor``
+EXECUTORS = ("local", "ray")
+#: trials in flight per worker (keeps every worker busy without shipping the whole study at once)
+IN_FLIGHT = 2
+
+
+@dataclass(frozen=True)
+class PlanEntry:
+    """A plan of the study (one per scene, planner and step mode).
+
+    Attributes:
+        scene: scene name.
+        planner: planner name.
+        mode: ``smallest``, ``equal`` or ``goal`` (the reactive planner: it walks to the goal).
+        plan: the plan (may have no solution: then its trials are not run).
+        plan_time: wall time to get it [s] (cache hits are fast).
+    """
+
+    scene: str
+    planner: str
+    mode: str
+    plan: FootstepPlan
+    plan_time: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """The row of ``plans.json``."""
+        return {
+            "scene": self.scene,
+            "planner": self.planner,
+            "mode": self.mode,
+            "status": self.plan.status.value,
+            "n_steps": int(self.plan.n_steps) if self.plan.has_solution else None,
+            "objective": self.plan.objective if self.plan.has_solution else None,
+            "solve_time": self.plan.solve_time,
+            "plan_time": self.plan_time,
+            "message": self.plan.message,
+        }
+
+
+def _planner(design: StudyDesign, folder: Path) -> Callable[[Scene, str, int | None], FootstepPlan]:
+    """``plan(scene, planner, n_steps)`` for the study's simulator, cached in ``folder``."""
+    if design.simulator == "mujoco":
+        from footfall.sim.biped.plans import plan_for_walk
+
+        def plan_mujoco(scene: Scene, planner: str, n: int | None) -> FootstepPlan:
+            return plan_for_walk(scene, planner, n, design.time_limit, folder)
+
+        return plan_mujoco
+    from footfall.planning.cache import PlanCache, cached_plan
+    from footfall.planning.plan import PlannerOptions
+
+    cache, options = PlanCache(folder), PlannerOptions(time_limit=design.time_limit)
+
+    def plan_reduced(scene: Scene, planner: str, n: int | None) -> FootstepPlan:
+        return cached_plan(scene, planner, n, options, cache=cache)
+
+    return plan_reduced
+
+
+def make_plans(
+    design: StudyDesign, folder: Path, say: Callable[[str], None] | None = None
+) -> list[PlanEntry]:
+    """Every plan the study walks (see the module docstring), planned or read from the cache."""
+    plan = _planner(design, folder)
+    out: list[PlanEntry] = []
+
+    def timed(scene: Scene, planner: str, n: int | None, mode: str) -> PlanEntry:
+        if say:
+            say(f"planning {scene.name} / {planner} ({mode} N{'' if n is None else f' = {n}'})")
+        t0 = time.perf_counter()
+        p = plan(scene, planner, n)
+        entry = PlanEntry(scene.name, planner, mode, p, time.perf_counter() - t0)
+        if say:
+            n_txt = p.n_steps if p.has_solution else "-"
+            say(f"  {p.status.value}, N = {n_txt}, {entry.plan_time:.1f} s")
+        return entry
+
+    for name in design.scenes:
+        scene = builtin_scene(name)
+        reactive = None
+        if "reactive" in design.planners or "equal" in design.steps:
+            reactive = timed(scene, "reactive", None, "goal")
+            if "reactive" in design.planners:
+                out.append(reactive)
+        n_equal = reactive.plan.n_steps if reactive and reactive.plan.has_solution else None
+        for planner in design.planners:
+            if planner == "reactive":
+                continue
+            smallest = None
+            if "smallest" in design.steps:
+                smallest = timed(scene, planner, None, "smallest")
+                out.append(smallest)
+            if "equal" in design.steps:
+                if n_equal is None:  # no reactive walk, no equal N: the report says so
+                    if say:
+                        say(f"  {name} / {planner}: no equal-N plan (the reactive planner failed)")
+                elif smallest and smallest.plan.has_solution and smallest.plan.n_steps == n_equal:
+                    out.append(PlanEntry(name, planner, "equal", smallest.plan, 0.0))
+                else:
+                    out.append(timed(scene, planner, n_equal, "equal"))
+    return out
+
+
+def make_trials(design: StudyDesign, plans: list[PlanEntry]) -> list[Trial]:
+    """The study's walks, one per distinct (scene, planner, N, impulse, seed), in a fixed order.
+
+    A walk that serves both step modes is one trial with both flags."""
+    scenes = {name: builtin_scene(name) for name in design.scenes}
+    flags: dict[str, list[bool]] = {}
+    spec: dict[str, tuple[PlanEntry, float, int]] = {}
+    for entry in plans:
+        if not entry.plan.has_solution or entry.plan.states.shape[0] != entry.plan.n_steps:
+            continue
+        for impulse in design.impulses():
+            for seed in design.seeds_at(impulse, entry.mode):
+                key = trial_key(entry.scene, entry.planner, entry.plan.n_steps, impulse, seed)
+                f = flags.setdefault(key, [False, False])
+                f[0] |= entry.mode in ("smallest", "goal")
+                f[1] |= entry.mode in ("equal", "goal")
+                spec.setdefault(key, (entry, impulse, seed))
+    trials = []
+    for key, (entry, impulse, seed) in spec.items():
+        trials.append(
+            Trial(
+                key=key,
+                scene=scenes[entry.scene],
+                planner=entry.planner,
+                plan=entry.plan,
+                smallest_n=flags[key][0],
+                equal_n=flags[key][1],
+                impulse=impulse,
+                disturbance=Disturbance.of_seed(seed),
+                design=design,
+            )
+        )
+    return trials
+
+
+def _local(trials: list[Trial], workers: int) -> Iterator[dict[str, Any]]:
+    if not trials:
+        return
+    # The first trial runs here: it compiles (or loads) the numba kernels once and leaves them in
+    # numba's disk cache, so the workers load them instead of each compiling them at once.
+    yield run_trial(trials[0])
+    if workers <= 1:
+        for t in trials[1:]:
+            yield run_trial(t)
+        return
+    import multiprocessing as mp
+    from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+
+    # spawn: children import numpy afresh (single-threaded BLAS from the environment)
+    pool = ProcessPoolExecutor(workers, mp_context=mp.get_context("spawn"))
+    try:
+        todo = iter(trials[1:])
+        running: set[Future[dict[str, Any]]] = set()
+        while True:
+            while len(running) < IN_FLIGHT * workers:
+                nxt = next(todo, None)
+                if nxt is None:
+                    break
+                running.add(pool.submit(run_trial, nxt))
+            if not running:
+                break
+            finished, running = wait(running, return_when=FIRST_COMPLETED)
+            for f in finished:
+                yield f.result()
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _ray(trials: list[Trial], workers: int, address: str | None) -> Iterator[dict[str, Any]]:
+    try:
+        import ray
+    except ImportError:
+        raise InputError("--executor", "ray", "pip install 'footfall[study]' (Ray)") from None
+    started = not ray.is_initialized()
+    if started:
+        kw: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
+        if address is None:
+            kw["num_cpus"] = workers
+        ray.init(address=address, **kw)
+    try:
+        remote = ray.remote(num_cpus=1, max_retries=2)(run_trial)
+        todo = iter(trials)
+        running: list[Any] = []
+        cap = IN_FLIGHT * max(1, int(ray.cluster_resources().get("CPU", workers)))
+        while True:
+            while len(running) < cap:
+                t = next(todo, None)
+                if t is None:
+                    break
+                running.append(remote.remote(t))
+            if not running:
+                break
+            finished, running = ray.wait(running, num_returns=1)
+            for ref in finished:
+                yield ray.get(ref)
+    finally:
+        for ref in locals().get("running", []):
+            ray.cancel(ref, force=True)
+        if started:
+            ray.shutdown()
+
+
+def execute(
+    trials: list[Trial], executor: str = "local", workers: int = 1, address: str | None = None
+) -> Iterable[dict[str, Any]]:
+    """The rows of ``trials`` in the order they finish, from ``executor``."""
+    if executor not in EXECUTORS:
+        raise InputError("--executor", executor, f"one of {', '.join(EXECUTORS)}")
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise InputError("--workers", workers, "an integer >= 1")
+    if address is not None and executor != "ray":
+        raise InputError("--address", address, "only with --executor ray")
+    if executor == "ray":
+        return _ray(trials, workers, address)
+    return _local(trials, workers)
+
+
+@dataclass(frozen=True)
+class StudyRun:
+    """What :func:`run_study` did.
+
+    Attributes:
+        rows: every row of the folder's table that belongs to this study, sorted by key.
+        plans: the plans walked.
+        trials: walks the study declares.
+        ran: walks run now (the others were in the folder already).
+        wall_time: time of the walks run now [s].
+    """
+
+    rows: list[dict[str, Any]]
+    plans: list[PlanEntry]
+    trials: int
+    ran: int
+    wall_time: float
+
+
+def run_study(
+    design: StudyDesign,
+    out: Path,
+    executor: str = "local",
+    workers: int = 1,
+    address: str | None = None,
+    say: Callable[[str], None] | None = None,
+    progress: Callable[[int, int, dict[str, Any]], None] | None = None,
+    limit: int | None = None,
+) -> StudyRun:
+    """Plan, then walk every trial of ``design`` not yet in ``out`` (resumable, see above).
+
+    Args:
+        design: the study.
+        out: its folder (``trials.parquet``, ``plans/``, ``study.json``).
+        executor, workers, address: where the walks run (:func:`execute`).
+        say: called with a line of text (planning progress).
+        progress: called after each walk with (walks done, walks in the study, the row).
+        limit: run at most this many new walks (then stop as if interrupted; for tests and
+            for spreading a study over several sessions).
+    """
+    execute([], executor, workers, address)  # validates the arguments before any planning
+    out = Path(out)
+    store = TrialStore(out, design)
+    plans = make_plans(design, out / "plans", say)
+    trials = make_trials(design, plans)
+    todo = [t for t in trials if not store.done(t.key)]
+    if limit is not None:
+        todo = todo[:limit]
+    done = len(trials) - len([t for t in trials if not store.done(t.key)])
+    t0 = time.perf_counter()
+    ran = 0
+    try:
+        for row in execute(todo, executor, workers, address):
+            store.add(row)
+            ran += 1
+            if progress:
+                progress(done + ran, len(trials), row)
+    finally:
+        store.close()
+    keys = {t.key for t in trials}
+    rows = [store.rows[k] for k in sorted(store.rows) if k in keys]
+    return StudyRun(rows, plans, len(trials), ran, time.perf_counter() - t0)

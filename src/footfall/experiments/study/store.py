@@ -1,0 +1,153 @@
+"""The study's table on disk: ``DIR/trials.parquet``, one row per trial, written as trials finish.
+
+Finished rows are appended in small Parquet part files (``DIR/trials.parts/part-*.parquet``, each
+written to a temporary name and renamed, so a crash leaves either a whole part or none); closing the
+store merges the parts into ``trials.parquet`` sorted by key and removes them. A rerun reads both, so
+Ctrl-C, a crash or a lost worker loses at most the trials that had not finished. The folder also
+holds ``study.json`` (the design's fingerprint): a folder is reused only by a study whose trials
+compute the same numbers.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from pathlib import Path
+from typing import Any
+
+from footfall.errors import InputError
+from footfall.experiments.study.design import StudyDesign
+from footfall.experiments.study.trials import COLUMNS
+
+TABLE = "trials.parquet"
+PARTS = "trials.parts"
+META = "study.json"
+#: a part file is written after this many rows or ...
+FLUSH_ROWS = 25
+#: ... this many seconds since the last one
+FLUSH_SECONDS = 10.0
+
+
+def _arrow() -> Any:
+    try:
+        import pyarrow
+        import pyarrow.parquet
+    except ImportError:
+        raise InputError(
+            "pyarrow", "not installed", "pip install 'footfall[study]' (the study table is Parquet)"
+        ) from None
+    return pyarrow
+
+
+def schema() -> Any:
+    """The Arrow schema of the table (``trials.COLUMNS``)."""
+    pa = _arrow()
+    kinds = {
+        "string": pa.string(),
+        "int64": pa.int64(),
+        "float64": pa.float64(),
+        "bool": pa.bool_(),
+    }
+    return pa.schema([(name, kinds[kind]) for name, kind in COLUMNS])
+
+
+def read_rows(path: Path) -> list[dict[str, Any]]:
+    """The rows of one Parquet file of this schema (a damaged file is an error naming it)."""
+    pa = _arrow()
+    try:
+        table = pa.parquet.read_table(path)
+    except (OSError, pa.ArrowException) as e:
+        raise InputError("trials file", str(path), f"a readable Parquet table ({e})") from None
+    missing = [n for n, _ in COLUMNS if n not in table.column_names]
+    if missing:
+        raise InputError("trials file", str(path), f"the study columns (missing {missing})")
+    return table.select([n for n, _ in COLUMNS]).to_pylist()
+
+
+def write_rows(path: Path, rows: list[dict[str, Any]]) -> Path:
+    """Write ``rows`` as one Parquet file, atomically (temporary name, then rename)."""
+    pa = _arrow()
+    table = pa.Table.from_pylist(rows, schema=schema())
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    pa.parquet.write_table(table, tmp)
+    os.replace(tmp, path)
+    return path
+
+
+class TrialStore:
+    """The finished rows of a study folder, and the writer of new ones.
+
+    Args:
+        folder: the study's output folder (created).
+        design: the study; a folder holding trials of a study with another fingerprint
+            (:meth:`StudyDesign.fingerprint`) is refused.
+    """
+
+    def __init__(self, folder: Path, design: StudyDesign) -> None:
+        self.folder = Path(folder)
+        self.folder.mkdir(parents=True, exist_ok=True)
+        _arrow()
+        meta = self.folder / META
+        fp = design.fingerprint()
+        if meta.exists():
+            try:
+                old = json.loads(meta.read_text())["fingerprint"]
+            except (OSError, ValueError, KeyError, TypeError):
+                raise InputError(
+                    "study folder", str(meta), "a study.json written by footfall study"
+                ) from None
+            if old != fp:
+                diff = sorted(k for k in set(old) | set(fp) if old.get(k) != fp.get(k))
+                raise InputError(
+                    "--out",
+                    str(self.folder),
+                    f"a folder of this study or a new one: its trials were run with other "
+                    f"{', '.join(diff)} ({', '.join(f'{k}={old.get(k)!r}' for k in diff)})",
+                )
+        meta.write_text(json.dumps({"fingerprint": fp, "design": design.to_dict()}, indent=1))
+        self.parts = self.folder / PARTS
+        self.rows: dict[str, dict[str, Any]] = {}
+        table = self.folder / TABLE
+        if table.exists():
+            for r in read_rows(table):
+                self.rows[r["key"]] = r
+        if self.parts.is_dir():
+            for p in sorted(self.parts.glob("part-*.parquet")):
+                for r in read_rows(p):
+                    self.rows[r["key"]] = r
+        self.pending: list[dict[str, Any]] = []
+        self.flushed_at = time.monotonic()
+        self.n_parts = 0
+
+    def done(self, key: str) -> bool:
+        """Whether the trial ``key`` has a row (errors included: rerun them with a new folder or
+        by deleting their rows; a trial that raises is expected to raise again)."""
+        return key in self.rows
+
+    def add(self, row: dict[str, Any]) -> None:
+        """Keep a finished row; write a part file every ``FLUSH_ROWS`` rows or ``FLUSH_SECONDS``."""
+        self.rows[row["key"]] = row
+        self.pending.append(row)
+        if len(self.pending) >= FLUSH_ROWS or time.monotonic() - self.flushed_at > FLUSH_SECONDS:
+            self.flush()
+
+    def flush(self) -> None:
+        """Write the pending rows as one part file."""
+        if self.pending:
+            self.parts.mkdir(exist_ok=True)
+            name = f"part-{time.time_ns():020d}-{os.getpid()}-{self.n_parts:05d}.parquet"
+            write_rows(self.parts / name, self.pending)
+            self.n_parts += 1
+            self.pending = []
+        self.flushed_at = time.monotonic()
+
+    def close(self) -> Path:
+        """Merge everything into ``trials.parquet`` (sorted by key) and remove the parts."""
+        self.flush()
+        path = write_rows(self.folder / TABLE, [self.rows[k] for k in sorted(self.rows)])
+        if self.parts.is_dir():
+            for p in self.parts.glob("part-*.parquet"):
+                p.unlink()
+            self.parts.rmdir()
+        return path
