@@ -27,7 +27,7 @@ import numpy as np
 from footfall._geometry import rot2
 from footfall._typing import FloatArray
 from footfall._validate import check_fields, finite, finite_vector, non_negative, positive
-from footfall.errors import InputError
+from footfall.errors import InputError, MissingExtraError
 from footfall.models.biped import BipedParams, Side
 from footfall.terrain.heightmap.grid import (
     MAX_CELLS,
@@ -55,11 +55,12 @@ __all__ = [
 
 
 def _require_extra() -> None:
+    """Raise :class:`MissingExtraError` unless the ``terrain`` extra is installed."""
     try:
         import shapely  # noqa: F401
         import skimage  # noqa: F401
     except ImportError as e:
-        raise ImportError(
+        raise MissingExtraError(
             f"height maps need the 'terrain' extra ({e.name} is missing): "
             'pip install "footfall[terrain]"'
         ) from None
@@ -173,13 +174,13 @@ def regions_from_heightmap(
 
     Raises:
         InputError: too many spikes, or no traversable planar region at all.
-        ImportError: the ``terrain`` extra is not installed.
+        MissingExtraError: the ``terrain`` extra is not installed (also an ImportError).
     """
+    _require_extra()
     import shapely
 
     from footfall.terrain.heightmap import polygons, segment
 
-    _require_extra()
     opts = HeightmapOptions() if options is None else options
     if not isinstance(heightmap, HeightMap):
         raise InputError("heightmap", type(heightmap).__name__, "a HeightMap")
