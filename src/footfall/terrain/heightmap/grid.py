@@ -287,8 +287,9 @@ def rasterize_scene(
 
     Each cell takes the height of the highest region containing its centre (regions sharing an
     edge agree there), ``fill`` where none does. The grid spans the regions' bounding box plus
-    ``pad`` on every side; cell edges (not centres) fall on ``min + k * resolution`` so that
-    region edges at round coordinates do not cut through cell centres.
+    ``pad`` on every side; cell edges (not centres) fall on ``min - pad + k * resolution``, so a
+    region edge on that lattice never passes through a cell centre (the known cells then add up
+    to the regions' area exactly).
 
     Args:
         scene: the scene.
