@@ -170,6 +170,16 @@ def test_the_foot_margin_keeps_regions_that_far_inside_the_terrain() -> None:
         assert np.max(home.signed_distance(r.vertices)) <= -(margin - res / 2) + 1e-12
 
 
+def test_terrain_reaching_the_map_edges_is_recovered() -> None:
+    """No unknown border: segments touch the first and last rows and columns."""
+    res = 0.02
+    x, _ = np.meshgrid(res * np.arange(100), res * np.arange(60))
+    heights = np.where(x < 1.0, 0.0, 0.1)  # a 10 cm step at x = 1 m
+    result = regions_from_heightmap(_noisy(HeightMap(heights, res, np.zeros(2))))
+    assert sorted(round(float(r.centroid[2]), 2) for r in result.regions) == [0.0, 0.1]
+    assert sum(r.area for r in result.regions) >= MIN_COVERAGE * heights.size * res**2
+
+
 # ============================================================================= files
 def test_every_file_format_reads_the_same_map(tmp_path: Path) -> None:
     rng = np.random.default_rng(1)

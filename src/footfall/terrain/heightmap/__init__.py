@@ -292,7 +292,10 @@ def _segment_masks(
     for k, box in enumerate(ndimage.find_objects(labels), start=1):
         if box is None:
             continue
-        grow = tuple(slice(max(s.start - 2, 0), s.stop + 2) for s in box)
+        grow = tuple(
+            slice(max(s.start - 2, 0), min(s.stop + 2, n))
+            for s, n in zip(box, labels.shape, strict=True)
+        )
         lab = labels[grow]
         mask = lab == k
         rows, cols = np.mgrid[grow[0], grow[1]]

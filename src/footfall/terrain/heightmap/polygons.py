@@ -8,8 +8,9 @@ and split into convex pieces by recursive cuts: at a reflex vertex, one of its t
 extended into the polygon until it leaves it, cutting the polygon in two (the classic cut that
 removes that reflex angle, exact on rectilinear outlines); of all such cuts the one cutting off
 the smallest part goes first, so a border left jagged by noise is peeled off in thin strips (the
-caller drops pieces too thin for a foot) and the body stays whole. Touching pieces whose union is
-convex are merged at the end. An L gives two pieces.
+caller drops pieces too thin for a foot) and the body stays whole. A part with a hole (an
+occluded patch) is first cut across the hole (no cut from a hole's vertex splits it). Touching
+pieces whose union is convex are merged at the end. An L gives two pieces.
 """
 
 from __future__ import annotations
@@ -135,6 +136,15 @@ def convex_pieces(
             continue
         if _is_convex(p):
             done.append(p)
+            continue
+        if p.interiors:  # no cut from a hole's vertex splits a polygon: cut across the hole
+            hole = max(p.interiors, key=lambda r: shapely.Polygon(r).area)
+            cx = shapely.Polygon(hole).centroid.x
+            y0, y1 = p.bounds[1] - resolution, p.bounds[3] + resolution
+            todo.extend(
+                shapely.simplify(q, 0.0)
+                for q in _split(p, shapely.LineString([(cx, y0), (cx, y1)]))
+            )
             continue
         # the shortest cuts are tried (a cut off a notch is short), the smallest part wins
         lines = [_cut_line(p, o, d, span) for o, d in _reflex_rays(p)]

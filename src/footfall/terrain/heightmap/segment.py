@@ -34,6 +34,11 @@ from footfall._typing import FloatArray
 MIN_WINDOW_FILL = 0.5
 #: most refits of a plane while growing it from its seed (it usually settles in 3-6)
 GROW_ITERATIONS = 30
+#: two planes (or segments) merge when the RMS distance of each one's smoothed heights from the
+#: plane fitted to both is at most this fraction of ``plane_tolerance``: one surface split in two
+#: gives the smoothed noise (~``window`` times below the raw noise), while a flight of stairs
+#: against the ramp it approximates gives riser / sqrt(12) (1.7 cm for 6 cm risers)
+MERGE_FRACTION = 1.0 / 3.0
 #: seeds tried for each plane of a component (the one growing largest is kept)
 SEEDS_PER_PLANE = 6
 #: most planes looked for in one connected component
@@ -209,6 +214,26 @@ def _assign(
     return out
 
 
+def _fits_both(
+    plane: FloatArray,
+    a: np.ndarray,
+    b: np.ndarray,
+    x: FloatArray,
+    y: FloatArray,
+    zs: FloatArray,
+    rms_max: float,
+) -> bool:
+    """Whether the cells of ``a`` and, separately, of ``b`` lie within ``rms_max`` (RMS) of
+    ``plane``: each side on its own, so a small set is not outvoted by a large one."""
+    for cells in (a, b):
+        if not cells.any():
+            return False
+        dev = zs[cells] - plane_height(plane, x[cells], y[cells])
+        if np.sqrt(np.mean(dev**2)) > rms_max:
+            return False
+    return True
+
+
 def _settle(
     comp: np.ndarray,
     planes: list[FloatArray],
@@ -221,7 +246,7 @@ def _settle(
 ) -> list[FloatArray]:
     """k-planes on one component: nearest plane per cell and refit until the assignment settles
     (boundaries move to where planes cross); planes whose cells together fit one plane within
-    ``tol`` are merged (greedy seeding can split one surface between two near-equal planes)."""
+    ``MERGE_FRACTION * tol`` (RMS) are merged (greedy seeding can split one surface between two near-equal planes)."""
     prev = None
     for _ in range(KPLANES_ITERATIONS):
         idx = _assign(comp, planes, x, y, zs, tol)
@@ -236,7 +261,7 @@ def _settle(
                 for b in range(a + 1, len(sets)):
                     both = sets[a] | sets[b]
                     p = fit_plane(x[both], y[both], z[both])
-                    if np.max(np.abs(zs[both] - plane_height(p, x[both], y[both]))) <= tol:
+                    if _fits_both(p, sets[a], sets[b], x, y, zs, MERGE_FRACTION * tol):
                         sets[a] = both
                         del sets[b]
                         merged = True
@@ -315,8 +340,8 @@ def _merge_adjacent(
     smooth: np.ndarray,
     tol: float,
 ) -> np.ndarray:
-    """Merge touching segments whose cells together fit one plane within ``tol`` (smoothed
-    heights of smooth cells), smallest first; return labels renumbered 1..K.
+    """Merge touching segments whose cells together fit one plane within ``MERGE_FRACTION *
+    tol`` (RMS, smoothed heights of smooth cells), smallest first; return labels renumbered 1..K.
 
     A pocket of smooth cells fenced off by noisy ones forms its own small component and plane;
     once the rims have grown, it touches the surface it belongs to and joins it here."""
@@ -333,8 +358,9 @@ def _merge_adjacent(
         for a, b in sorted(pairs, key=lambda ab: min(size[ab[0]], size[ab[1]])):
             both = (labels == a) | (labels == b)
             p = fit_plane(x[both], y[both], z[both])
-            use = both & smooth
-            if np.max(np.abs(zs[use] - plane_height(p, x[use], y[use])), initial=0.0) <= tol:
+            if _fits_both(
+                p, (labels == a) & smooth, (labels == b) & smooth, x, y, zs, MERGE_FRACTION * tol
+            ):
                 labels = np.where(labels == b, a, labels)
                 merged = True
                 break
