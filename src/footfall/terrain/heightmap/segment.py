@@ -8,7 +8,7 @@
    components, but a crease (a floor meeting a ramp) does not.
 3. **Planes per component.** Greedy: a few smooth cells deep inside what is left, spread apart,
    each seed a plane (their local fit); a plane is grown over the connected cells whose smoothed
-   height lies within ``plane_tolerance`` and refitted until it settles; the plane that grows
+   height lies within ``SMOOTH_FRACTION * plane_tolerance`` and refitted until it settles; the plane that grows
    largest is kept (as in RANSAC, a seed on a crease gives a compromise plane that stays small),
    its cells are removed and the next round starts. Then every smooth cell goes to the nearest plane (k-planes), which puts the boundary
    between a floor and a ramp on the line where their planes meet, and planes are refitted.
@@ -34,11 +34,12 @@ from footfall._typing import FloatArray
 MIN_WINDOW_FILL = 0.5
 #: most refits of a plane while growing it from its seed (it usually settles in 3-6)
 GROW_ITERATIONS = 30
-#: two planes (or segments) merge when the RMS distance of each one's smoothed heights from the
-#: plane fitted to both is at most this fraction of ``plane_tolerance``: one surface split in two
-#: gives the smoothed noise (~``window`` times below the raw noise), while a flight of stairs
-#: against the ramp it approximates gives riser / sqrt(12) (1.7 cm for 6 cm risers)
-MERGE_FRACTION = 1.0 / 3.0
+#: smoothed heights are ~``window`` times less noisy than raw ones, so they are held to this
+#: fraction of ``plane_tolerance``: a plane grows over cells whose smoothed height is that close,
+#: and two planes (or segments) merge when the RMS distance of each one's smoothed heights from
+#: the plane fitted to both is that small. At the full tolerance a plane through a flight of
+#: stairs (every tread within riser / 2 of it) would outgrow each tread's own plane.
+SMOOTH_FRACTION = 1.0 / 3.0
 #: seeds tried for each plane of a component (the one growing largest is kept)
 SEEDS_PER_PLANE = 6
 #: most planes looked for in one connected component
@@ -185,7 +186,7 @@ def _component_planes(
         best: tuple[np.ndarray, FloatArray] | None = None
         for seed in _seeds(free, SEEDS_PER_PLANE, spacing):
             plane = np.array([zs[seed], fit.grad[0][seed], fit.grad[1][seed], x[seed], y[seed]])
-            region, plane = _grow_plane(seed, plane, free, x, y, zs, z, tol)
+            region, plane = _grow_plane(seed, plane, free, x, y, zs, z, SMOOTH_FRACTION * tol)
             if best is None or region.sum() > best[0].sum():
                 best = (region, plane)
         if best is None:
@@ -246,7 +247,7 @@ def _settle(
 ) -> list[FloatArray]:
     """k-planes on one component: nearest plane per cell and refit until the assignment settles
     (boundaries move to where planes cross); planes whose cells together fit one plane within
-    ``MERGE_FRACTION * tol`` (RMS) are merged (greedy seeding can split one surface between two near-equal planes)."""
+    ``SMOOTH_FRACTION * tol`` (RMS) are merged (greedy seeding can split one surface between two near-equal planes)."""
     prev = None
     for _ in range(KPLANES_ITERATIONS):
         idx = _assign(comp, planes, x, y, zs, tol)
@@ -261,7 +262,7 @@ def _settle(
                 for b in range(a + 1, len(sets)):
                     both = sets[a] | sets[b]
                     p = fit_plane(x[both], y[both], z[both])
-                    if _fits_both(p, sets[a], sets[b], x, y, zs, MERGE_FRACTION * tol):
+                    if _fits_both(p, sets[a], sets[b], x, y, zs, SMOOTH_FRACTION * tol):
                         sets[a] = both
                         del sets[b]
                         merged = True
@@ -340,7 +341,7 @@ def _merge_adjacent(
     smooth: np.ndarray,
     tol: float,
 ) -> np.ndarray:
-    """Merge touching segments whose cells together fit one plane within ``MERGE_FRACTION *
+    """Merge touching segments whose cells together fit one plane within ``SMOOTH_FRACTION *
     tol`` (RMS, smoothed heights of smooth cells), smallest first; return labels renumbered 1..K.
 
     A pocket of smooth cells fenced off by noisy ones forms its own small component and plane;
@@ -359,7 +360,7 @@ def _merge_adjacent(
             both = (labels == a) | (labels == b)
             p = fit_plane(x[both], y[both], z[both])
             if _fits_both(
-                p, (labels == a) & smooth, (labels == b) & smooth, x, y, zs, MERGE_FRACTION * tol
+                p, (labels == a) & smooth, (labels == b) & smooth, x, y, zs, SMOOTH_FRACTION * tol
             ):
                 labels = np.where(labels == b, a, labels)
                 merged = True
