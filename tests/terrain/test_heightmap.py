@@ -9,6 +9,7 @@ free raster of the original scene.
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -317,3 +318,13 @@ def test_a_start_off_the_recovered_terrain_is_an_input_error() -> None:
     assert scene.terrain.locate(scene.start.left, 1e-6) and scene.terrain.locate(
         scene.start.right, 1e-6
     )
+
+
+def test_without_the_terrain_extra_the_error_names_it(monkeypatch: pytest.MonkeyPatch) -> None:
+    from footfall.errors import MissingExtraError
+
+    monkeypatch.setitem(sys.modules, "shapely", None)  # import shapely now raises ImportError
+    hm = rasterize_scene(builtin_scene("flat"), 0.05)
+    with pytest.raises(MissingExtraError, match=r"footfall\[terrain\]"):
+        regions_from_heightmap(hm)
+    assert issubclass(MissingExtraError, ImportError)

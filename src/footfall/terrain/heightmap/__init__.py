@@ -183,29 +183,17 @@ def regions_from_heightmap(
         MissingExtraError: the ``terrain`` extra is not installed (also an ImportError).
     """
     _require_extra()
-    import shapely
-
-    from footfall.terrain.heightmap import polygons, segment
+    from footfall.terrain.heightmap import segment
 
     opts = HeightmapOptions() if options is None else options
     if not isinstance(heightmap, HeightMap):
         raise InputError("heightmap", type(heightmap).__name__, "a HeightMap")
     res = heightmap.resolution
     z = np.array(heightmap.heights)
-    spikes = _spikes(z, opts.spike_height)
-    n_known = int(np.count_nonzero(~np.isnan(z)))
-    if spikes.sum() > opts.max_spike_fraction * n_known:
-        i, j = np.argwhere(spikes)[0]
-        raise InputError(
-            "heights",
-            f"{int(spikes.sum())} spike cells of {n_known} (e.g. [{i}, {j}] = {z[i, j]:g} m)",
-            f"at most {opts.max_spike_fraction:.0%} cells more than {opts.spike_height} m away "
-            "from all their neighbours (raise --max-spikes or filter the map)",
-        )
+    spikes = _checked_spikes(z, opts)
     z[spikes] = np.nan
     # fit in coordinates relative to the map's median height (no cancellation far from z = 0)
     z_ref = float(np.nanmedian(z))
-    min_cells = max(3, math.ceil(opts.min_area / res**2))
     seg = segment.segment(
         z - z_ref,
         res,
@@ -213,31 +201,10 @@ def regions_from_heightmap(
         max_slope_deg=opts.max_slope_deg,
         roughness=opts.roughness,
         plane_tolerance=opts.plane_tolerance,
-        min_cells=min_cells,
+        min_cells=max(3, math.ceil(opts.min_area / res**2)),
     )
     labels = _tidy_labels(seg.labels)
-    gx, gy = heightmap.cell_centres()
-    regions: list[Region] = []
-    owner: list[int] = []
-    for k, box, mask in _segment_masks(labels, seg.planes, z - z_ref, res, opts.plane_tolerance):
-        sub_origin = np.array([gx[box][0, 0], gy[box][0, 0]])
-        outline = polygons.cells_outline(mask, res, sub_origin)
-        cells = (labels[box] == k) & ~np.isnan(z[box])
-        cxy = np.column_stack([gx[box][cells], gy[box][cells]])
-        cz = z[box][cells]
-        for part in polygons.clean_outline(outline, res, opts.margin, opts.min_area):
-            for piece in polygons.convex_pieces(part, res, opts.min_area, opts.min_width):
-                if piece.area < opts.min_area or polygons.width(piece) < opts.min_width:
-                    continue
-                # the segment's cells in and around the piece: a thin strip alone pins its tilt
-                # across its width poorly, and the segment is one plane within tolerance anyway
-                halo = shapely.buffer(piece, PLANE_HALO_WINDOWS * opts.window * res)
-                near = shapely.contains_xy(halo, cxy[:, 0], cxy[:, 1])
-                normal, offset = _piece_plane(cxy[near], cz[near])
-                if normal[2] < math.cos(math.radians(opts.max_slope_deg)):
-                    continue
-                regions.append(Region(f"s{k}", normal, offset, polygons.ccw_vertices(piece)))
-                owner.append(k)
+    regions, owner = _convex_regions(heightmap, z, labels, seg.planes, z_ref, opts)
     if not regions:
         raise InputError(
             "heights",
@@ -259,6 +226,60 @@ def regions_from_heightmap(
         spikes=spikes,
         options=opts,
     )
+
+
+def _checked_spikes(z: FloatArray, opts: HeightmapOptions) -> np.ndarray:
+    """The spike cells of ``z``; :class:`InputError` when more than the options allow."""
+    spikes = _spikes(z, opts.spike_height)
+    n_known = int(np.count_nonzero(~np.isnan(z)))
+    if spikes.sum() > opts.max_spike_fraction * n_known:
+        i, j = np.argwhere(spikes)[0]
+        raise InputError(
+            "heights",
+            f"{int(spikes.sum())} spike cells of {n_known} (e.g. [{i}, {j}] = {z[i, j]:g} m)",
+            f"at most {opts.max_spike_fraction:.0%} cells more than {opts.spike_height} m away "
+            "from all their neighbours (raise --max-spikes or filter the map)",
+        )
+    return spikes
+
+
+def _convex_regions(
+    heightmap: HeightMap,
+    z: FloatArray,
+    labels: np.ndarray,
+    planes: FloatArray,
+    z_ref: float,
+    opts: HeightmapOptions,
+) -> tuple[list[Region], list[int]]:
+    """Convex regions of every segment (module doc, steps 3-4) and the segment of each."""
+    import shapely
+
+    from footfall.terrain.heightmap import polygons
+
+    res = heightmap.resolution
+    gx, gy = heightmap.cell_centres()
+    regions: list[Region] = []
+    owner: list[int] = []
+    for k, box, mask in _segment_masks(labels, planes, z - z_ref, res, opts.plane_tolerance):
+        sub_origin = np.array([gx[box][0, 0], gy[box][0, 0]])
+        outline = polygons.cells_outline(mask, res, sub_origin)
+        cells = (labels[box] == k) & ~np.isnan(z[box])
+        cxy = np.column_stack([gx[box][cells], gy[box][cells]])
+        cz = z[box][cells]
+        for part in polygons.clean_outline(outline, res, opts.margin, opts.min_area):
+            for piece in polygons.convex_pieces(part, res, opts.min_area, opts.min_width):
+                if piece.area < opts.min_area or polygons.width(piece) < opts.min_width:
+                    continue
+                # the segment's cells in and around the piece: a thin strip alone pins its tilt
+                # across its width poorly, and the segment is one plane within tolerance anyway
+                halo = shapely.buffer(piece, PLANE_HALO_WINDOWS * opts.window * res)
+                near = shapely.contains_xy(halo, cxy[:, 0], cxy[:, 1])
+                normal, offset = _piece_plane(cxy[near], cz[near])
+                if normal[2] < math.cos(math.radians(opts.max_slope_deg)):
+                    continue
+                regions.append(Region(f"s{k}", normal, offset, polygons.ccw_vertices(piece)))
+                owner.append(k)
+    return regions, owner
 
 
 def _tidy_labels(labels: np.ndarray) -> np.ndarray:

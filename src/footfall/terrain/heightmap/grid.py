@@ -199,7 +199,7 @@ def _read_png(
             if im.mode not in _PNG16_MODES:
                 raise InputError("map", f"a PNG in mode {im.mode}", "a 16-bit greyscale PNG")
             counts = np.array(im, dtype=np.int64)
-    except (UnidentifiedImageError, OSError, SyntaxError) as e:
+    except (UnidentifiedImageError, Image.DecompressionBombError, OSError, SyntaxError) as e:
         raise InputError("map", str(path), f"a readable 16-bit PNG ({e})") from None
     z = counts.astype(np.float64) * scale + height_offset
     if nodata is not None:
