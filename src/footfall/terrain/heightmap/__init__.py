@@ -6,8 +6,10 @@ Pipeline (:func:`regions_from_heightmap`):
    unknown; too many is an error;
 2. local plane fit and slope / roughness filter, plane extraction and growth into planar
    segments (:mod:`.segment`);
-3. per segment: its outline along cell edges, one-cell gaps closed, simplified, eroded by the
-   foot margin, split into convex pieces (:mod:`.polygons`);
+3. per segment: one-cell bumps opened, one-cell gaps and two-cell notches whose heights fit its
+   plane closed, its outline along cell edges simplified, eroded by the foot margin and split
+   into convex pieces (:mod:`.polygons`), pieces smaller than ``min_area`` or thinner than
+   ``min_width`` dropped;
 4. per convex piece: the least-squares plane (eq. 5.15) of the segment's cells inside it or
    within ``PLANE_HALO_WINDOWS`` fit windows of it.
 

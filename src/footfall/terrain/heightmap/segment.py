@@ -8,13 +8,17 @@
    components, but a crease (a floor meeting a ramp) does not.
 3. **Planes per component.** Greedy: a few smooth cells deep inside what is left, spread apart,
    each seed a plane (their local fit); a plane is grown over the connected cells whose smoothed
-   height lies within ``SMOOTH_FRACTION * plane_tolerance`` and refitted until it settles; the plane that grows
-   largest is kept (as in RANSAC, a seed on a crease gives a compromise plane that stays small),
-   its cells are removed and the next round starts. Then every smooth cell goes to the nearest plane (k-planes), which puts the boundary
-   between a floor and a ramp on the line where their planes meet, and planes are refitted.
+   height lies within ``SMOOTH_FRACTION * plane_tolerance`` and refitted until it settles; the
+   plane that grows largest is kept (as in RANSAC, a seed on a crease gives a compromise plane
+   that stays small), its cells are removed and the next round starts. Then every smooth cell
+   goes to the nearest plane (k-planes) and planes are refitted until that settles, which puts
+   the border between a floor and a ramp on the line where their planes meet; planes that fit
+   one plane together are merged.
 4. **Growth.** Labels expand one cell at a time into the remaining known cells (the rims along
    step edges that the local fit rejected) while the cell's own height is within
    ``plane_tolerance`` of the label's plane: a cell is traversable when it lies on its plane.
+   Touching segments that fit one plane together are merged (a pocket of smooth cells fenced off
+   by noisy ones).
 
 Smoothed heights (the local fit's value at the cell) are used to decide membership inside smooth
 areas, where they are ``w`` times less noisy than raw heights; raw heights decide the rims, where
