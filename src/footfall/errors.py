@@ -63,3 +63,8 @@ class SolverError(FootfallError):
 
 class SolverUnavailableError(FootfallError):
     """A requested solver backend is not installed; the message says what to install."""
+
+
+class MissingExtraError(FootfallError, ImportError):
+    """An optional dependency group (a pip extra) is not installed; the message names it and the
+    command that installs it."""

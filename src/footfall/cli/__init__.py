@@ -1,8 +1,9 @@
 """The ``footfall`` command line.
 
 Every command that computes something writes JSON and a figure into ``--out``. The commands live
-by subject in :mod:`.planning`, :mod:`.simulation` and :mod:`.bench`; :func:`main` turns errors into
-one line and an exit code (:func:`main` lists them) and ends worker processes on SIGINT / SIGTERM.
+by subject in :mod:`.planning`, :mod:`.simulation`, :mod:`.bench` and :mod:`.terrain`;
+:func:`main` turns errors into one line and an exit code (:func:`main` lists them) and ends worker
+processes on SIGINT / SIGTERM.
 """
 
 from __future__ import annotations
@@ -77,6 +78,6 @@ def main() -> None:
 
 
 # the command modules register their commands on ``app`` when imported
-from footfall.cli import bench, planning, simulation, study  # noqa: E402
+from footfall.cli import bench, planning, simulation, study, terrain  # noqa: E402
 
-__all__ = ["app", "bench", "main", "planning", "simulation", "study"]
+__all__ = ["app", "bench", "main", "planning", "simulation", "study", "terrain"]

@@ -1,6 +1,7 @@
 """Terrain: convex planar regions (document 000, eq. 5.15-5.18), scenes, YAML files, built-ins.
 
-The scene file schema is in ``SCHEMA.md`` next to this file.
+The scene file schema is in ``SCHEMA.md`` next to this file. Scenes from a robot's height map:
+:mod:`footfall.terrain.heightmap` (needs the ``terrain`` extra).
 """
 
 from footfall.terrain.edges import inset_riser_edges, riser_edge_insets
