@@ -36,7 +36,7 @@ STEP_MODES = ("smallest", "equal")
 #: controllers of the MuJoCo walker (``WalkOptions.controller``)
 CONTROLLERS = ("wbc", "servo")
 #: the studies that ship with footfall (``footfall study --builtin NAME``)
-BUILTIN_STUDIES = ("section55", "quick")
+BUILTIN_STUDIES = ("section55", "section55_reduced", "quick")
 #: largest study file accepted [bytes]
 MAX_STUDY_BYTES = 100_000
 #: most trials one study may declare (a typo like ``seeds: 2000000`` is refused, not queued)
