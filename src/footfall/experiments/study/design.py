@@ -255,7 +255,7 @@ def study_from_dict(data: object, source: str = "study") -> StudyDesign:
     """Validate plain data (a parsed study file) into a :class:`StudyDesign`."""
     if not isinstance(data, dict):
         raise InputError(source, type(data).__name__, "a mapping of study fields")
-    unknown = sorted(str(k) for k in data if k not in _FIELDS)
+    unknown = sorted((k for k in data if k not in _FIELDS), key=str)
     if unknown:
         raise InputError(
             f"{source}: {unknown[0]}",

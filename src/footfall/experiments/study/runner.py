@@ -291,6 +291,11 @@ def run_study(
     store = TrialStore(out, design)
     plans = make_plans(design, out / "plans", say)
     trials = make_trials(design, plans)
+    for t in trials:  # a walk run by an earlier study may serve a step mode added since
+        r = store.rows.get(t.key)
+        if r is not None and (t.smallest_n > r["smallest_n"] or t.equal_n > r["equal_n"]):
+            smallest, equal = r["smallest_n"] or t.smallest_n, r["equal_n"] or t.equal_n
+            store.add(r | {"smallest_n": smallest, "equal_n": equal})
     todo = [t for t in trials if not store.done(t.key)]
     if limit is not None:
         todo = todo[:limit]

@@ -147,7 +147,8 @@ class TrialStore:
         self.flush()
         path = write_rows(self.folder / TABLE, [self.rows[k] for k in sorted(self.rows)])
         if self.parts.is_dir():
-            for p in self.parts.glob("part-*.parquet"):
+            # the parts and any temporary file a crash left mid-write (.part-*.tmp)
+            for p in [*self.parts.glob("part-*.parquet"), *self.parts.glob(".part-*.tmp")]:
                 p.unlink()
             self.parts.rmdir()
         return path

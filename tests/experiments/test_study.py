@@ -1,0 +1,594 @@
+"""`footfall study` (issue 25) without walking: the design file, the paired disturbance, the
+statistics against hand values and scipy used directly, and the Parquet store."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+from scipy import stats as sps
+
+from footfall.errors import InputError
+from footfall.experiments.study import (
+    BUILTIN_STUDIES,
+    COLUMNS,
+    Disturbance,
+    StudyDesign,
+    builtin_study,
+    load_study,
+    parse_study,
+)
+from footfall.experiments.study import stats as st
+from footfall.experiments.study import store as store_mod
+from footfall.experiments.study.design import (
+    MAX_TRIALS,
+    PUSH_PHASE_WINDOW,
+    PUSH_STEP_WINDOW,
+    study_from_dict,
+)
+from footfall.experiments.study.store import TrialStore
+from footfall.experiments.study.trials import normalise_row
+
+Z95 = 1.959963984540054  # standard normal quantile at 0.975
+
+# ---------------------------------------------------------------------------------------------
+# design
+
+
+def _reduced(**kw: Any) -> dict[str, Any]:
+    base: dict[str, Any] = {
+        "name": "t",
+        "simulator": "reduced",
+        "scenes": ["flat"],
+        "planners": ["miqcqp", "reactive"],
+        "steps": ["smallest"],
+        "seeds": 2,
+        "push_levels": [],
+        "level_seeds": 0,
+    }
+    return base | kw
+
+
+@pytest.mark.parametrize("name", BUILTIN_STUDIES)
+def test_builtin_studies_load(name: str) -> None:
+    d = builtin_study(name)
+    assert d.name == name
+    assert d.max_trials() > 0
+    assert {"quick", "section55"} <= set(BUILTIN_STUDIES)
+
+
+def test_builtin_study_values() -> None:
+    quick, s55 = builtin_study("quick"), builtin_study("section55")
+    assert quick.simulator == "reduced" and quick.controller is None
+    assert s55.simulator == "mujoco" and s55.controller == "wbc"
+    assert s55.seeds == 200 and s55.level_steps == ("smallest",)
+    with pytest.raises(InputError) as e:
+        builtin_study("nope")
+    assert e.value.field == "study"
+
+
+@pytest.mark.parametrize(
+    ("data", "field"),
+    [
+        ({"simulator": "x"}, "simulator"),
+        ({"controller": "wbc"}, "controller"),
+        ({"simulator": "mujoco", "noise_pos": 0.01}, "noise_pos"),
+        ({"simulator": "mujoco", "placement_error": 0.01}, "placement_error"),
+        ({"default_push": -1.0}, "default_push"),
+        ({"planners": ["miqcqp", "miqcqp"]}, "planners[1]"),
+        ({"planners": ["astar"]}, "planners[0]"),
+        ({"scenes": ["no_such_scene"]}, "scenes[0]"),
+        ({"level_steps": ["equal"]}, "level_steps[0]"),
+        ({"seeds": 0}, "seeds"),
+        ({"seeds": True}, "seeds"),
+        ({"push_levels": [1.0, 1.0], "level_seeds": 1}, "push_levels"),
+        ({"push_levels": [2.0], "level_seeds": 0}, "level_seeds"),
+        ({"push_duration": 0.0}, "push_duration"),
+        ({"time_limit": float("nan")}, "time_limit"),
+        ({"seeds": 10**7}, "seeds"),
+    ],
+)
+def test_bad_values_name_their_field(data: dict[str, Any], field: str) -> None:
+    with pytest.raises(InputError) as e:
+        study_from_dict(_reduced(**data))
+    assert e.value.field == field
+
+
+def test_unknown_key_and_missing_name_are_refused() -> None:
+    with pytest.raises(InputError) as e:
+        parse_study(yaml.safe_dump(_reduced(colour="red")), "s.yaml")
+    assert "colour" in e.value.field
+    data = _reduced()
+    del data["name"]
+    with pytest.raises(InputError) as e:
+        parse_study(yaml.safe_dump(data), "s.yaml")
+    assert "name" in e.value.field
+
+
+def test_a_non_text_key_is_an_input_error() -> None:
+    # YAML keys may be numbers; the error must still be an InputError naming the key
+    with pytest.raises(InputError) as e:
+        parse_study("name: a\nsimulator: reduced\n1: 2\n", "s.yaml")
+    assert "1" in e.value.field
+
+
+def test_a_huge_study_is_refused_before_anything_runs() -> None:
+    per_seed = 3  # miqcqp, kinematic and reactive, one scene, one step mode, one impulse
+    seeds = MAX_TRIALS // per_seed + 1
+    with pytest.raises(InputError) as e:
+        StudyDesign(
+            name="big",
+            simulator="reduced",
+            controller=None,
+            scenes=("flat",),
+            planners=("miqcqp", "kinematic", "reactive"),
+            steps=("smallest",),
+            seeds=seeds,
+            push_levels=(),
+            level_seeds=0,
+        )
+    assert e.value.field == "seeds"
+    # one seed fewer fits exactly
+    ok = StudyDesign(
+        name="big",
+        simulator="reduced",
+        controller=None,
+        scenes=("flat",),
+        planners=("miqcqp", "kinematic", "reactive"),
+        steps=("smallest",),
+        seeds=MAX_TRIALS // per_seed,
+        push_levels=(),
+        level_seeds=0,
+    )
+    assert ok.max_trials() == per_seed * (MAX_TRIALS // per_seed)
+
+
+def test_yaml_with_a_python_tag_is_refused_and_runs_nothing(tmp_path: Path) -> None:
+    marker = tmp_path / "ran"
+    text = f'name: !!python/object/apply:os.system ["touch {marker}"]\nsimulator: reduced\n'
+    f = tmp_path / "evil.yaml"
+    f.write_text(text)
+    with pytest.raises(InputError):
+        load_study(f)
+    with pytest.raises(InputError):
+        parse_study(text)
+    assert not marker.exists()
+
+
+def test_load_study_refuses_missing_file_folder_and_bad_yaml(tmp_path: Path) -> None:
+    with pytest.raises(InputError) as e:
+        load_study(tmp_path / "missing.yaml")
+    assert e.value.field == "study file"
+    with pytest.raises(InputError) as e:
+        load_study(tmp_path)
+    assert e.value.field == "study file"
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: [unclosed\n")
+    with pytest.raises(InputError):
+        load_study(bad)
+    good = tmp_path / "good.yaml"
+    good.write_text(yaml.safe_dump(_reduced()))
+    d = load_study(good)
+    assert d.controller is None and d.planners == ("miqcqp", "reactive")
+
+
+def test_max_trials_hand_counted() -> None:
+    d = StudyDesign(
+        name="count",
+        simulator="reduced",
+        controller=None,
+        scenes=("flat", "discrete_steps"),
+        planners=("miqcqp", "kinematic", "reactive"),
+        steps=("smallest", "equal"),
+        default_push=3.0,
+        seeds=5,
+        push_levels=(0.0, 3.0, 6.0),
+        level_seeds=2,
+        level_steps=("smallest",),
+    )
+    # per scene, impulses 3 (default), 0, 6:
+    #   horizon planners (2) x [3 N s: 5 smallest + 5 equal; 0 and 6 N s: 2 smallest each] = 28
+    #   reactive: 5 + 2 + 2 = 9
+    assert d.max_trials() == 2 * (2 * (5 + 5 + 2 + 2) + 9) == 74
+    assert d.impulses() == (3.0, 0.0, 6.0)
+    assert list(d.seeds_at(0.0, "equal")) == []
+    assert list(d.seeds_at(6.0, "smallest")) == [0, 1]
+    assert list(d.seeds_at(6.0, "goal")) == [0, 1]
+    # without level_steps the equal mode is walked at every level too
+    e = replace(d, level_steps=None)
+    assert e.level_steps == ("smallest", "equal")
+    assert e.max_trials() == 2 * (2 * (5 + 5 + 2 + 2 + 2 + 2) + 9) == 90
+
+
+# ---------------------------------------------------------------------------------------------
+# disturbance
+
+
+def test_disturbance_is_a_pure_function_of_the_seed() -> None:
+    ds = [Disturbance.of_seed(s) for s in range(40)]
+    assert Disturbance.of_seed(7) == ds[7]
+    assert Disturbance.of_seed(np.int64(7)) == ds[7]
+    assert len({(d.step_fraction, d.phase, d.direction) for d in ds}) == 40
+    for s, d in enumerate(ds):
+        assert d.seed == s
+        assert PUSH_STEP_WINDOW[0] <= d.step_fraction <= PUSH_STEP_WINDOW[1]
+        assert PUSH_PHASE_WINDOW[0] <= d.phase <= PUSH_PHASE_WINDOW[1]
+        assert 0.0 <= d.direction < 2 * math.pi
+        assert 0.0 <= d.initial_direction < 2 * math.pi
+        for n in (1, 2, 7, 11, 40):
+            k = d.push_step(n)
+            assert 0 <= k <= n - 1
+            assert k == min(n - 1, math.floor(d.step_fraction * n))
+    # directions cover the circle, not a corner of it
+    assert np.ptp([d.direction for d in ds]) > math.pi
+    for bad in (-1, 1.5, True):
+        with pytest.raises(InputError):
+            Disturbance.of_seed(bad)  # type: ignore[arg-type]
+
+
+# ---------------------------------------------------------------------------------------------
+# statistics
+
+
+def _wilson_ref(k: int, n: int, z: float = Z95) -> tuple[float, float]:
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z / (1 + z * z / n) * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
+    return centre - half, centre + half
+
+
+@pytest.mark.parametrize(("k", "n"), [(45, 50), (1, 3), (7, 10), (50, 50), (3, 200)])
+def test_wilson_matches_the_closed_form(k: int, n: int) -> None:
+    lo, hi = st.wilson(k, n)
+    rlo, rhi = _wilson_ref(k, n)
+    assert lo == pytest.approx(max(0.0, rlo), abs=1e-12)
+    assert hi == pytest.approx(min(1.0, rhi), abs=1e-12)
+
+
+def test_wilson_published_value_and_edges() -> None:
+    lo, hi = st.wilson(45, 50)
+    assert lo == pytest.approx(0.786, abs=5e-4) and hi == pytest.approx(0.957, abs=5e-4)
+    lo0, hi0 = st.wilson(0, 20)
+    assert lo0 == pytest.approx(0.0, abs=1e-12) and 0 < hi0 < 0.2
+    assert hi0 == pytest.approx(Z95**2 / (20 + Z95**2), rel=1e-12)
+    assert all(math.isnan(x) for x in st.wilson(0, 0))
+    # a 99 % interval is wider
+    lo99, hi99 = st.wilson(45, 50, level=0.99)
+    assert lo99 < lo and hi99 > hi
+
+
+def _binom_two_sided(a: int, b: int) -> float:
+    n = a + b
+    tail = sum(math.comb(n, i) for i in range(min(a, b) + 1)) / 2**n
+    return min(1.0, 2 * tail)
+
+
+@pytest.mark.parametrize(("a", "b"), [(1, 9), (0, 6), (3, 12), (5, 5), (9, 1), (0, 0), (2, 1)])
+def test_mcnemar_is_the_exact_binomial_test(a: int, b: int) -> None:
+    p = st.mcnemar_p(a, b)
+    assert p == pytest.approx(_binom_two_sided(a, b), rel=1e-12)
+    if a + b:
+        assert p == pytest.approx(sps.binomtest(a, a + b, 0.5).pvalue, rel=1e-12)
+    assert st.mcnemar_p(1, 9) == pytest.approx(22 / 1024)
+
+
+def test_mean_ci() -> None:
+    x = [0.011, 0.013, 0.012, 0.020, 0.009, 0.015, 0.010, 0.014]
+    m, lo, hi = st.mean_ci(x)
+    assert m == pytest.approx(math.fsum(x) / len(x), rel=1e-14)
+    assert min(x) <= lo < m < hi <= max(x)
+    # roughly the t interval's width (BCa of a well-behaved sample)
+    t_half = sps.t.ppf(0.975, len(x) - 1) * np.std(x, ddof=1) / math.sqrt(len(x))
+    assert 0.4 * t_half < (hi - lo) / 2 < 1.5 * t_half
+    assert st.mean_ci(x) == (m, lo, hi)  # fixed bootstrap seed: reproducible
+    assert st.mean_ci([0.02, 0.02, 0.02]) == (0.02, 0.02, 0.02)
+    m1, lo1, hi1 = st.mean_ci([0.5])
+    assert m1 == 0.5 and math.isnan(lo1) and math.isnan(hi1)
+    assert all(math.isnan(v) for v in st.mean_ci([]))
+    # non-finite values and None are left out
+    assert st.mean_ci([1.0, math.nan, None, 3.0, math.inf])[0] == 2.0  # type: ignore[list-item]
+
+
+def test_wilcoxon_p_matches_scipy() -> None:
+    d = [-0.003, -0.001, 0.0005, -0.004, -0.002, -0.0025, 0.001, -0.0035]
+    assert st.wilcoxon_p(d) == pytest.approx(sps.wilcoxon(d).pvalue, rel=1e-12)
+    assert st.wilcoxon_p([0.0, 0.0]) == 1.0
+    assert math.isnan(st.wilcoxon_p([]))
+
+
+def _row(
+    planner: str,
+    seed: int,
+    success: bool,
+    zmp: float,
+    *,
+    scene: str = "s",
+    impulse: float = 3.0,
+    smallest: bool = True,
+    equal: bool = False,
+    error: str | None = None,
+    n_steps: int = 7,
+) -> dict[str, Any]:
+    return normalise_row(
+        {
+            "key": f"{scene}|{planner}|N={n_steps}|J={impulse:g}|seed={seed}|{smallest}{equal}",
+            "scene": scene,
+            "planner": planner,
+            "n_steps": n_steps,
+            "smallest_n": smallest,
+            "equal_n": equal,
+            "push_impulse": impulse,
+            "seed": seed,
+            "simulator": "reduced",
+            "success": None if error else success,
+            "fell": None if error else not success,
+            "zmp_offset_mean": None if error else zmp,
+            "zmp_offset_max": None if error else 2 * zmp,
+            "footstep_error_mean": None if error else 0.001,
+            "error": error,
+        }
+    )
+
+
+def _paired_rows() -> list[dict[str, Any]]:
+    rows = []
+    a_b = {0: (0.010, 0.015), 1: (0.012, 0.014), 2: (0.011, 0.020)}
+    for s, (za, zb) in a_b.items():  # both succeed
+        rows += [_row("miqcqp", s, True, za), _row("kinematic", s, True, zb)]
+    rows += [_row("miqcqp", 3, True, 0.010), _row("kinematic", 3, False, 0.300)]  # planner only
+    rows += [_row("miqcqp", 4, False, 0.500), _row("kinematic", 4, True, 0.010)]  # baseline only
+    rows += [_row("miqcqp", 5, False, 0.400), _row("kinematic", 5, False, 0.100)]  # neither
+    # an error: seed 6 is not walked by both
+    rows += [_row("miqcqp", 6, True, 0.001), _row("kinematic", 6, True, 0.0, error="Boom: x")]
+    rows += [_row("miqcqp", 7, False, 0.002)]  # no baseline walk at all
+    # other step mode, other impulse, other scene: all left out
+    rows += [
+        _row("miqcqp", 8, True, 0.001, smallest=False, equal=True),
+        _row("kinematic", 8, True, 0.900, smallest=False, equal=True),
+        _row("miqcqp", 0, True, 0.001, impulse=0.0),
+        _row("kinematic", 0, False, 0.900, impulse=0.0),
+        _row("miqcqp", 0, False, 0.001, scene="other"),
+        _row("kinematic", 0, True, 0.900, scene="other"),
+    ]
+    return rows
+
+
+def test_paired_counts_and_difference_by_hand() -> None:
+    p = st.paired(_paired_rows(), "s", "smallest", 3.0, "miqcqp", "kinematic")
+    diffs = [0.010 - 0.015, 0.012 - 0.014, 0.011 - 0.020]
+    assert p.pairs == 3
+    assert p.zmp_diff == pytest.approx(-0.016 / 3, abs=1e-15)
+    assert p.zmp_lo <= p.zmp_diff <= p.zmp_hi
+    assert p.zmp_p == pytest.approx(sps.wilcoxon(diffs).pvalue)
+    assert p.seeds == 6  # seeds 0-5: walked by both without error
+    assert (p.only_planner, p.only_baseline) == (1, 1)
+    assert p.success_p == 1.0
+    # the equal mode holds only seed 8 (one pair): mean difference exact
+    q = st.paired(_paired_rows(), "s", "equal", 3.0, "miqcqp", "kinematic")
+    assert (q.pairs, q.seeds) == (1, 1)
+    assert q.zmp_diff == pytest.approx(0.001 - 0.900)
+    # swapping planner and baseline swaps the sign and the discordant counts
+    r = st.paired(_paired_rows(), "s", "smallest", 3.0, "kinematic", "miqcqp")
+    assert r.zmp_diff == pytest.approx(-p.zmp_diff)
+    assert (r.only_planner, r.only_baseline) == (1, 1)
+
+
+def test_paired_mcnemar_from_discordant_seeds() -> None:
+    rows = []
+    for s in range(12):
+        a_ok = s < 10  # miqcqp succeeds on 10 of 12
+        b_ok = s < 2 or s >= 10  # kinematic on 2 shared + 2 of its own
+        rows += [_row("miqcqp", s, a_ok, 0.01), _row("kinematic", s, b_ok, 0.01)]
+    p = st.paired(rows, "s", "smallest", 3.0, "miqcqp", "kinematic")
+    assert (p.seeds, p.only_planner, p.only_baseline, p.pairs) == (12, 8, 2, 2)
+    assert p.success_p == pytest.approx(sps.binomtest(8, 10, 0.5).pvalue)
+
+
+def _pairs_with_diffs(diffs: list[float]) -> st.Paired:
+    rows = []
+    for s, d in enumerate(diffs):
+        rows += [_row("miqcqp", s, True, 0.02 + d), _row("kinematic", s, True, 0.02)]
+    return st.paired(rows, "s", "smallest", 3.0, "miqcqp", "kinematic")
+
+
+NSTEPS = {("s", "miqcqp", "smallest"): 7, ("s", "kinematic", "smallest"): 9}
+
+
+def test_verdict_wording() -> None:
+    rng = np.random.default_rng(3)
+    noise = rng.normal(0.0, 0.004, 20)
+    zero_mean = list(noise - noise.mean())
+    lower = list(-0.005 + rng.normal(0.0, 0.0005, 20))
+    higher = [-x for x in lower]
+    (ns,) = st.verdict([_pairs_with_diffs(zero_mean)], NSTEPS)
+    (holds,) = st.verdict([_pairs_with_diffs(lower)], NSTEPS)
+    (fails,) = st.verdict([_pairs_with_diffs(higher)], NSTEPS)
+    (few,) = st.verdict([_pairs_with_diffs([-0.01])], NSTEPS)
+    assert "not significant" in ns and "holds" not in ns and "NOT" not in ns
+    assert "the claim holds" in holds and "not significant" not in holds
+    assert "does NOT hold" in fails and "holds:" not in fails.replace("NOT hold", "")
+    assert "cannot be judged" in few
+    for line in (ns, holds, fails):
+        assert "miqcqp N = 7" in line and "kinematic N = 9" in line and "20 pairs" in line
+    # the printed mean difference is the hand mean, in mm
+    assert f"{1000 * np.mean(lower):+.2f} mm" in holds
+
+
+def test_zmp_significant_needs_both_the_test_and_the_interval() -> None:
+    p = _pairs_with_diffs(list(-0.005 + np.linspace(-0.0005, 0.0005, 20)))
+    assert p.zmp_significant
+    assert not replace(p, zmp_p=0.2).zmp_significant
+    assert not replace(p, zmp_hi=0.001).zmp_significant
+
+
+def test_cells_success_counts_and_wilson() -> None:
+    zmps = [0.010, 0.012, 0.014, 0.016, 0.018, 0.020, 0.022, 0.5, 0.6, 0.7]
+    rows = [_row("miqcqp", s, s < 7, z) for s, z in enumerate(zmps)]
+    rows.append(_row("miqcqp", 10, True, 0.0, error="RuntimeError: x"))
+    rows += [_row("reactive", s, True, 0.03, smallest=True, equal=True, n_steps=11) for s in (0, 1)]
+    out = st.cells(rows, ["smallest", "equal"])
+    by = {(c.planner, c.mode): c for c in out}
+    assert set(by) == {("miqcqp", "smallest"), ("reactive", "smallest"), ("reactive", "equal")}
+    c = by["miqcqp", "smallest"]
+    assert (c.walks, c.errors, c.successes, c.n_steps) == (10, 1, 7, 7)
+    assert c.success_rate == 0.7
+    lo, hi = _wilson_ref(7, 10)
+    assert c.success_lo == pytest.approx(lo) and c.success_hi == pytest.approx(hi)
+    assert c.zmp_mean == pytest.approx(np.mean(zmps[:7]))  # successful walks only
+    assert c.zmp_max_mean == pytest.approx(2 * np.mean(zmps[:7]))
+    r = by["reactive", "equal"]
+    assert (r.walks, r.successes, r.n_steps) == (2, 2, 11)
+    assert r.success_lo == pytest.approx(_wilson_ref(2, 2)[0])
+    frag = st.fragility(out)
+    f0 = frag[0]
+    assert (f0.planner, f0.mode, f0.successes, f0.walks) == ("miqcqp", "smallest", 7, 10)
+
+
+# ---------------------------------------------------------------------------------------------
+# store
+
+
+def _design(**kw: Any) -> StudyDesign:
+    return study_from_dict(_reduced(**kw))
+
+
+def _rows(n: int) -> list[dict[str, Any]]:
+    out = []
+    for s in range(n):
+        out.append(
+            normalise_row(
+                {
+                    "key": f"flat|reactive|N=11|J=4|seed={s}",
+                    "scene": "flat",
+                    "planner": "reactive",
+                    "n_steps": 11,
+                    "smallest_n": True,
+                    "equal_n": True,
+                    "push_impulse": 4.0,
+                    "seed": s,
+                    "simulator": "reduced",
+                    "controller": None,
+                    "push_step": 5,
+                    "push_time": 2.5 + s / 7,
+                    "push_direction": s / 3,
+                    "success": s % 2 == 0,
+                    "fell": s % 2 == 1,
+                    "zmp_offset_mean": 0.01 * s if s != 2 else math.nan,
+                    "zmp_offset_max": 0.02 * s,
+                    "footstep_error_mean": 1e-3,
+                    "goal_error": 0.1,
+                    "steps_landed": 11,
+                    "wall_time": 0.1,
+                    "error": "ValueError: x" if s == 3 else None,
+                }
+            )
+        )
+    return out
+
+
+def _same(a: dict[str, Any], b: dict[str, Any]) -> bool:
+    for k in a.keys() | b.keys():
+        x, y = a[k], b[k]
+        if isinstance(x, float) and isinstance(y, float) and math.isnan(x) and math.isnan(y):
+            continue
+        if x != y or type(x) is not type(y):
+            return False
+    return True
+
+
+def test_store_round_trip(tmp_path: Path) -> None:
+    d = _design()
+    rows = _rows(5)
+    s = TrialStore(tmp_path, d)
+    for r in rows:
+        s.add(r)
+    s.flush()
+    parts = list((tmp_path / "trials.parts").glob("part-*.parquet"))
+    assert parts, "rows are on disk before close"
+    assert not (tmp_path / "trials.parquet").exists()
+    path = s.close()
+    assert path == tmp_path / "trials.parquet" and path.is_file()
+    assert not (tmp_path / "trials.parts").exists()
+    again = TrialStore(tmp_path, d)
+    assert set(again.rows) == {r["key"] for r in rows}
+    for r in rows:
+        assert again.done(r["key"])
+        assert _same(again.rows[r["key"]], r), (again.rows[r["key"]], r)
+    assert not again.done("flat|reactive|N=11|J=4|seed=99")
+    # the file is sorted by key with the documented columns and types
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(path)
+    assert table.column_names == [c for c, _ in COLUMNS]
+    assert table.column("key").to_pylist() == sorted(r["key"] for r in rows)
+    assert str(table.schema.field("success").type) == "bool"
+    assert str(table.schema.field("n_steps").type) == "int64"
+
+
+def test_store_flushes_part_files_as_rows_arrive_and_a_crash_keeps_them(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(store_mod, "FLUSH_ROWS", 2)
+    d = _design()
+    rows = _rows(5)
+    s = TrialStore(tmp_path, d)
+    for r in rows:
+        s.add(r)
+    assert len(list((tmp_path / "trials.parts").glob("part-*.parquet"))) == 2  # 2 + 2 rows
+    # no close (a crash): a new store sees the flushed rows, not the pending one
+    s2 = TrialStore(tmp_path, d)
+    assert set(s2.rows) == {r["key"] for r in rows[:4]}
+    s2.add(rows[4])
+    s2.close()
+    assert set(TrialStore(tmp_path, d).rows) == {r["key"] for r in rows}
+    assert not (tmp_path / "trials.parts").exists()
+
+
+def test_store_close_survives_a_temporary_file_left_by_a_crash(tmp_path: Path) -> None:
+    d = _design()
+    s = TrialStore(tmp_path, d)
+    s.add(_rows(1)[0])
+    s.flush()
+    # a crash in write_rows leaves its temporary file beside the parts
+    (tmp_path / "trials.parts" / ".part-00000000000000000001-1-00000.parquet.1.tmp").write_bytes(
+        b"x"
+    )
+    s2 = TrialStore(tmp_path, d)
+    s2.add(_rows(2)[1])
+    s2.close()
+    assert set(TrialStore(tmp_path, d).rows) == {r["key"] for r in _rows(2)}
+
+
+def test_store_refuses_a_folder_of_another_study(tmp_path: Path) -> None:
+    d = _design(initial_impulse=0.5)
+    TrialStore(tmp_path, d).close()
+    with pytest.raises(InputError) as e:
+        TrialStore(tmp_path, replace(d, initial_impulse=0.9))
+    assert e.value.field == "--out"
+    assert "initial_impulse" in str(e.value)
+    with pytest.raises(InputError) as e:
+        TrialStore(tmp_path, replace(d, noise_vel=0.1))
+    assert e.value.field == "--out"
+    # a study that only grows (more seeds, planners, pushes) reuses the folder
+    TrialStore(tmp_path, replace(d, seeds=9, planners=("kinematic", "miqcqp", "reactive")))
+
+
+def test_store_refuses_a_damaged_table_or_meta(tmp_path: Path) -> None:
+    d = _design()
+    s = TrialStore(tmp_path, d)
+    s.add(_rows(1)[0])
+    s.close()
+    (tmp_path / "trials.parquet").write_bytes(b"PAR1 this is not parquet PAR1")
+    with pytest.raises(InputError) as e:
+        TrialStore(tmp_path, d)
+    assert e.value.field == "trials file"
+    (tmp_path / "trials.parquet").unlink()
+    (tmp_path / "study.json").write_text("{not json")
+    with pytest.raises(InputError) as e:
+        TrialStore(tmp_path, d)
+    assert e.value.field == "study folder"
