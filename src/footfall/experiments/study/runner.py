@@ -130,7 +130,9 @@ def make_plans(
 
 
 def make_trials(design: StudyDesign, plans: list[PlanEntry]) -> list[Trial]:
-    """The study's walks, one per distinct (scene, planner, N, impulse, seed), in a fixed order.
+    """The study's walks, one per distinct (scene, planner, N, impulse, seed), in a fixed order:
+    seed by seed (every cell of seed ``s`` before any of ``s + 1``), so a study stopped early
+    holds the same seeds in every cell it reached, paired and balanced.
 
     A walk that serves both step modes is one trial with both flags."""
     scenes = {name: builtin_scene(name) for name in design.scenes}
@@ -147,7 +149,7 @@ def make_trials(design: StudyDesign, plans: list[PlanEntry]) -> list[Trial]:
                 f[1] |= entry.mode in ("equal", "goal")
                 spec.setdefault(key, (entry, impulse, seed))
     trials = []
-    for key, (entry, impulse, seed) in spec.items():
+    for key, (entry, impulse, seed) in sorted(spec.items(), key=lambda kv: kv[1][2]):
         trials.append(
             Trial(
                 key=key,
