@@ -68,13 +68,20 @@ def markdown(
     md += [
         "## Plans",
         "",
-        "| scene | planner | N mode | status | N | planning time [s] |",
-        "|---|---|---|---|---|---|",
+        "A plan stopped by the time limit is the best found, not a proven optimum: its gap "
+        "(relative, incumbent vs bound) says how far from optimal it may be.",
+        "",
+        "| scene | planner | N mode | status | N | objective | gap | solve time [s] |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for p in plans:
-        n = p.plan.n_steps if p.plan.has_solution else "-"
+        ok = p.plan.has_solution
+        n = p.plan.n_steps if ok else "-"
+        obj = f"{p.plan.objective:.4g}" if ok and p.plan.objective == p.plan.objective else "-"
+        gap = f"{p.plan.gap:.2%}" if ok and p.plan.gap < float("inf") else "-"
         md.append(
-            f"| {p.scene} | {p.planner} | {p.mode} | {p.plan.status.value} | {n} | {p.plan_time:.1f} |"
+            f"| {p.scene} | {p.planner} | {p.mode} | {p.plan.status.value} | {n} | {obj} | {gap} "
+            f"| {p.plan.solve_time:.1f} |"
         )
     md += [
         "",
