@@ -101,7 +101,7 @@ def study_command(
         f"{design.initial_impulse:g} N s.",
         "",
         f"Command: `footfall {' '.join(sys.argv[1:])}`. This run: {run.ran} new walks in "
-        f"{run.wall_time:.0f} s ({executor}, {workers} workers"
+        f"{run.wall_time:.0f} s ({executor}, {workers} worker{'s' if workers != 1 else ''}"
         + (
             f", {60 * run.ran / run.wall_time:.1f} walks/min"
             if run.ran and run.wall_time > 0
