@@ -126,3 +126,40 @@ def test_walk_logs_its_smallest_n_search_and_records_its_controller(tmp_path: Pa
     walked = json.loads((out / "walk.json").read_text())
     assert records[-1]["n_steps"] == walked["plan"]["n_steps"]
     assert walked["controller"]["name"] == "wbc"  # the biped's default controller
+
+
+def test_study_logs_its_smallest_n_searches(tmp_path: Path) -> None:
+    """``footfall study`` in a pipe: a line per plan and the search's own lines per N."""
+    study = tmp_path / "tiny.yaml"
+    study.write_text(
+        "name: tiny\nsimulator: reduced\nscenes: [flat]\nplanners: [miqcqp]\n"
+        "steps: [smallest]\ndefault_push: 0.0\nseeds: 1\npush_levels: []\nlevel_seeds: 0\n"
+        "time_limit: 60\n"
+    )
+    res = subprocess.run(
+        [sys.executable, "-m", "footfall", "study", str(study), "--out", str(tmp_path / "o")],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert res.returncode == 0, res.stderr
+    assert "planning flat / miqcqp (smallest N)" in res.stderr
+    assert any(" optimal in " in line for line in res.stderr.splitlines() if line.startswith("["))
+
+
+def test_compare_in_mujoco_logs_its_smallest_n_search(tmp_path: Path) -> None:
+    pytest.importorskip("mujoco")
+    res = subprocess.run(
+        [
+            *(sys.executable, "-m", "footfall", "compare", "--sim", "mujoco", "--scenes", "flat"),
+            *("--planners", "miqcqp", "--trials", "1", "--push-max", "0"),
+            *("--out", str(tmp_path / "o")),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert res.returncode == 0, res.stderr
+    lines = [line for line in res.stderr.splitlines() if line.startswith("[")]
+    assert any("flat with miqcqp" in line for line in lines), res.stderr
+    assert any(" optimal in " in line for line in lines), res.stderr

@@ -69,7 +69,8 @@ class ProgressLog:
         if self.terminal and not self.quiet:
             self.status = console.status(f"planning {self.title} ...")
             self.status.__enter__()
-        self._emit({"event": "start", "what": self.title}, None)
+        # without a terminal the log says what it is about (a command may plan several times)
+        self._emit({"event": "start", "what": self.title}, f"planning {self.title}", False)
         return self
 
     def __exit__(

@@ -370,6 +370,8 @@ def _compare_mujoco(
             robot_aware=robot_aware,
             heading_segments=heading_segments,
             controller=controller,
+            # plain lines (printed above the status line; a second live display is refused)
+            monitor_for=lambda title: ProgressLog(title, terminal=False),
         )
     table = compare_table(rows)
     header = describe(trials, force, PUSH_DURATION) + f" Controller: {controller}."

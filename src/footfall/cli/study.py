@@ -86,7 +86,19 @@ def study_command(
             console.print(line)
 
     started = time.perf_counter()
-    run = run_study(design, out, executor, workers, address, say, progress, limit)
+    from footfall.cli._progress import ProgressLog
+
+    run = run_study(
+        design,
+        out,
+        executor,
+        workers,
+        address,
+        say,
+        progress,
+        limit,
+        monitor_for=lambda title: ProgressLog(title, quiet),
+    )
     if terminal:
         console.print()
     header = [

@@ -11,12 +11,14 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
+from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from footfall.errors import InputError
+from footfall.planning.run import SearchMonitor
 from footfall.sim.biped.options import WalkOptions
 from footfall.sim.biped.plans import plan_for_walk, random_push
 from footfall.sim.biped.result import WalkResult
@@ -58,6 +60,7 @@ def compare_mujoco(
     robot_aware: bool = True,
     heading_segments: int | None = None,
     controller: str = "wbc",
+    monitor_for: Callable[[str], AbstractContextManager[SearchMonitor | None]] | None = None,
 ) -> list[dict[str, Any]]:
     """Walk every scene x planner x seed in MuJoCo with a seeded push; one row per walk.
 
@@ -75,6 +78,8 @@ def compare_mujoco(
         heading_segments: L of the miqcqp and kinematic plans (:func:`plan_for_walk`; None: its
             default).
         controller: the walker's whole-body controller (``WalkOptions.controller``).
+        monitor_for: ``monitor_for(title)`` gives a context manager yielding the monitor of a
+            plan's smallest-N search (``footfall plan``'s progress lines); None: silent.
 
     Returns:
         Rows of :func:`walk_row` plus ``plan_status`` and ``plan_time_s``; a scene/planner
@@ -88,15 +93,18 @@ def compare_mujoco(
         for planner in planners:
             n = (n_steps or {}).get((name, planner))
             t0 = time.perf_counter()
-            plan = plan_for_walk(
-                scene,
-                planner,
-                n,
-                time_limit,
-                cache_dir,
-                robot_aware=robot_aware,
-                heading_segments=heading_segments,
-            )
+            title = f"{name} with {planner}"
+            with monitor_for(title) if monitor_for else nullcontext() as monitor:
+                plan = plan_for_walk(
+                    scene,
+                    planner,
+                    n,
+                    time_limit,
+                    cache_dir,
+                    robot_aware=robot_aware,
+                    heading_segments=heading_segments,
+                    monitor=monitor,
+                )
             plan_time = time.perf_counter() - t0
             if not plan.has_solution:
                 rows.append({"scene": name, "planner": planner, "plan_status": plan.status.value})

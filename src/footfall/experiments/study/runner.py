@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterable, Iterator
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -24,10 +25,13 @@ from footfall.experiments.study.design import Disturbance, StudyDesign
 from footfall.experiments.study.store import TrialStore
 from footfall.experiments.study.trials import Trial, run_trial, trial_key
 from footfall.planning.plan import FootstepPlan
+from footfall.planning.run import SearchMonitor
 from footfall.terrain.scene import Scene, builtin_scene
 
 #: the executors of ``footfall study --executor``
 EXECUTORS = ("local", "ray")
+#: ``monitor_for(title)``: a context manager yielding the search monitor of one plan (or None)
+MonitorFactory = Callable[[str], AbstractContextManager[SearchMonitor | None]]
 #: trials in flight per worker (keeps every worker busy without shipping the whole study at once)
 IN_FLIGHT = 2
 
@@ -65,13 +69,18 @@ class PlanEntry:
         }
 
 
-def _planner(design: StudyDesign, folder: Path) -> Callable[[Scene, str, int | None], FootstepPlan]:
-    """``plan(scene, planner, n_steps)`` for the study's simulator, cached in ``folder``."""
+Planner = Callable[[Scene, str, "int | None", "SearchMonitor | None"], FootstepPlan]
+
+
+def _planner(design: StudyDesign, folder: Path) -> Planner:
+    """``plan(scene, planner, n_steps, monitor)`` for the study's simulator, cached in ``folder``."""
     if design.simulator == "mujoco":
         from footfall.sim.biped.plans import plan_for_walk
 
-        def plan_mujoco(scene: Scene, planner: str, n: int | None) -> FootstepPlan:
-            return plan_for_walk(scene, planner, n, design.time_limit, folder)
+        def plan_mujoco(
+            scene: Scene, planner: str, n: int | None, monitor: SearchMonitor | None
+        ) -> FootstepPlan:
+            return plan_for_walk(scene, planner, n, design.time_limit, folder, monitor=monitor)
 
         return plan_mujoco
     from footfall.planning.cache import PlanCache, cached_plan
@@ -79,24 +88,34 @@ def _planner(design: StudyDesign, folder: Path) -> Callable[[Scene, str, int | N
 
     cache, options = PlanCache(folder), PlannerOptions(time_limit=design.time_limit)
 
-    def plan_reduced(scene: Scene, planner: str, n: int | None) -> FootstepPlan:
-        return cached_plan(scene, planner, n, options, cache=cache)
+    def plan_reduced(
+        scene: Scene, planner: str, n: int | None, monitor: SearchMonitor | None
+    ) -> FootstepPlan:
+        return cached_plan(scene, planner, n, options, cache=cache, monitor=monitor)
 
     return plan_reduced
 
 
 def make_plans(
-    design: StudyDesign, folder: Path, say: Callable[[str], None] | None = None
+    design: StudyDesign,
+    folder: Path,
+    say: Callable[[str], None] | None = None,
+    monitor_for: MonitorFactory | None = None,
 ) -> list[PlanEntry]:
-    """Every plan the study walks (see the module docstring), planned or read from the cache."""
+    """Every plan the study walks (see the module docstring), planned or read from the cache.
+
+    ``say`` hears one line per plan; ``monitor_for(title)`` gives the monitor of a smallest-N
+    search (``footfall plan``'s progress lines)."""
     plan = _planner(design, folder)
     out: list[PlanEntry] = []
 
     def timed(scene: Scene, planner: str, n: int | None, mode: str) -> PlanEntry:
+        title = f"{scene.name} / {planner} ({mode} N{'' if n is None else f' = {n}'})"
         if say:
-            say(f"planning {scene.name} / {planner} ({mode} N{'' if n is None else f' = {n}'})")
+            say(f"planning {title}")
         t0 = time.perf_counter()
-        p = plan(scene, planner, n)
+        with monitor_for(title) if monitor_for else nullcontext() as monitor:
+            p = plan(scene, planner, n, monitor)
         entry = PlanEntry(scene.name, planner, mode, p, time.perf_counter() - t0)
         if say:
             n_txt = p.n_steps if p.has_solution else "-"
@@ -276,6 +295,7 @@ def run_study(
     say: Callable[[str], None] | None = None,
     progress: Callable[[int, int, dict[str, Any]], None] | None = None,
     limit: int | None = None,
+    monitor_for: MonitorFactory | None = None,
 ) -> StudyRun:
     """Plan, then walk every trial of ``design`` not yet in ``out`` (resumable, see above).
 
@@ -287,11 +307,12 @@ def run_study(
         progress: called after each walk with (walks done, walks in the study, the row).
         limit: run at most this many new walks (then stop as if interrupted; for tests and
             for spreading a study over several sessions).
+        monitor_for: progress of the smallest-N searches (:func:`make_plans`).
     """
     execute([], executor, workers, address)  # validates the arguments before any planning
     out = Path(out)
     store = TrialStore(out, design)
-    plans = make_plans(design, out / "plans", say)
+    plans = make_plans(design, out / "plans", say, monitor_for)
     trials = make_trials(design, plans)
     for t in trials:  # a walk run by an earlier study may serve a step mode added since
         r = store.rows.get(t.key)
