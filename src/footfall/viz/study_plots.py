@@ -29,6 +29,7 @@ def plot_fragility(points: Sequence[dict[str, Any]], path: Path) -> Path:
     fig, axes = _grid(len(scenes))
     for ax, scene in zip(axes, scenes, strict=False):
         keys = list(dict.fromkeys((p["planner"], p["mode"]) for p in points if p["scene"] == scene))
+        drawn: set[tuple[object, ...]] = set()
         for planner, mode in keys:
             pts = sorted(
                 (
@@ -38,6 +39,11 @@ def plot_fragility(points: Sequence[dict[str, Any]], path: Path) -> Path:
                 ),
                 key=lambda p: p["impulse"],
             )
+            # the same walks in both modes (the reactive planner's) are drawn once
+            same = (planner, *((p["impulse"], p["walks"], p["successes"]) for p in pts))
+            if same in drawn:
+                continue
+            drawn.add(same)
             x = np.array([p["impulse"] for p in pts])
             y = np.array([p["successes"] / p["walks"] if p["walks"] else np.nan for p in pts])
             lo = np.array([p["lo"] for p in pts])

@@ -1,0 +1,199 @@
+"""The MPC's solvers against references that share no code with them (issue 24).
+
+- the torque-disc QP (``solve_ball_qp``): the closed form of ``P = p I`` (each block alone:
+  ``v_j = -q_j / max(p, ||q_j||)``), scipy's SLSQP on the same problem, and KKT conditions
+  recomputed here;
+- its pieces: the cold start's multipliers by hand, the dual's ``S = (P + Lambda)^-1`` and value
+  from numpy's inverse;
+- the footstep-polygon QP (``_clarabel_in_polygon``): SLSQP with the polygon and disc rows.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import minimize
+
+from footfall.control.mpc import (
+    _ball_dual,
+    _check_polygon,
+    _clarabel_in_polygon,
+    _cold_start,
+    solve_ball_qp,
+)
+from footfall.errors import InputError
+
+
+def _random_pd(rng: np.random.Generator, n: int, cond: float = 1.0) -> np.ndarray:
+    a = rng.normal(size=(n, n))
+    return a @ a.T + cond * np.eye(n)
+
+
+def _slsqp(p: np.ndarray, q: np.ndarray, extra: list[dict] | None = None, n_u: int | None = None):
+    """Reference minimiser of 1/2 z'Pz + q'z with ||z_j|| <= 1 on the first n_u entries' blocks."""
+    n = q.shape[0]
+    n_u = n if n_u is None else n_u
+    cons = [
+        {"type": "ineq", "fun": (lambda z, j=j: 1.0 - z[2 * j] ** 2 - z[2 * j + 1] ** 2)}
+        for j in range(n_u // 2)
+    ] + (extra or [])
+    best = None
+    rng = np.random.default_rng(0)
+    for start in [np.zeros(n), *(rng.uniform(-0.5, 0.5, n) for _ in range(4))]:
+        res = minimize(
+            lambda z: 0.5 * z @ p @ z + q @ z,
+            start,
+            jac=lambda z: p @ z + q,
+            constraints=cons,
+            method="SLSQP",
+            options={"ftol": 1e-14, "maxiter": 500},
+        )
+        if best is None or res.fun < best.fun:
+            best = res
+    return best
+
+
+def _objective(p: np.ndarray, q: np.ndarray, v: np.ndarray) -> float:
+    return float(0.5 * v @ p @ v + q @ v)
+
+
+@pytest.mark.parametrize("p_scale", [0.5, 2.0, 10.0])
+def test_scaled_identity_has_the_closed_form_solution(p_scale: float) -> None:
+    """P = p I decouples the blocks: v_j = -q_j / max(p, ||q_j||), lambda_j = max(||q_j|| - p, 0)."""
+    q = np.array([3.0, 4.0, 0.1, -0.2, -1.0, 0.0, 0.0, 0.0])  # norms 5, 0.22, 1, 0
+    p = p_scale * np.eye(8)
+    v, lam, _, ok = solve_ball_qp(p, q)
+    assert ok
+    norms = np.linalg.norm(q.reshape(4, 2), axis=1)
+    expected_v = -(q.reshape(4, 2) / np.maximum(p_scale, norms)[:, None]).ravel()
+    np.testing.assert_allclose(v, expected_v, atol=1e-9)
+    np.testing.assert_allclose(lam, np.maximum(norms - p_scale, 0.0), atol=1e-7)
+
+
+def test_cold_start_is_each_blocks_exact_multiplier_with_a_diagonal_p() -> None:
+    q = np.array([3.0, 4.0, 0.3, 0.4, 0.0, -6.0])  # norms 5, 0.5, 6
+    p = np.diag([2.0, 2.0, 1.0, 1.0, 4.0, 2.0])  # block diagonals 2, 1, (4 + 2) / 2 = 3
+    lam = _cold_start(p, q)
+    # unconstrained norms ||P^-1 q_j||: 2.5, 0.5, 3 -> p_jj * max(norm - 1, 0)
+    np.testing.assert_allclose(lam, [2.0 * 1.5, 0.0, 3.0 * 2.0])
+
+
+def test_dual_matches_numpy_inverse_and_its_closed_form_value() -> None:
+    rng = np.random.default_rng(3)
+    p = _random_pd(rng, 6)
+    q = rng.normal(0, 3, 6)
+    lam = np.array([0.5, 0.0, 2.0])
+    s, v, phi = _ball_dual(p, q, lam)
+    ref = np.linalg.inv(p + np.diag(np.repeat(lam, 2)))
+    np.testing.assert_allclose(s, ref, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(v, -ref @ q, rtol=1e-10, atol=1e-12)
+    assert phi == pytest.approx(0.5 * q @ ref @ q + 0.5 * lam.sum(), rel=1e-12)
+
+
+def test_dual_refuses_a_matrix_that_is_not_positive_definite() -> None:
+    p = np.diag([1.0, -3.0, 1.0, 1.0])
+    with pytest.raises(np.linalg.LinAlgError):
+        _ball_dual(p, np.ones(4), np.zeros(2))
+    # the multipliers lift it: P + Lambda is positive definite with lambda_0 > 3
+    _, v, _ = _ball_dual(p, np.ones(4), np.array([4.0, 0.0]))
+    assert np.all(np.isfinite(v))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_random_problems_match_slsqp_and_the_kkt_conditions(seed: int) -> None:
+    rng = np.random.default_rng(100 + seed)
+    n = 2 * int(rng.integers(1, 6))
+    p = _random_pd(rng, n, cond=0.2)
+    q = rng.normal(0, 4, n)
+    v, lam, _, ok = solve_ball_qp(p, q)
+    assert ok
+    vb = v.reshape(-1, 2)
+    norms = np.linalg.norm(vb, axis=1)
+    assert np.all(norms <= 1.0 + 1e-12) and np.all(lam >= 0.0)
+    # complementarity and stationarity, recomputed here
+    assert np.all(lam * np.abs(1.0 - norms**2) < 1e-7)
+    assert np.abs(p @ v + q + np.repeat(lam, 2) * v).max() < 1e-6
+    ref = _slsqp(p, q)
+    assert _objective(p, q, v) <= ref.fun + 1e-8
+    np.testing.assert_allclose(v, ref.x, atol=1e-4)
+
+
+def test_warm_start_from_the_solution_converges_at_once_and_cold_takes_steps() -> None:
+    rng = np.random.default_rng(11)
+    p = _random_pd(rng, 8, cond=0.1)
+    q = rng.normal(0, 20, 8)
+    v, lam, it_cold, ok = solve_ball_qp(p, q)
+    assert ok and it_cold >= 1 and np.count_nonzero(lam) >= 1
+    v2, lam2, it_warm, ok2 = solve_ball_qp(p, q, lam0=lam)
+    assert ok2 and it_warm == 0
+    np.testing.assert_allclose(v2, v, atol=1e-12)
+    # negative warm starts are clipped to the feasible multipliers, not trusted
+    v3, _, _, ok3 = solve_ball_qp(p, q, lam0=-np.ones(4))
+    assert ok3
+    np.testing.assert_allclose(v3, v, atol=1e-7)
+
+
+def test_iteration_limit_reports_no_convergence_and_returns_a_feasible_point() -> None:
+    rng = np.random.default_rng(12)
+    p = _random_pd(rng, 10, cond=0.01)
+    q = rng.normal(0, 50, 10)
+    _, _, it_full, ok = solve_ball_qp(p, q)
+    assert ok and it_full >= 2
+    v, _, it, ok0 = solve_ball_qp(p, q, max_iter=0)
+    assert not ok0 and it == 0
+    assert np.all(np.linalg.norm(v.reshape(-1, 2), axis=1) <= 1.0 + 1e-12)
+    # a loose tolerance stops earlier than a tight one
+    _, _, it_loose, ok_loose = solve_ball_qp(p, q, tol=1e-2)
+    assert ok_loose and it_loose <= it_full
+
+
+def test_inactive_discs_leave_the_unconstrained_optimum() -> None:
+    rng = np.random.default_rng(13)
+    p = _random_pd(rng, 6, cond=5.0)
+    q = rng.normal(0, 0.1, 6)
+    v, lam, it, ok = solve_ball_qp(p, q)
+    assert ok and it == 0 and np.all(lam == 0.0)
+    np.testing.assert_allclose(v, np.linalg.solve(p, -q), atol=1e-12)
+
+
+def _polygon_case(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
+    rng = np.random.default_rng(200 + seed)
+    n_u = 4
+    p = _random_pd(rng, n_u + 2, cond=0.5)
+    q = rng.normal(0, 3, n_u + 2)
+    # a square |d_x|, |d_y| <= 0.05 around the origin, usually active
+    a = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
+    b = np.full(4, 0.05)
+    return p, q, a, b, n_u
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_polygon_qp_matches_slsqp(seed: int) -> None:
+    p, q, a, b, n_u = _polygon_case(seed)
+    res = _clarabel_in_polygon(p, q, a, b, n_u)
+    assert str(res.status) == "Solved"
+    z = np.asarray(res.x)
+    assert np.all(a @ z[n_u:] <= b + 1e-7)
+    assert np.all(np.linalg.norm(z[:n_u].reshape(-1, 2), axis=1) <= 1.0 + 1e-7)
+    extra = [
+        {"type": "ineq", "fun": (lambda z, k=k: b[k] - a[k] @ z[n_u:])} for k in range(a.shape[0])
+    ]
+    ref = _slsqp(p, q, extra, n_u)
+    assert _objective(p, q, z) == pytest.approx(ref.fun, abs=1e-7)
+    np.testing.assert_allclose(z, ref.x, atol=1e-4)
+
+
+def test_polygon_arrays_are_checked() -> None:
+    a, b = _check_polygon([[1.0, 0.0], [0.0, 1.0]], [0.1, 0.2])
+    assert a.shape == (2, 2) and b.shape == (2,)
+    for bad_a, bad_b, field in (
+        ([1.0, 0.0], [0.1], "a"),
+        (np.zeros((0, 2)), np.zeros(0), "a"),
+        ([[1.0, np.nan]], [0.1], "a"),
+        ([[1.0, 0.0, 0.0]], [0.1], "a"),
+        ([[1.0, 0.0]], [0.1, 0.2], "b"),
+        ([[1.0, 0.0]], [np.inf], "b"),
+    ):
+        with pytest.raises(InputError) as err:
+            _check_polygon(bad_a, bad_b)
+        assert err.value.field == field
