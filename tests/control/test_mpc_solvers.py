@@ -125,6 +125,7 @@ def test_warm_start_from_the_solution_converges_at_once_and_cold_takes_steps() -
     v, lam, it_cold, ok = solve_ball_qp(p, q)
     assert ok and it_cold >= 1 and np.count_nonzero(lam) >= 1
     v2, lam2, it_warm, ok2 = solve_ball_qp(p, q, lam0=lam)
+    np.testing.assert_allclose(lam2, lam, atol=1e-12)
     assert ok2 and it_warm == 0
     np.testing.assert_allclose(v2, v, atol=1e-12)
     # negative warm starts are clipped to the feasible multipliers, not trusted

@@ -59,6 +59,11 @@ def quadruped_cmd(
     compare: bool = typer.Option(False, help="Also run the other strategies (body sway table)."),
     out: Path = typer.Option("out/quadruped", help="Output folder."),
     video: bool = typer.Option(True, "--video/--no-video", help="Render an MP4 (offscreen GL)."),
+    controller: str = typer.Option(
+        "servo",
+        help="servo: the document's joint position servos on the planned angles; wbc: joint "
+        "torques from the whole-body QP that puts the centre of pressure on the planned ZMP.",
+    ),
 ) -> None:
     """Walk gait up a slope (document 001): plan with ZMP/OSP, simulate in MuJoCo, measure."""
     import math
@@ -71,6 +76,8 @@ def quadruped_cmd(
     from footfall.sim.quadruped.sim import simulate
     from footfall.viz.quadruped_plots import save_walk_figures
 
+    if controller not in ("servo", "wbc"):
+        raise InputError("--controller", controller, "servo or wbc")
     if not math.isfinite(slope_deg) or not 0.0 <= slope_deg <= 60.0:
         raise InputError("--slope-deg", slope_deg, "a slope in [0, 60] deg")
     if not math.isfinite(body_deg) or not 0.0 <= body_deg <= slope_deg:
@@ -95,10 +102,11 @@ def quadruped_cmd(
     plans, infeasible = plan_strategies(QuadrupedRobot(), params, compare)
     plan = plans[strat]
     console.print(f"simulating {cycles} cycles on {slope_deg:g} deg ({plan.duration:.1f} s)...")
-    res = simulate(plan, video_path=out / "quadruped.mp4" if video else None)
+    res = simulate(plan, video_path=out / "quadruped.mp4" if video else None, controller=controller)
     if video and res.video is None:
         console.print(res.video_note)
     payload = res.metrics.to_dict()
+    payload["controller"] = {"name": controller, "qp_failures": res.qp_failures}
     if compare:
         payload["strategy_comparison"] = compare_strategies(plans, res)
         payload["strategy_comparison_infeasible"] = infeasible
@@ -111,6 +119,11 @@ def quadruped_cmd(
         f"fell {m.fell}, margin min {m.stability_margin_min_m:.3f} m "
         f"mean {m.stability_margin_mean_m:.3f} m, {m.realtime_factor:.0f}x real time"
     )
+    if m.zmp_error_mean_m is not None and m.zmp_error_max_m is not None:
+        console.print(
+            f"{controller}: centre of pressure vs planned ZMP: mean "
+            f"{100 * m.zmp_error_mean_m:.1f} cm, max {100 * m.zmp_error_max_m:.1f} cm"
+        )
     console.print(f"wrote {out / 'quadruped.json'}")
 
 

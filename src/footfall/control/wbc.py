@@ -97,6 +97,31 @@ class Contact:
     def n_points(self) -> int:
         return int(self.points.shape[0])
 
+    @classmethod
+    def point(
+        cls,
+        name: str,
+        jacobian: FloatArray,
+        drift: FloatArray,
+        point: FloatArray,
+        normal: FloatArray,
+        friction: float,
+        min_normal: float = 0.0,
+    ) -> Contact:
+        """A point foot (a quadruped's sphere on the ground): one force at ``point`` (3,) [m],
+        whose velocity must not change (``jacobian`` (3, nv) and ``drift`` (3,) of the point,
+        linear rows only). The body may turn about the point: its angular rows are left out
+        (zero rows here, dropped from the QP's equalities by :meth:`WholeBodyController.solve`).
+        """
+        jac = np.zeros((6, np.asarray(jacobian).shape[-1]))
+        jac[:3] = jacobian
+        dr = np.zeros(6)
+        dr[:3] = drift
+        p = np.asarray(point, dtype=float)
+        return cls(
+            name, jac, dr, p, p.reshape(1, 3), np.asarray(normal, float), friction, min_normal
+        )
+
 
 @dataclass(frozen=True)
 class MotionTask:
@@ -239,6 +264,16 @@ class WholeBodyController:
         packed = _pack(p)
         h_mat, g_vec, c_mat, lower, upper, n_eq, t_map = assemble(*packed, *self.eps)  # type: ignore[call-arg]
         n = h_mat.shape[0]
+        # equalities 0 = 0 (a point contact's angular rows) make the active set's system
+        # singular: drop them (a zero row with a non-zero side would be an infeasible problem)
+        eq = c_mat[:n_eq]
+        zero = ~np.any(eq != 0.0, axis=1)
+        if zero.any():
+            if np.any(lower[:n_eq][zero] != 0.0):
+                raise SolverError("whole-body QP: an equality row is zero but its value is not")
+            keep = np.concatenate([~zero, np.ones(c_mat.shape[0] - n_eq, dtype=bool)])
+            c_mat, lower, upper = c_mat[keep], lower[keep], upper[keep]
+            n_eq -= int(zero.sum())
         senses = np.zeros(lower.shape[0], dtype=np.int32)
         senses[:n_eq] = 5
         key = (n, lower.shape[0])

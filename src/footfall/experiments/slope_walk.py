@@ -55,8 +55,11 @@ def compare_strategies(
     plans: dict[ZmpStrategy, GaitPlan], done: SimResult
 ) -> dict[str, dict[str, Any]]:
     """Table of body sway, margin and speed by strategy value, simulating every plan but the first
-    (whose simulation is ``done``)."""
+    (whose simulation is ``done``), with ``done``'s controller."""
     from footfall.sim.quadruped.sim import simulate
 
     first = next(iter(plans))
-    return {s.value: _row((done if s is first else simulate(p)).metrics) for s, p in plans.items()}
+    return {
+        s.value: _row((done if s is first else simulate(p, controller=done.controller)).metrics)
+        for s, p in plans.items()
+    }

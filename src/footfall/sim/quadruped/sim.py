@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from footfall._typing import FloatArray
 from footfall._validate import positive
-from footfall.errors import FootfallError
+from footfall.errors import FootfallError, InputError
 from footfall.quadruped.gait import GaitParams, GaitPlan, GaitTrajectory, PhaseKind, plan_gait
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
 from footfall.quadruped.stability import centre_of_pressure, stability_margin, support_polygon
@@ -37,6 +37,8 @@ FALL_HEIGHT_FRACTION = 0.5
 FALL_TILT = math.radians(30.0)
 #: video frame rate [1/s]
 VIDEO_FPS = 30
+#: the quadruped's controllers (``simulate(controller=...)``)
+CONTROLLERS = ("servo", "wbc")
 
 
 @dataclass(frozen=True)
@@ -185,6 +187,8 @@ class SimResult:
         sim_time: simulated time [s].
         video: path of the MP4, or None.
         video_note: why there is no video, if there is none.
+        controller: ``servo`` or ``wbc`` (see :func:`simulate`).
+        qp_failures: physics steps whose whole-body QP failed (``wbc``; the last torques held).
     """
 
     t: FloatArray
@@ -201,6 +205,8 @@ class SimResult:
     sim_time: float = 0.0
     video: Path | None = None
     video_note: str = ""
+    controller: str = "servo"
+    qp_failures: int = 0
 
 
 def _pitch_of(xmat: FloatArray) -> float:
@@ -383,6 +389,8 @@ class _Recorder:
         self.sim_time = 0.0
         self.video: Path | None = None
         self.video_note = ""
+        #: whole-body QP solves that failed (the last torques held for that step)
+        self.qp_failures = 0
 
     def measure(self, k: int) -> None:
         """Record sample ``k``: trunk, feet, loaded contacts, CoP, margin, slip; detect a fall."""
@@ -439,6 +447,47 @@ def _track(
             progress(k / n)
 
 
+def _track_wbc(
+    sim: QuadrupedSim,
+    rec: _Recorder,
+    video: _Video,
+    control_dt: float,
+    progress: Callable[[float], None] | None,
+    gains: Any,
+    settle_time: float,
+) -> None:
+    """Drive every joint by torque from the whole-body QP (:mod:`.wbc`) at every physics step,
+    measuring after each control period; it also holds the first reference while the robot
+    settles (no hand-over transient from another controller)."""
+    from footfall.sim.quadruped.wbc import QuadrupedWbc
+
+    m, d, mj = sim.model, sim.data, sim.mujoco
+    wbc = QuadrupedWbc(sim, rec.planned, rec.plan.posture.slope_normal, gains)
+    substeps = max(1, round(control_dt / m.opt.timestep))
+    frame_every = max(1, round(1.0 / (VIDEO_FPS * control_dt)))
+    t_start = float(rec.t[0])
+    every = gains.qp_every
+    for i in range(round(settle_time / m.opt.timestep)):
+        mj.mj_step1(m, d)
+        if i % every == 0:
+            d.ctrl[sim.actuators] = wbc.torques(t_start)
+        mj.mj_step2(m, d)
+    n = rec.t.shape[0]
+    for k in range(n):
+        for s in range(substeps):
+            mj.mj_step1(m, d)
+            i = k * substeps + s
+            if i % every == 0:
+                d.ctrl[sim.actuators] = wbc.torques(t_start + i * m.opt.timestep)
+            mj.mj_step2(m, d)
+        rec.measure(k)
+        if k % frame_every == 0:
+            video.frame(d)
+        if progress is not None and k % 200 == 0:
+            progress(k / n)
+    rec.qp_failures = wbc.failures
+
+
 def simulate(
     plan: GaitPlan,
     settings: SimSettings | None = None,
@@ -447,8 +496,15 @@ def simulate(
     video_path: Path | None = None,
     video_size: tuple[int, int] = (640, 480),
     progress: Callable[[float], None] | None = None,
+    controller: str = "servo",
+    wbc_gains: Any = None,
 ) -> SimResult:
-    """Simulate ``plan`` in MuJoCo with joint position control and measure it.
+    """Simulate ``plan`` in MuJoCo and measure it.
+
+    ``controller``: ``servo`` (document 001: joint position servos on the planned angles) or
+    ``wbc`` (joint torques from the whole-body QP that puts the centre of pressure on the planned
+    ZMP, :mod:`footfall.sim.quadruped.wbc`); ``wbc_gains`` its
+    :class:`~footfall.sim.quadruped.wbc.QuadrupedWbcGains` (None: the defaults).
 
     Args:
         plan: the gait plan (its slope defines the scene).
@@ -464,6 +520,12 @@ def simulate(
         A :class:`SimResult` with metrics.
     """
     control_dt = positive("control_dt", control_dt)
+    if controller not in CONTROLLERS:
+        raise InputError("controller", controller, f"one of {', '.join(CONTROLLERS)}")
+    if controller == "wbc":
+        from footfall.sim.quadruped.wbc import QuadrupedWbcGains, check_gains
+
+        wbc_gains = QuadrupedWbcGains() if wbc_gains is None else check_gains(wbc_gains)
     sim = QuadrupedSim(plan.robot, plan.posture.slope, settings)
     ref = plan.sample(control_dt)
     sim.set_pose(ref.body_pos[0], ref.body_pitch, ref.joints[0])
@@ -471,10 +533,13 @@ def simulate(
     rec = _Recorder(sim, plan, ref)
 
     wall0 = time.perf_counter()
-    # settle in the initial pose so the legs take the weight before the gait starts
-    for _ in range(round(settle_time / sim.model.opt.timestep)):
-        sim.mujoco.mj_step(sim.model, sim.data)
-    _track(sim, rec, video, control_dt, progress)
+    if controller == "wbc":
+        _track_wbc(sim, rec, video, control_dt, progress, wbc_gains, settle_time)
+    else:
+        # settle in the initial pose so the legs take the weight before the gait starts
+        for _ in range(round(settle_time / sim.model.opt.timestep)):
+            sim.mujoco.mj_step(sim.model, sim.data)
+        _track(sim, rec, video, control_dt, progress)
     rec.wall_time = time.perf_counter() - wall0 - video.render_time
     rec.video = video.close()
     rec.video_note = video.note
@@ -494,6 +559,8 @@ def simulate(
         sim_time=rec.sim_time,
         video=rec.video,
         video_note=rec.video_note,
+        controller=controller,
+        qp_failures=rec.qp_failures,
     )
 
 
