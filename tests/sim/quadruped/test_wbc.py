@@ -137,3 +137,24 @@ def test_controller_and_gains_are_checked() -> None:
     with pytest.raises(InputError) as err:
         QuadrupedWbcGains(trunk_kp=-1.0)
     assert err.value.field == "wbc_gains.trunk_kp"
+
+
+def test_a_push_moves_the_trunk_by_its_impulse() -> None:
+    """A lateral push of J [N s] moves the trunk sideways by at most what it would move in free
+    flight over the pulse, 1/2 (J / m) T, and by a good part of it (the legs resist)."""
+    from footfall.sim.pushes import Push
+
+    plan = _plan(15.0, 10.0, cycles=1)
+    push = Push.horizontal(0.5, 40.0, math.pi / 2, 0.1)
+    quiet = simulate(plan, controller="wbc")
+    pushed = simulate(plan, controller="wbc", pushes=(push,))
+    k0, k1 = np.searchsorted(quiet.t, [0.5, 0.6])
+    # the same walk until the push, then pushed sideways (+y) relative to the quiet walk
+    np.testing.assert_allclose(pushed.trunk_pos[:k0], quiet.trunk_pos[:k0], atol=1e-9)
+    dy = pushed.trunk_pos[k1, 1] - quiet.trunk_pos[k1, 1]
+    # free flight would move the trunk 1/2 (J / m) * 0.1 s = 2 cm; the stance legs resist
+    free = 0.5 * 40.0 / plan.robot.total_mass * 0.1
+    assert 0.2 * free < dy < 1.2 * free
+    with pytest.raises(InputError) as err:
+        simulate(plan, pushes=("push",))  # type: ignore[arg-type]
+    assert err.value.field == "pushes[0]"

@@ -26,6 +26,7 @@ from footfall.errors import FootfallError, InputError
 from footfall.quadruped.gait import GaitParams, GaitPlan, GaitTrajectory, PhaseKind, plan_gait
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
 from footfall.quadruped.stability import centre_of_pressure, stability_margin, support_polygon
+from footfall.sim.pushes import Push
 from footfall.sim.quadruped import names as nm
 from footfall.sim.quadruped.mjcf import SimSettings, slope_scene
 
@@ -420,12 +421,22 @@ class _Recorder:
         return bool(tilt > FALL_TILT or low < FALL_HEIGHT_FRACTION * post.height)
 
 
+def _push_force(sim: QuadrupedSim, pushes: tuple[Push, ...], t: float) -> None:
+    """Apply the pushes active at gait time ``t`` [s] to the trunk (world frame, at its centre)."""
+    f = np.zeros(3)
+    for p in pushes:
+        if p.active(t):
+            f += p.force
+    sim.data.xfrc_applied[sim.trunk, :3] = f
+
+
 def _track(
     sim: QuadrupedSim,
     rec: _Recorder,
     video: _Video,
     control_dt: float,
     progress: Callable[[float], None] | None,
+    pushes: tuple[Push, ...] = (),
 ) -> None:
     """Track the planned joint angles sample by sample, measuring after each control period."""
     m, d, mj = sim.model, sim.data, sim.mujoco
@@ -439,6 +450,8 @@ def _track(
         # joint targets interpolated linearly between plan samples at every physics step
         for s in range(substeps):
             d.ctrl[sim.actuators] = q0 + (q1 - q0) * (s / substeps)
+            if pushes:
+                _push_force(sim, pushes, float(rec.t[0]) + (k * substeps + s) * m.opt.timestep)
             mj.mj_step(m, d)
         rec.measure(k)
         if k % frame_every == 0:
@@ -455,6 +468,7 @@ def _track_wbc(
     progress: Callable[[float], None] | None,
     gains: Any,
     settle_time: float,
+    pushes: tuple[Push, ...] = (),
 ) -> None:
     """Drive every joint by torque from the whole-body QP (:mod:`.wbc`) at every physics step,
     measuring after each control period; it also holds the first reference while the robot
@@ -479,6 +493,8 @@ def _track_wbc(
             i = k * substeps + s
             if i % every == 0:
                 d.ctrl[sim.actuators] = wbc.torques(t_start + i * m.opt.timestep)
+            if pushes:
+                _push_force(sim, pushes, t_start + i * m.opt.timestep)
             mj.mj_step2(m, d)
         rec.measure(k)
         if k % frame_every == 0:
@@ -498,13 +514,15 @@ def simulate(
     progress: Callable[[float], None] | None = None,
     controller: str = "servo",
     wbc_gains: Any = None,
+    pushes: tuple[Push, ...] = (),
 ) -> SimResult:
     """Simulate ``plan`` in MuJoCo and measure it.
 
     ``controller``: ``servo`` (document 001: joint position servos on the planned angles) or
     ``wbc`` (joint torques from the whole-body QP that puts the centre of pressure on the planned
     ZMP, :mod:`footfall.sim.quadruped.wbc`); ``wbc_gains`` its
-    :class:`~footfall.sim.quadruped.wbc.QuadrupedWbcGains` (None: the defaults).
+    :class:`~footfall.sim.quadruped.wbc.QuadrupedWbcGains` (None: the defaults). ``pushes``:
+    forces on the trunk (:class:`~footfall.sim.pushes.Push`, times since the gait started).
 
     Args:
         plan: the gait plan (its slope defines the scene).
@@ -520,6 +538,10 @@ def simulate(
         A :class:`SimResult` with metrics.
     """
     control_dt = positive("control_dt", control_dt)
+    pushes = tuple(pushes)
+    for i, p in enumerate(pushes):
+        if not isinstance(p, Push):
+            raise InputError(f"pushes[{i}]", p, "a footfall.sim.Push")
     if controller not in CONTROLLERS:
         raise InputError("controller", controller, f"one of {', '.join(CONTROLLERS)}")
     if controller == "wbc":
@@ -534,12 +556,12 @@ def simulate(
 
     wall0 = time.perf_counter()
     if controller == "wbc":
-        _track_wbc(sim, rec, video, control_dt, progress, wbc_gains, settle_time)
+        _track_wbc(sim, rec, video, control_dt, progress, wbc_gains, settle_time, pushes)
     else:
         # settle in the initial pose so the legs take the weight before the gait starts
         for _ in range(round(settle_time / sim.model.opt.timestep)):
             sim.mujoco.mj_step(sim.model, sim.data)
-        _track(sim, rec, video, control_dt, progress)
+        _track(sim, rec, video, control_dt, progress, pushes)
     rec.wall_time = time.perf_counter() - wall0 - video.render_time
     rec.video = video.close()
     rec.video_note = video.note

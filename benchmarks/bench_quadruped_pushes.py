@@ -1,0 +1,78 @@
+"""Quadruped push survival, servo vs whole-body control: lateral pushes on the trunk during the
+walk gait on the document's 15 degree slope; success (no fall, >= 90 % of the servo walk's
+distance without a push) per impulse and controller, Wilson 95 % intervals, paired McNemar.
+
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_quadruped_pushes.py --seeds 10 --impulses 20,40,60
+
+Trial ``s`` pushes sideways (+y or -y from the seed) for 0.1 s at a seeded time within a seeded
+body shift or swing of cycles 2-4; both controllers get the same push (paired).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+import numpy as np
+from scipy import stats
+
+from footfall.quadruped import GaitParams, QuadrupedRobot, plan_gait
+from footfall.sim.pushes import Push
+from footfall.sim.quadruped.sim import simulate
+
+
+def wilson(k: int, n: int) -> tuple[float, float]:
+    z = 1.959964
+    p = k / n
+    den = 1 + z * z / n
+    mid = (p + z * z / (2 * n)) / den
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
+    return max(0.0, mid - half), min(1.0, mid + half)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--impulses", default="20,40,60", help="N s, comma-separated")
+    ap.add_argument("--slope-deg", type=float, default=15.0)
+    ap.add_argument("--body-deg", type=float, default=10.0)
+    ap.add_argument("--cycles", type=int, default=4)
+    args = ap.parse_args()
+    plan = plan_gait(
+        QuadrupedRobot(),
+        GaitParams(
+            slope=math.radians(args.slope_deg),
+            body_pitch=math.radians(args.body_deg),
+            cycles=args.cycles,
+        ),
+    )
+    base = simulate(plan).metrics.distance_up_slope_m
+    cycle = plan.duration / args.cycles
+    print(
+        f"{args.slope_deg:g} deg, {args.cycles} cycles ({plan.duration:.1f} s), "
+        f"servo distance without push {base:.2f} m"
+    )
+    for imp in (float(x) for x in args.impulses.split(",")):
+        ok: dict[str, list[bool]] = {"servo": [], "wbc": []}
+        for seed in range(args.seeds):
+            rng = np.random.default_rng([seed, 2101])
+            t0 = float(rng.uniform(1.0, min(3.0, args.cycles - 1.0)) * cycle)
+            side = 1.0 if rng.uniform() < 0.5 else -1.0
+            push = Push.horizontal(t0, imp, side * math.pi / 2, 0.1)
+            for ctrl in ok:
+                m = simulate(plan, controller=ctrl, pushes=(push,)).metrics
+                ok[ctrl].append(bool(not m.fell and m.distance_up_slope_m >= 0.9 * base))
+        line = [f"{imp:5.1f} N s:"]
+        for ctrl, v in ok.items():
+            k, n = sum(v), len(v)
+            lo, hi = wilson(k, n)
+            line.append(f"{ctrl} {k}/{n} ({100 * lo:.0f}-{100 * hi:.0f} %)")
+        a = sum(x and not y for x, y in zip(ok["wbc"], ok["servo"], strict=True))
+        b = sum(y and not x for x, y in zip(ok["wbc"], ok["servo"], strict=True))
+        p = 1.0 if a + b == 0 else stats.binomtest(a, a + b, 0.5).pvalue
+        line.append(f"wbc-only {a}, servo-only {b}, McNemar p = {p:.2g}")
+        print("  ".join(line), flush=True)
+
+
+if __name__ == "__main__":
+    main()
