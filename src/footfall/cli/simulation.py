@@ -46,9 +46,11 @@ def demo(out: Path = typer.Option(Path("out/demo"), help="Output folder.")) -> N
 # --- quadruped (document 001) ---
 @app.command("quadruped")
 def quadruped_cmd(
-    slope_deg: float = typer.Option(15.0, help="Slope angle beta_S [deg]."),
+    slope_deg: float = typer.Option(
+        15.0, help="Slope angle beta_S [deg]; negative walks downhill."
+    ),
     body_deg: float = typer.Option(
-        10.0, help="Body angle beta_B to the horizontal [deg], in [0, slope]."
+        10.0, help="Body angle beta_B to the horizontal [deg], between 0 and the slope."
     ),
     step: float = typer.Option(0.4, help="Step length S along the slope [m]."),
     height: float = typer.Option(0.1, help="Swing height H normal to the slope [m]."),
@@ -78,11 +80,12 @@ def quadruped_cmd(
 
     if controller not in ("servo", "wbc"):
         raise InputError("--controller", controller, "servo or wbc")
-    if not math.isfinite(slope_deg) or not 0.0 <= slope_deg <= 60.0:
-        raise InputError("--slope-deg", slope_deg, "a slope in [0, 60] deg")
-    if not math.isfinite(body_deg) or not 0.0 <= body_deg <= slope_deg:
+    if not math.isfinite(slope_deg) or not -60.0 <= slope_deg <= 60.0:
+        raise InputError("--slope-deg", slope_deg, "a slope in [-60, 60] deg (negative: downhill)")
+    lo, hi = min(0.0, slope_deg), max(0.0, slope_deg)
+    if not math.isfinite(body_deg) or not lo <= body_deg <= hi:
         raise InputError(
-            "--body-deg", body_deg, f"a body angle within [0, --slope-deg] = [0, {slope_deg:g}] deg"
+            "--body-deg", body_deg, f"a body angle between 0 and --slope-deg = {slope_deg:g} deg"
         )
     try:
         strat = ZmpStrategy(strategy)

@@ -91,15 +91,17 @@ class SlopePosture:
     mode: BodyPosture = BodyPosture.COMPROMISE
 
     def __post_init__(self) -> None:
-        slope = non_negative("slope", self.slope)
-        if slope > MAX_SLOPE:
-            raise InputError("slope", slope, f"at most {MAX_SLOPE:.3f} rad (60 deg)")
+        slope = finite("slope", self.slope)
+        if abs(slope) > MAX_SLOPE:
+            raise InputError("slope", slope, f"within +-{MAX_SLOPE:.3f} rad (60 deg)")
         pitch = finite("body_pitch", self.body_pitch)
-        if not 0.0 <= pitch <= slope + 1e-12:
+        lo, hi = min(0.0, slope), max(0.0, slope)
+        if not lo - 1e-12 <= pitch <= hi + 1e-12:
             raise InputError(
                 "body_pitch",
                 round(pitch, 6),
-                f"within [0, slope] = [0, {slope:.4f}] rad ([0, {math.degrees(slope):.2f}] deg)",
+                f"within [0, slope] = [{lo:.4f}, {hi:.4f}] rad "
+                f"([{math.degrees(lo):.2f}, {math.degrees(hi):.2f}] deg; negative downhill)",
             )
         object.__setattr__(self, "slope", slope)
         object.__setattr__(self, "body_pitch", pitch)

@@ -158,3 +158,29 @@ def test_a_push_moves_the_trunk_by_its_impulse() -> None:
     with pytest.raises(InputError) as err:
         simulate(plan, pushes=("push",))  # type: ignore[arg-type]
     assert err.value.field == "pushes[0]"
+
+
+def test_downhill_walk_descends_with_the_cop_on_the_plan() -> None:
+    """A negative slope walks downhill (issue 21): the trunk goes down by about the slope's drop
+    over the distance walked, and the wbc keeps the CoP on the planned ZMP."""
+    plan = _plan(-15.0, -10.0)
+    res = simulate(plan, controller="wbc")
+    m = res.metrics
+    assert not m.fell and res.qp_failures == 0
+    dx = res.trunk_pos[-1, 0] - res.trunk_pos[0, 0]
+    dz = res.trunk_pos[-1, 2] - res.trunk_pos[0, 2]
+    assert dx > 0.3
+    assert dz == pytest.approx(dx * math.tan(math.radians(-15.0)), abs=0.03)
+    assert m.zmp_error_mean_m <= COP_MEAN_MAX and m.zmp_error_max_m <= COP_MAX_MAX
+
+
+def test_downhill_posture_is_checked() -> None:
+    from footfall.quadruped.posture import BodyPosture, SlopePosture
+
+    SlopePosture(math.radians(-20.0), math.radians(-13.0), 0.5, BodyPosture.COMPROMISE)
+    with pytest.raises(InputError) as err:  # a nose-up body on a downhill slope
+        SlopePosture(math.radians(-20.0), math.radians(5.0), 0.5, BodyPosture.COMPROMISE)
+    assert err.value.field == "body_pitch"
+    with pytest.raises(InputError) as err:
+        SlopePosture(math.radians(-61.0), 0.0, 0.5, BodyPosture.COMPROMISE)
+    assert err.value.field == "slope"
