@@ -22,7 +22,7 @@ from enum import Enum
 import numpy as np
 
 from footfall._typing import FloatArray
-from footfall._validate import finite, non_negative, positive
+from footfall._validate import finite, positive
 from footfall.errors import InputError
 from footfall.quadruped.kinematics import body_rotation
 from footfall.quadruped.robot import LEGS, Leg, QuadrupedRobot
