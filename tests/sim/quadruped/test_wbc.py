@@ -184,3 +184,24 @@ def test_downhill_posture_is_checked() -> None:
     with pytest.raises(InputError) as err:
         SlopePosture(math.radians(-61.0), 0.0, 0.5, BodyPosture.COMPROMISE)
     assert err.value.field == "slope"
+
+
+@pytest.mark.parametrize("friction", [0.4, 1.0])
+def test_the_friction_setting_is_the_contacts_friction(friction: float) -> None:
+    """MuJoCo mixes two geoms' friction by their maximum unless one has priority: the feet have
+    it, so SimSettings.friction is the friction of every foot contact (the floor's default 1 did
+    override a smaller setting before) and the wbc's friction pyramid uses the same number."""
+    from footfall.sim.quadruped.mjcf import SimSettings
+
+    plan = _plan(15.0, 10.0, cycles=1)
+    ref = plan.sample(0.01)
+    sim = QuadrupedSim(plan.robot, plan.posture.slope, SimSettings(friction=friction))
+    sim.set_pose(ref.body_pos[0], ref.body_pitch, ref.joints[0])
+    for _ in range(50):
+        mujoco.mj_step(sim.model, sim.data)
+    d = sim.data
+    feet = set(sim.foot_geoms)
+    mus = [float(d.contact[i].friction[0]) for i in range(d.ncon) if set(d.contact[i].geom) & feet]
+    assert len(mus) >= 4 and np.allclose(mus, friction)
+    wbc = QuadrupedWbc(sim, ref, plan.posture.slope_normal, QuadrupedWbcGains())
+    assert wbc.friction == pytest.approx(friction)

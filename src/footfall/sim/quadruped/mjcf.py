@@ -113,7 +113,7 @@ def _leg_xml(robot: QuadrupedRobot, settings: SimSettings, leg_index: int) -> st
             <geom type="capsule" fromto="0 0 0 0 0 {-l2:.6g}" size="{shank_r}" material="leg"
                   {nocol}/>
             <geom name="{nm.foot_geom(leg)}" type="sphere" size="{r:.6g}" pos="0 0 {-l2:.6g}"
-                  material="foot" friction="{settings.friction:.6g} 0.02 0.002"
+                  material="foot" friction="{settings.friction:.6g} 0.02 0.002" priority="1"
                   contype="{nm.ROBOT_CONTYPE}" conaffinity="{nm.ROBOT_CONAFFINITY}"/>
             <site name="{nm.foot_site(leg)}" pos="0 0 {-l2:.6g}" size="0.01"/>
           </body>
