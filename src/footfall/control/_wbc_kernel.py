@@ -50,6 +50,7 @@ def assemble(
     points: np.ndarray,
     n_points: np.ndarray,
     normal: np.ndarray,
+    tangent: np.ndarray,
     friction: np.ndarray,
     min_normal: np.ndarray,
     motion_jac: np.ndarray,
@@ -68,7 +69,8 @@ def assemble(
 
     Shapes: ``mass`` (nv, nv), ``bias`` (nv,), ``actuated`` (na,), ``unactuated`` (nu,);
     per contact c < nc: ``jac`` (nc, 6, nv), ``drift`` (nc, 6), ``origin`` (nc, 3), ``points``
-    (nc, kmax, 3) of which the first ``n_points[c]`` count, ``normal`` (nc, 3), ``friction`` and
+    (nc, kmax, 3) of which the first ``n_points[c]`` count, ``normal`` (nc, 3), ``tangent``
+    (nc, 3) (the first face direction of the friction pyramid; zero: any), ``friction`` and
     ``min_normal`` (nc,); motion rows ``motion_jac`` (rm, nv), ``motion_rhs`` (rm,) (the desired
     acceleration minus the drift), ``motion_w`` (rm,); wrench rows ``wrench_rows`` (rw, 6),
     ``wrench_about`` (rw, 3), ``wrench_target`` (rw,), ``wrench_w`` (rw,), ``wrench_mask``
@@ -170,6 +172,11 @@ def assemble(
     for c in range(nc):
         nrm = normal[c]
         t1, t2 = _tangents(nrm)
+        if tangent[c, 0] != 0.0 or tangent[c, 1] != 0.0 or tangent[c, 2] != 0.0:
+            t1 = tangent[c].copy()
+            t2[0] = nrm[1] * t1[2] - nrm[2] * t1[1]
+            t2[1] = nrm[2] * t1[0] - nrm[0] * t1[2]
+            t2[2] = nrm[0] * t1[1] - nrm[1] * t1[0]
         mu = friction[c] * PYRAMID_SHARE
         for i in range(n_points[c]):
             col = nv + offset[c] + 3 * i

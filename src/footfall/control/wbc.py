@@ -82,6 +82,11 @@ class Contact:
         normal: (3,) unit contact normal (pointing into the robot).
         friction: Coulomb friction coefficient.
         min_normal: lower bound of each point's normal force [N].
+        tangent: (3,) unit tangent (orthogonal to ``normal``) that sets the orientation of the
+            friction pyramid: its faces bound the force along ``tangent`` and ``normal x
+            tangent`` by ``mu / sqrt(2)``, its edges reach the cone (``mu``) half-way between
+            them. None: any orientation. A contact that must hold a known tangential load (a
+            foot on a slope) admits the most when that load points at an edge.
     """
 
     name: str
@@ -92,6 +97,7 @@ class Contact:
     normal: FloatArray
     friction: float
     min_normal: float = 0.0
+    tangent: FloatArray | None = None
 
     @property
     def n_points(self) -> int:
@@ -107,6 +113,7 @@ class Contact:
         normal: FloatArray,
         friction: float,
         min_normal: float = 0.0,
+        tangent: FloatArray | None = None,
     ) -> Contact:
         """A point foot (a quadruped's sphere on the ground): one force at ``point`` (3,) [m],
         whose velocity must not change (``jacobian`` (3, nv) and ``drift`` (3,) of the point,
@@ -119,7 +126,15 @@ class Contact:
         dr[:3] = drift
         p = np.asarray(point, dtype=float)
         return cls(
-            name, jac, dr, p, p.reshape(1, 3), np.asarray(normal, float), friction, min_normal
+            name,
+            jac,
+            dr,
+            p,
+            p.reshape(1, 3),
+            np.asarray(normal, float),
+            friction,
+            min_normal,
+            tangent,
         )
 
 
@@ -314,6 +329,7 @@ def _pack(p: WbcProblem) -> tuple[Any, ...]:
     points = np.zeros((nc, kmax, 3))
     n_points = np.zeros(nc, dtype=np.int64)
     normal = np.zeros((nc, 3))
+    tangent = np.zeros((nc, 3))
     friction = np.zeros(nc)
     min_normal = np.zeros(nc)
     for i, c in enumerate(p.contacts):
@@ -321,6 +337,8 @@ def _pack(p: WbcProblem) -> tuple[Any, ...]:
         points[i, : c.n_points] = c.points
         n_points[i] = c.n_points
         normal[i], friction[i], min_normal[i] = c.normal, c.friction, c.min_normal
+        if c.tangent is not None:
+            tangent[i] = c.tangent
     rm = sum(t.acceleration.shape[0] for t in p.motion_tasks)
     m_jac, m_rhs, m_w = np.empty((rm, nv)), np.empty(rm), np.empty(rm)
     r0 = 0
@@ -356,6 +374,7 @@ def _pack(p: WbcProblem) -> tuple[Any, ...]:
         points,
         n_points,
         normal,
+        tangent,
         friction,
         min_normal,
         m_jac,
@@ -398,6 +417,13 @@ def _check_problem(p: WbcProblem) -> None:
             raise InputError(f"contact {c.name}.friction", c.friction, "a positive number")
         if abs(float(np.linalg.norm(c.normal)) - 1.0) > 1e-6:
             raise InputError(f"contact {c.name}.normal", c.normal.tolist(), "a unit vector")
+        if c.tangent is not None:
+            _shape(f"contact {c.name}.tangent", c.tangent, (3,))
+            tg = np.asarray(c.tangent, dtype=float)
+            if abs(float(np.linalg.norm(tg)) - 1.0) > 1e-6 or abs(float(tg @ c.normal)) > 1e-6:
+                raise InputError(
+                    f"contact {c.name}.tangent", tg.tolist(), "a unit vector orthogonal to normal"
+                )
     for t in p.motion_tasks:
         r = t.acceleration.shape[0] if np.ndim(t.acceleration) == 1 else -1
         _weights(t.weight, r, t.name)

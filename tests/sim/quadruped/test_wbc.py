@@ -205,3 +205,16 @@ def test_the_friction_setting_is_the_contacts_friction(friction: float) -> None:
     assert len(mus) >= 4 and np.allclose(mus, friction)
     wbc = QuadrupedWbc(sim, ref, plan.posture.slope_normal, QuadrupedWbcGains())
     assert wbc.friction == pytest.approx(friction)
+
+
+def test_forty_degrees_is_walked_with_the_pyramid_edge_downhill() -> None:
+    """With the friction pyramid turned so that gravity's pull along the slope points at an edge
+    (where it reaches Coulomb's cone), the wbc walks 40 degrees at friction 1: an inscribed
+    pyramid facing the slope would admit atan(1 / sqrt(2)) = 35 degrees and its QP would fail."""
+    params = GaitParams(
+        slope=math.radians(40.0), body_pitch=math.radians(27.0), step=0.25, cycles=2
+    )
+    plan = plan_gait(QuadrupedRobot(), params)
+    res = simulate(plan, controller="wbc")
+    assert not res.metrics.fell and res.qp_failures == 0
+    assert res.metrics.zmp_error_mean_m <= COP_MEAN_MAX

@@ -156,6 +156,16 @@ class QuadrupedWbc:
         self.ref = _Reference(ref)
         self.gains = gains
         self.normal = np.asarray(normal, dtype=float)
+        # Gravity's pull along the slope points at an edge of the friction pyramid (where it
+        # reaches Coulomb's cone, mu) rather than at a face (mu / sqrt(2)): the first face
+        # direction is the downhill direction turned 45 degrees about the normal.
+        down = np.array([0.0, 0.0, -1.0]) - self.normal * (-self.normal[2])
+        if np.linalg.norm(down) > 1e-9:
+            down /= np.linalg.norm(down)
+            side = np.cross(self.normal, down)
+            self.tangent: FloatArray | None = (down + side) / math.sqrt(2.0)
+        else:  # flat ground: no preferred direction
+            self.tangent = None
         self.friction = float(m.geom_friction[sim.foot_geoms[0], 0])
         self.radius = float(m.geom_size[sim.foot_geoms[0], 0])
         self.foot_bodies = [int(m.site_bodyid[s]) for s in sim.foot_sites]
@@ -197,7 +207,9 @@ class QuadrupedWbc:
                 jac, drift = self.model.frame(self.foot_bodies[leg], pt)
                 name = f"foot{leg}"
                 contacts.append(
-                    Contact.point(name, jac[:3], drift[:3], pt, self.normal, self.friction)
+                    Contact.point(
+                        name, jac[:3], drift[:3], pt, self.normal, self.friction, 0.0, self.tangent
+                    )
                 )
                 points.append(pt)
                 if stance[leg] and g.unload_time > 0 and to_switch[leg] < g.unload_time:
