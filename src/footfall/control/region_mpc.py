@@ -1,0 +1,355 @@
+"""Region-aware footstep corrections: the MPC of eq. (5.19) with the next footstep in a foothold.
+
+Beyond the document: section 5.4 leaves foothold regions and reach to the planner, and its MPC
+(eq. 5.19a-e) moves the next footstep ``p_{i+1}`` freely. Here the footstep the MPC may choose
+is kept in a convex foothold region (eq. 5.18) inset by the sole, as linear rows ``G d <= h`` on
+the footstep offset ``d = p_{i+1} - p_i`` (x, y) *in the same QP* as the torques:
+
+    minimise  1/2 z^T H z + z^T F theta + c(theta)        (5.19a, condensed; z = [u; d])
+    s.t.      ||u_j / U||_2 <= 1  per torque block         (5.19e)
+              G d <= h                                     (region rows, beyond the document)
+
+``H``, ``F``, ``c`` are those of :func:`footfall.control.mpc.build_mpc`. The sole inset
+(:func:`sole_inset_offsets`) is exact for a rectangle ``foot_length x foot_width`` at the
+footstep's heading: row ``g`` moves in by the sole's support ``L/2 |g . t| + W/2 |g . s|``
+(``t``, ``s`` the sole's forward and lateral axes), i.e. the region shrunk by the Minkowski
+difference with the sole, so every point of the sole lies in the region.
+
+Solution (exact, three stages, cheapest first):
+
+1. the unconstrained optimum (:meth:`MPC.solve_theta`); if it satisfies the rows it is optimal;
+2. with the torque balls inactive the torques are eliminated in closed form,
+   ``u(d) = u_0(theta) + K d``, leaving a strictly convex 2-D QP in ``d`` over the polygon. Its
+   minimiser is the unconstrained one or lies on one row (the minimiser on that row's line) or on
+   two (their intersection): every candidate is evaluated and the feasible one with the least
+   cost is the optimum (:func:`solve_polygon_qp`). If ``u(d)`` then satisfies the balls, the
+   pair is a KKT point of the full problem (zero ball multipliers) and hence optimal;
+3. otherwise the full second-order cone program is solved with Clarabel.
+
+Several regions (dairlib's ``AlipMultiQP`` approach): one QP per candidate region, the planned
+(or previously chosen) region first; another is chosen when the first has no feasible footstep,
+or when its optimal cost exceeds another's by more than ``switch_margin``
+(:func:`choose_region`). The cost compared is the full eq. (5.19a) cost.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from footfall._typing import FloatArray
+from footfall.control.mpc import MPC, MPCSolution, MPCStatus, _clarabel_in_polygon
+from footfall.errors import InputError
+
+#: a footstep this far [m] outside a region row still satisfies it (solver tolerance)
+ROW_TOL = 1e-9
+#: a torque block this much above its bound (relative) still counts as inside (stage 2 test)
+BALL_TOL = 1e-9
+#: how a region solution was found (:class:`RegionSolution.method`)
+METHODS = ("unconstrained", "polygon_qp", "clarabel", "infeasible")
+
+
+def sole_inset_offsets(
+    a: FloatArray, b: FloatArray, heading: float, length: float, width: float, margin: float = 0.0
+) -> FloatArray:
+    """Offsets ``h`` (E,) [m] of the rows ``a p <= h`` that keep a whole sole in ``a p <= b``.
+
+    The sole is a ``length x width`` rectangle centred on ``p`` (2,) and turned by ``heading``
+    [rad]; row ``a_i`` (a unit outward normal) moves in by the sole's support in that direction,
+    ``length/2 |a_i . t| + width/2 |a_i . s|`` with ``t = (cos, sin)``, ``s = (-sin, cos)``, plus
+    ``margin`` [m].
+
+    Args:
+        a: unit outward normals (E, 2) of the region (eq. 5.18).
+        b: offsets (E,) [m].
+        heading: sole heading [rad].
+        length: sole length [m].
+        width: sole width [m].
+        margin: extra inset [m], >= 0.
+    """
+    t = np.array([math.cos(heading), math.sin(heading)])
+    s = np.array([-t[1], t[0]])
+    return np.asarray(b - 0.5 * length * np.abs(a @ t) - 0.5 * width * np.abs(a @ s) - margin)
+
+
+def solve_polygon_qp(
+    m_hess: FloatArray, m_lin: FloatArray, g: FloatArray, h: FloatArray, tol: float = ROW_TOL
+) -> tuple[FloatArray, tuple[int, ...]] | None:
+    """Exact minimiser of ``1/2 d^T M d + m^T d`` over the polygon ``G d <= h`` (2-D, M > 0).
+
+    The KKT point has at most two active rows (in 2-D any vertex is the intersection of two of
+    its rows), so it is among: the unconstrained minimiser, the minimiser on each row's line, and
+    each pair of rows' intersection. The feasible candidate of least cost is the optimum.
+
+    Args:
+        m_hess: M (2, 2), symmetric positive definite.
+        m_lin: m (2,).
+        g: rows (E, 2).
+        h: offsets (E,).
+        tol: feasibility tolerance of a candidate [same units as ``h``].
+
+    Returns:
+        ``(d (2,), active rows)`` or None when the polygon is empty.
+    """
+    m_inv = np.linalg.inv(m_hess)
+    d0 = -m_inv @ m_lin
+    if np.all(g @ d0 <= h + tol):
+        return d0, ()
+    e = g.shape[0]
+    cands = [d0[None, :]]
+    idx: list[tuple[int, ...]] = [()]
+    # minimiser on the line g_i d = h_i: d0 + M^-1 g_i (h_i - g_i d0) / (g_i M^-1 g_i)
+    mg = g @ m_inv  # (E, 2), rows M^-1 g_i (M symmetric)
+    den = np.einsum("ij,ij->i", mg, g)
+    cands.append(d0 + mg * ((h - g @ d0) / den)[:, None])
+    idx += [(i,) for i in range(e)]
+    ii, jj = np.triu_indices(e, 1)
+    det = g[ii, 0] * g[jj, 1] - g[ii, 1] * g[jj, 0]
+    ok = np.abs(det) > 1e-12
+    ii, jj, det = ii[ok], jj[ok], det[ok]
+    # Cramer's rule for [g_i; g_j] d = [h_i; h_j]
+    px = (h[ii] * g[jj, 1] - h[jj] * g[ii, 1]) / det
+    py = (g[ii, 0] * h[jj] - g[jj, 0] * h[ii]) / det
+    cands.append(np.stack([px, py], axis=1))
+    idx += [(int(i), int(j)) for i, j in zip(ii, jj, strict=True)]
+    pts = np.vstack(cands)
+    feas = np.all(pts @ g.T <= h + tol, axis=1)
+    if not feas.any():
+        return None
+    cost = 0.5 * np.einsum("ij,jk,ik->i", pts, m_hess, pts) + pts @ m_lin
+    cost[~feas] = np.inf
+    best = int(np.argmin(cost))
+    return pts[best], idx[best]
+
+
+@dataclass(frozen=True)
+class RegionRows:
+    """A candidate foothold: the region rows ``g d <= h`` on the footstep offset from the stance.
+
+    Attributes:
+        name: the region's name.
+        g: unit outward normals (E, 2), in the MPC's frame.
+        h: offsets (E,) [m] of ``d = p_{i+1} - p_i`` (already inset by the sole).
+    """
+
+    name: str
+    g: FloatArray
+    h: FloatArray
+
+    def __post_init__(self) -> None:
+        g = np.asarray(self.g, dtype=float)
+        h = np.asarray(self.h, dtype=float)
+        if g.ndim != 2 or g.shape[1] != 2 or g.shape[0] < 1 or not np.all(np.isfinite(g)):
+            raise InputError(f"regions[{self.name}].g", g.tolist(), "finite rows of shape (E, 2)")
+        if h.shape != (g.shape[0],) or not np.all(np.isfinite(h)):
+            raise InputError(f"regions[{self.name}].h", h.tolist(), f"shape ({g.shape[0]},)")
+        object.__setattr__(self, "g", g)
+        object.__setattr__(self, "h", h)
+
+    def violation(self, d: FloatArray) -> float:
+        """``max(g d - h)`` [m]: <= 0 when ``d`` (2,) satisfies every row."""
+        return float(np.max(self.g @ d - self.h))
+
+
+@dataclass(frozen=True)
+class RegionSolution:
+    """Eq. (5.19) solved with the next footstep in one region (or the region chosen among several).
+
+    Attributes:
+        solution: the MPC solution (torques, next footstep).
+        region: the region the footstep is in ("" when no candidate was feasible: ``solution``
+            is then the unconstrained one).
+        method: one of :data:`METHODS`.
+        cost: full eq. (5.19a) cost of the solution (inf when infeasible).
+        reason: why this region: ``planned``, ``kept`` (the region chosen earlier in this
+            support), ``first infeasible`` (the preferred region had no footstep the sole fits),
+            ``cheaper`` (cost lower by more than the switch margin) or ``none feasible``.
+        costs: every candidate's optimal cost by name (inf: infeasible).
+    """
+
+    solution: MPCSolution
+    region: str
+    method: str
+    cost: float
+    reason: str = ""
+    costs: dict[str, float] = field(default_factory=dict)
+
+
+class RegionMPC:
+    """The MPC of eq. (5.19) with the next footstep kept in foothold regions (module docstring).
+
+    Wraps an :class:`MPC` (its warm starts, counters and fallbacks) and precomputes, per tick,
+    the elimination of the torques used by stage 2.
+
+    Args:
+        mpc: the MPC to wrap.
+    """
+
+    def __init__(self, mpc: MPC) -> None:
+        if not isinstance(mpc, MPC):
+            raise InputError("mpc", mpc, "an MPC")
+        self.mpc = mpc
+        mdl = mpc.model
+        self._u0: list[FloatArray] = []  # u_0 = u0_map theta, (n_u, 10)
+        self._k: list[FloatArray] = []  # u = u_0 + K d, (n_u, 2)
+        self._m: list[FloatArray] = []  # M (2, 2)
+        self._m_lin: list[FloatArray] = []  # m = m_lin theta, (2, 10)
+        for k_s in range(mdl.n_ticks):
+            h, f = mdl.H[k_s], mdl.F[k_s]
+            n_u = h.shape[0] - 2
+            h_uu, h_ud, h_dd = h[:n_u, :n_u], h[:n_u, n_u:], h[n_u:, n_u:]
+            u0 = -np.linalg.solve(h_uu, f[:n_u])
+            k = -np.linalg.solve(h_uu, h_ud)
+            m = h_dd + h_ud.T @ k
+            self._u0.append(np.asarray(u0, dtype=float))
+            self._k.append(np.asarray(k, dtype=float))
+            self._m.append(0.5 * (m + m.T))
+            self._m_lin.append(f[n_u:] + h_ud.T @ u0)
+
+    def solve_region(
+        self,
+        k_s: int,
+        theta: FloatArray,
+        p_stance: FloatArray,
+        p_next_ref: FloatArray,
+        rows: RegionRows,
+        unconstrained: MPCSolution | None = None,
+    ) -> RegionSolution:
+        """Eq. (5.19) at tick ``k_s`` with the next footstep in ``rows`` (module docstring).
+
+        Args:
+            k_s: control tick, 0 <= k_s < M.
+            theta: ``[x_measured (4), (p_next_ref - p_stance)[:2], x_next_ref (4)]`` (10,).
+            p_stance: stance footstep p_i (3,) [m].
+            p_next_ref: planned next footstep (3,) [m] (its height is kept).
+            rows: the region rows on ``d = p_{i+1} - p_i``.
+            unconstrained: the unconstrained solution of this tick if already solved.
+
+        Returns:
+            The :class:`RegionSolution`; ``method`` ``infeasible`` (with the unconstrained
+            solution and an infinite cost) when no footstep satisfies the rows.
+        """
+        t0 = time.perf_counter()
+        sol = unconstrained
+        if sol is None:
+            sol = self.mpc.solve_theta(k_s, theta, p_stance, p_next_ref, t0)
+        if sol.fallback:
+            return RegionSolution(sol, "", "infeasible", math.inf)
+        d = sol.next_footstep[:2] - p_stance[:2]
+        if rows.violation(d) <= ROW_TOL:
+            cost = self.cost(k_s, sol.torques, d, theta)
+            return RegionSolution(sol, rows.name, "unconstrained", cost)
+        res = solve_polygon_qp(self._m[k_s], self._m_lin[k_s] @ theta, rows.g, rows.h)
+        if res is None:
+            return RegionSolution(sol, "", "infeasible", math.inf)
+        d = res[0]
+        u = self._u0[k_s] @ theta + self._k[k_s] @ d
+        mdl = self.mpc.model
+        v = u.reshape(-1, 2) / mdl.u_limits
+        method = "polygon_qp"
+        lam = np.zeros(v.shape[0])
+        iters = 0
+        if np.einsum("ij,ij->i", v, v).max() > 1.0 + BALL_TOL:
+            clar = self._clarabel(k_s, theta, p_stance, rows)
+            if clar is None:
+                return RegionSolution(sol, "", "infeasible", math.inf)
+            u, d, lam, iters = clar
+            method = "clarabel"
+        out = MPCSolution(
+            k_s=k_s,
+            torques=u.reshape(-1, 2),
+            block_ticks=mdl.block_ticks[k_s],
+            next_footstep=np.array([p_stance[0] + d[0], p_stance[1] + d[1], p_next_ref[2]]),
+            status=MPCStatus.OPTIMAL,
+            fallback=False,
+            solve_time=sol.solve_time + time.perf_counter() - t0,
+            iterations=iters,
+            multipliers=lam,
+        )
+        return RegionSolution(out, rows.name, method, self.cost(k_s, u, d, theta))
+
+    def _clarabel(
+        self, k_s: int, theta: FloatArray, p_stance: FloatArray, rows: RegionRows
+    ) -> tuple[FloatArray, FloatArray, FloatArray, int] | None:
+        """Stage 3: the full cone program; ``(u, d, ball multipliers, iterations)`` or None."""
+        mdl = self.mpc.model
+        n_u = mdl.H[k_s].shape[0] - 2
+        scale = np.concatenate([np.tile(mdl.u_limits, n_u // 2), np.ones(2)])
+        p = scale[:, None] * mdl.H[k_s] * scale[None, :]
+        q = scale * (mdl.F[k_s] @ theta)
+        try:
+            res = _clarabel_in_polygon(p, q, rows.g, rows.h, n_u)
+        except (ValueError, RuntimeError):  # pragma: no cover - solver internals
+            return None
+        if str(res.status) not in ("Solved", "AlmostSolved"):
+            return None
+        z = np.asarray(res.x, dtype=float)
+        vb = z[:n_u].reshape(-1, 2)
+        vb = vb / np.maximum(np.linalg.norm(vb, axis=1), 1.0)[:, None]
+        duals = np.asarray(res.z, dtype=float)[rows.g.shape[0] :].reshape(-1, 3)[:, 0]
+        return (vb * mdl.u_limits).ravel(), z[n_u:], duals, int(res.iterations)
+
+    def cost(self, k_s: int, u: FloatArray, d: FloatArray, theta: FloatArray) -> float:
+        """Full eq. (5.19a) cost at tick ``k_s`` of torques ``u`` (n_u,) [N m] and footstep
+        offset ``d`` (2,) [m]."""
+        return self.mpc.model.cost(k_s, np.concatenate([np.ravel(u), d]), theta)
+
+    def solve(
+        self,
+        k_s: int,
+        theta: FloatArray,
+        p_stance: FloatArray,
+        p_next_ref: FloatArray,
+        candidates: Sequence[RegionRows],
+        switch_margin: float,
+        first_reason: str = "planned",
+    ) -> RegionSolution:
+        """Eq. (5.19) with one QP per candidate region; the chosen one (:func:`choose_region`).
+
+        Args:
+            k_s, theta, p_stance, p_next_ref: as for :meth:`solve_region`.
+            candidates: the regions, the preferred one (planned or kept) first.
+            switch_margin: another region is chosen over the first only if its cost is lower by
+                more than this.
+            first_reason: the reason reported when the first candidate is chosen.
+        """
+        if not candidates:
+            raise InputError("candidates", candidates, "at least one region")
+        t0 = time.perf_counter()
+        unc = self.mpc.solve_theta(k_s, theta, p_stance, p_next_ref, t0)
+        sols = [self.solve_region(k_s, theta, p_stance, p_next_ref, c, unc) for c in candidates]
+        best = choose_region(sols, switch_margin, first_reason)
+        costs = {c.name: s.cost for c, s in zip(candidates, sols, strict=True)}
+        chosen = replace(
+            best,
+            costs=costs,
+            solution=replace(best.solution, solve_time=time.perf_counter() - t0),
+        )
+        if chosen.region:
+            self.mpc._last = chosen.solution  # warm start / fallback from what is applied
+        return chosen
+
+
+def choose_region(
+    sols: Sequence[RegionSolution], switch_margin: float, first_reason: str = "planned"
+) -> RegionSolution:
+    """The region among ``sols`` (one per candidate, the preferred first) to step into.
+
+    The first, unless it is infeasible (then the cheapest feasible: ``first infeasible``) or
+    another is cheaper by more than ``switch_margin`` (``cheaper``); when none is feasible the
+    first (unconstrained) solution with reason ``none feasible``.
+    """
+    first = sols[0]
+    feas = [s for s in sols if math.isfinite(s.cost)]
+    if not feas:
+        return replace(first, region="", reason="none feasible")
+    best = min(feas, key=lambda s: s.cost)
+    if not math.isfinite(first.cost):
+        return replace(best, reason="first infeasible")
+    if best is not first and best.cost < first.cost - switch_margin:
+        return replace(best, reason="cheaper")
+    return replace(first, reason=first_reason)
