@@ -150,7 +150,7 @@ def test_every_stage_of_the_solver_is_used(model) -> None:  # type: ignore[no-un
         h = np.array([c[0] + 0.02, 0.02 - c[0], c[1] + 0.03, 0.03 - c[1]])
         rs = RegionMPC(MPC(model)).solve(k_s, theta, stance, ref, [RegionRows("r", g, h)], 0.1)
         methods.add(rs.method)
-    assert methods == {"unconstrained", "polygon_qp", "clarabel"}
+    assert methods == {"unconstrained", "polygon_qp", "active_set"}
 
 
 def _stones() -> dict[str, Region]:

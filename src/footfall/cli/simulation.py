@@ -23,6 +23,12 @@ from footfall.cli._common import (
 from footfall.cli._progress import ProgressLog
 from footfall.errors import InputError
 
+_REGION_HELP = (
+    "How the MPC keeps the next footstep on the terrain (issue 23): off (document 000: free; "
+    "the MuJoCo walker keeps a uniform margin inside the planned region), planned (in the planned "
+    "region inset by the sole, same QP), nearby (or the best region within reach)."
+)
+
 
 # --- demo ---
 @app.command()
@@ -137,6 +143,7 @@ def simulate_command(
     engine: str = typer.Option(
         "auto", help="Loop engine: auto, compiled (numba) or python (reference)."
     ),
+    region_aware: str = typer.Option("off", "--region-aware", help=_REGION_HELP),
     out: Path = typer.Option(Path("out/simulate"), help="Output folder."),
 ) -> None:
     """Plan a scene, walk it in closed loop (MPC eq. 5.19 on the ALIP plant), write sim.json + figures."""
@@ -162,6 +169,7 @@ def simulate_command(
         placement_error=placement_error,
         seed=seed,
         engine=engine,
+        region_aware=region_aware,
     )
     sc = resolve_scene(scene)
     output_folder(out)
@@ -174,7 +182,7 @@ def simulate_command(
         from footfall.errors import InfeasibleError
 
         raise InfeasibleError(f"{planner} found no plan for {sc.name}: {plan.message}")
-    res = simulate(plan, opts, goal=sc.goal.position)
+    res = simulate(plan, opts, goal=sc.goal.position, regions=sc.terrain.regions)
     m = res.metrics
     write_json(out / "sim.json", run_report(sc.name, plan, opts, res))
     figs = save_sim_figures(res, out, sc.terrain)
@@ -231,6 +239,9 @@ def compare_command(
     placement_error: float = typer.Option(0.01, help="Landing error (std per axis) [m]."),
     mismatch: float = typer.Option(0.0, help="Mass/CoM-height mismatch fraction (uniform +-)."),
     rate: float = typer.Option(500.0, help="Control rate [Hz]."),
+    region_aware: str = typer.Option(
+        "off", "--region-aware", help="--sim reduced: " + _REGION_HELP
+    ),
     out: Path = typer.Option(Path("out/compare"), help="Output folder (plans cached in plans/)."),
     sim: str = typer.Option(
         "reduced",
@@ -289,6 +300,7 @@ def compare_command(
         placement_error=placement_error,
         mismatch=mismatch,
         control_rate=rate,
+        region_aware=region_aware,
     )
     scene_objs = {sc.name: sc for sc in map(resolve_scene, _list_arg(scenes))}
     output_folder(out)
@@ -408,6 +420,7 @@ def walk_cmd(
     controller: str | None = typer.Option(
         None, help=_CONTROLLER_HELP + " Default: the robot's (biped: wbc, g1: servo)."
     ),
+    region_aware: str = typer.Option("off", "--region-aware", help=_REGION_HELP),
     quiet: bool = typer.Option(
         False, "--quiet", help="No planning progress lines or status line (results still print)."
     ),
@@ -465,9 +478,9 @@ def walk_cmd(
     if not plan.has_solution:
         console.print(f"{sc.name}: {planner} found no plan ({plan.status.value}). {plan.message}")
         raise typer.Exit(1)
-    opts = WalkOptions(controller=controller)
+    opts = WalkOptions(controller=controller, region_aware=region_aware)
     pushes = (random_push(seed, push, plan, opts),) if push > 0 else ()
-    opts = WalkOptions(controller=controller, pushes=pushes)
+    opts = WalkOptions(controller=controller, pushes=pushes, region_aware=region_aware)
     with console.status(f"walking {plan.n_steps} steps in MuJoCo ..."):
         res = walk(
             sc, plan, opts, model_params=model, video_path=out / "walk.mp4" if video else None

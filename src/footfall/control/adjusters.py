@@ -16,10 +16,10 @@ from typing import Protocol
 
 import numpy as np
 
-from footfall._geometry import inset_polygon, polygons_intersect, project_to_polygon, rot2
+from footfall._geometry import inset_polygon, project_to_polygon, rot2
 from footfall._typing import FloatArray
 from footfall.control.mpc import MPC, MPCWeights, build_mpc
-from footfall.control.region_mpc import RegionMPC, RegionRows, sole_inset_offsets
+from footfall.control.region_mpc import RegionMPC, region_rows, regions_in_reach
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
 from footfall.planning.plan import FootstepPlan
@@ -476,17 +476,11 @@ class MPCAdjuster(PlanFollower):
         if self.region_aware == "nearby":
             names += [n for n in self._regions_nearby(phase, stance) if n != first]
         heading = float(plan.headings[phase + 1])
-        robot = plan.robot
-        cands = []
-        for name in names:
-            region = self.regions.get(name)
-            if region is None:
-                continue
-            a, b = region.halfspaces()
-            h = sole_inset_offsets(
-                a, b, heading, robot.foot_length, robot.foot_width, self.landing_margin
-            )
-            cands.append(RegionRows(name, a @ rot, h - a @ stance[:2]))
+        cands = [
+            region_rows(self.regions[n], stance, heading, plan.robot, self.landing_margin, rot)
+            for n in names
+            if n in self.regions
+        ]
         theta = np.concatenate([x_r, pr_r[:2] - ps_r[:2], xn_r])
         if not cands:  # the plan's region is unknown: the document's unconstrained MPC
             sol = self.mpc.solve_theta(k_s, theta, ps_r, pr_r)
@@ -513,19 +507,16 @@ class MPCAdjuster(PlanFollower):
         return target, u
 
     def _regions_nearby(self, phase: int, stance: FloatArray) -> tuple[str, ...]:
-        """Regions within reach of the stance foot of ``phase`` (computed once per phase): the
-        polygon meets the reach trapezoid (eq. 5.12f) and the height is within the robot's step
-        height of the stance foot."""
+        """Regions within reach of the stance foot of ``phase`` (once per phase)."""
         if phase not in self._nearby:
-            robot = self.plan.robot
-            rot = rot2(float(self.plan.headings[phase]))
-            reach = stance[:2] + robot.reach.for_stance(self.plan.sides[phase]) @ rot.T
-            out = []
-            for name, region in self.regions.items():
-                dz = abs(float(region.centroid[2]) - float(stance[2]))
-                if dz <= robot.step_height_max and polygons_intersect(reach, region.vertices):
-                    out.append(name)
-            self._nearby[phase] = tuple(out)
+            plan = self.plan
+            self._nearby[phase] = regions_in_reach(
+                tuple(self.regions.values()),
+                stance,
+                float(plan.headings[phase]),
+                plan.sides[phase],
+                plan.robot,
+            )
         return self._nearby[phase]
 
 

@@ -24,7 +24,11 @@ Solution (exact, three stages, cheapest first):
    two (their intersection): every candidate is evaluated and the feasible one with the least
    cost is the optimum (:func:`solve_polygon_qp`). If ``u(d)`` then satisfies the balls, the
    pair is a KKT point of the full problem (zero ball multipliers) and hence optimal;
-3. otherwise the full second-order cone program is solved with Clarabel.
+3. otherwise the torque bounds bind: for a guess of the active rows (stage 2's first, then
+   every single row and pair) the footstep is eliminated and the torques solve the ball QP of
+   eq. (5.19e) exactly (:func:`footfall.control.mpc.solve_ball_qp`); the first guess whose point
+   satisfies every row with multipliers >= 0 is a KKT point of the whole convex problem, hence
+   optimal. Clarabel on the full second-order cone program is the last resort.
 
 Several regions (dairlib's ``AlipMultiQP`` approach): one QP per candidate region, the planned
 (or previously chosen) region first; another is chosen when the first has no feasible footstep,
@@ -41,16 +45,28 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from footfall._geometry import polygons_intersect, rot2
 from footfall._typing import FloatArray
-from footfall.control.mpc import MPC, MPCSolution, MPCStatus, _clarabel_in_polygon
+from footfall.control.mpc import (
+    MPC,
+    MPCSolution,
+    MPCStatus,
+    _clarabel_in_polygon,
+    solve_ball_qp,
+)
 from footfall.errors import InputError
+from footfall.models.biped import BipedParams, Side
+from footfall.terrain.region import Region
 
 #: a footstep this far [m] outside a region row still satisfies it (solver tolerance)
 ROW_TOL = 1e-9
 #: a torque block this much above its bound (relative) still counts as inside (stage 2 test)
 BALL_TOL = 1e-9
+#: a region row's multiplier this far below zero (relative to the footstep gradient) still counts
+#: as >= 0 in the KKT test of an active-set guess
+MU_TOL = 1e-7
 #: how a region solution was found (:class:`RegionSolution.method`)
-METHODS = ("unconstrained", "polygon_qp", "clarabel", "infeasible")
+METHODS = ("unconstrained", "polygon_qp", "active_set", "clarabel", "pruned", "infeasible")
 
 
 def sole_inset_offsets(
@@ -155,6 +171,39 @@ class RegionRows:
         return float(np.max(self.g @ d - self.h))
 
 
+def region_rows(
+    region: Region,
+    stance: FloatArray,
+    heading: float,
+    robot: BipedParams,
+    margin: float = 0.0,
+    rot: FloatArray | None = None,
+) -> RegionRows:
+    """The rows of ``region`` on the footstep offset ``d = p_{i+1} - p_i`` from ``stance`` (3,):
+    the region inset by the sole (``robot.foot_length x robot.foot_width`` at ``heading`` [rad])
+    plus ``margin`` [m] (:func:`sole_inset_offsets`), expressed in the frame turned by ``rot``
+    (2, 2) (world frame when None: ``d_world = rot d``)."""
+    a, b = region.halfspaces()
+    h = sole_inset_offsets(a, b, heading, robot.foot_length, robot.foot_width, margin)
+    return RegionRows(region.name, a if rot is None else a @ rot, h - a @ stance[:2])
+
+
+def regions_in_reach(
+    regions: Sequence[Region], stance: FloatArray, heading: float, side: Side, robot: BipedParams
+) -> tuple[str, ...]:
+    """Names of the regions a step from ``stance`` (3,) [m] (stance foot ``side``, heading
+    [rad]) can reach: the polygon meets the reach trapezoid (eq. 5.12f) and its centroid's height
+    is within ``robot.step_height_max`` of the stance foot's."""
+    rot = rot2(heading)
+    reach = stance[:2] + robot.reach.for_stance(side) @ rot.T
+    return tuple(
+        r.name
+        for r in regions
+        if abs(float(r.centroid[2]) - float(stance[2])) <= robot.step_height_max
+        and polygons_intersect(reach, r.vertices)
+    )
+
+
 @dataclass(frozen=True)
 class RegionSolution:
     """Eq. (5.19) solved with the next footstep in one region (or the region chosen among several).
@@ -168,7 +217,9 @@ class RegionSolution:
         reason: why this region: ``planned``, ``kept`` (the region chosen earlier in this
             support), ``first infeasible`` (the preferred region had no footstep the sole fits),
             ``cheaper`` (cost lower by more than the switch margin) or ``none feasible``.
-        costs: every candidate's optimal cost by name (inf: infeasible).
+        costs: every candidate's optimal cost by name (inf: infeasible); for a candidate
+            ``pruned`` (not solved exactly: its torque-unbounded relaxation already cost more
+            than the first's minus the switch margin) that lower bound.
     """
 
     solution: MPCSolution
@@ -194,6 +245,8 @@ class RegionMPC:
             raise InputError("mpc", mpc, "an MPC")
         self.mpc = mpc
         mdl = mpc.model
+        # ball multipliers of the last active-set solve per (region, active rows): warm starts
+        self._warm: dict[tuple[str, tuple[int, ...]], tuple[int, FloatArray]] = {}
         self._u0: list[FloatArray] = []  # u_0 = u0_map theta, (n_u, 10)
         self._k: list[FloatArray] = []  # u = u_0 + K d, (n_u, 2)
         self._m: list[FloatArray] = []  # M (2, 2)
@@ -210,6 +263,22 @@ class RegionMPC:
             self._m.append(0.5 * (m + m.T))
             self._m_lin.append(f[n_u:] + h_ud.T @ u0)
 
+    def relaxed(
+        self, k_s: int, theta: FloatArray, rows: RegionRows
+    ) -> tuple[FloatArray, FloatArray, tuple[int, ...], float] | None:
+        """Stage 2: the problem without the torque bounds (5.19e), exactly.
+
+        Returns:
+            ``(u (n_u,) [N m], d (2,) [m], active rows, cost)`` or None when the rows leave no
+            footstep. The cost is a lower bound on the region's optimal cost (a relaxation).
+        """
+        res = solve_polygon_qp(self._m[k_s], self._m_lin[k_s] @ theta, rows.g, rows.h)
+        if res is None:
+            return None
+        d, active = res
+        u = self._u0[k_s] @ theta + self._k[k_s] @ d
+        return u, d, active, self.cost(k_s, u, d, theta)
+
     def solve_region(
         self,
         k_s: int,
@@ -218,6 +287,7 @@ class RegionMPC:
         p_next_ref: FloatArray,
         rows: RegionRows,
         unconstrained: MPCSolution | None = None,
+        relaxed: tuple[FloatArray, FloatArray, tuple[int, ...], float] | None = None,
     ) -> RegionSolution:
         """Eq. (5.19) at tick ``k_s`` with the next footstep in ``rows`` (module docstring).
 
@@ -228,6 +298,7 @@ class RegionMPC:
             p_next_ref: planned next footstep (3,) [m] (its height is kept).
             rows: the region rows on ``d = p_{i+1} - p_i``.
             unconstrained: the unconstrained solution of this tick if already solved.
+            relaxed: :meth:`relaxed` of these rows if already solved.
 
         Returns:
             The :class:`RegionSolution`; ``method`` ``infeasible`` (with the unconstrained
@@ -243,22 +314,24 @@ class RegionMPC:
         if rows.violation(d) <= ROW_TOL:
             cost = self.cost(k_s, sol.torques, d, theta)
             return RegionSolution(sol, rows.name, "unconstrained", cost)
-        res = solve_polygon_qp(self._m[k_s], self._m_lin[k_s] @ theta, rows.g, rows.h)
-        if res is None:
+        rel = relaxed if relaxed is not None else self.relaxed(k_s, theta, rows)
+        if rel is None:
             return RegionSolution(sol, "", "infeasible", math.inf)
-        d = res[0]
-        u = self._u0[k_s] @ theta + self._k[k_s] @ d
+        u, d, active, _ = rel
         mdl = self.mpc.model
         v = u.reshape(-1, 2) / mdl.u_limits
         method = "polygon_qp"
         lam = np.zeros(v.shape[0])
         iters = 0
         if np.einsum("ij,ij->i", v, v).max() > 1.0 + BALL_TOL:
-            clar = self._clarabel(k_s, theta, p_stance, rows)
-            if clar is None:
+            exact = self._active_sets(k_s, theta, rows, active)
+            method = "active_set"
+            if exact is None:
+                exact = self._clarabel(k_s, theta, rows)
+                method = "clarabel"
+            if exact is None:
                 return RegionSolution(sol, "", "infeasible", math.inf)
-            u, d, lam, iters = clar
-            method = "clarabel"
+            u, d, lam, iters = exact
         out = MPCSolution(
             k_s=k_s,
             torques=u.reshape(-1, 2),
@@ -272,10 +345,89 @@ class RegionMPC:
         )
         return RegionSolution(out, rows.name, method, self.cost(k_s, u, d, theta))
 
-    def _clarabel(
-        self, k_s: int, theta: FloatArray, p_stance: FloatArray, rows: RegionRows
+    def _active_sets(
+        self, k_s: int, theta: FloatArray, rows: RegionRows, first: tuple[int, ...]
     ) -> tuple[FloatArray, FloatArray, FloatArray, int] | None:
-        """Stage 3: the full cone program; ``(u, d, ball multipliers, iterations)`` or None."""
+        """Stage 3 with the torque bounds active: for a guess of the active rows (``first``,
+        then every single row, then every pair) the footstep is eliminated (on the row's line,
+        or fixed at the pair's corner), the torques solve the ball QP of eq. (5.19e) exactly
+        (:func:`footfall.control.mpc.solve_ball_qp`), and the guess is kept when the KKT
+        conditions of the whole problem hold: the footstep satisfies every row and the rows'
+        multipliers are >= 0. The problem is convex, so that point is the optimum.
+
+        Returns:
+            ``(u, d, ball multipliers, iterations)`` or None when no guess passes.
+        """
+        e = rows.g.shape[0]
+        guesses = [first] if first else []
+        guesses += [(i,) for i in range(e) if (i,) != first]
+        guesses += [(i, j) for i in range(e) for j in range(i + 1, e) if (i, j) != first]
+        for act in guesses:
+            res = self._solve_active(k_s, theta, rows, act)
+            if res is not None:
+                return res
+        return None
+
+    def _warm_start(self, k_s: int, key: tuple[str, tuple[int, ...]]) -> FloatArray | None:
+        """The ball multipliers of the last solve with the same region and active rows, shifted
+        to the blocks left at ``k_s`` (as :meth:`MPC.solve_theta` warm-starts); None in a new
+        single support (``k_s`` not after the last one)."""
+        last = self._warm.get(key)
+        if last is None or last[0] >= k_s:
+            return None
+        mdl = self.mpc.model
+        return last[1][mdl.first_block[k_s] - mdl.first_block[last[0]] :]
+
+    def _solve_active(
+        self, k_s: int, theta: FloatArray, rows: RegionRows, act: tuple[int, ...]
+    ) -> tuple[FloatArray, FloatArray, FloatArray, int] | None:
+        """The torque ball QP with rows ``act`` (1 or 2) active; None unless it is a KKT point."""
+        mdl = self.mpc.model
+        h, f = mdl.H[k_s], mdl.F[k_s] @ theta
+        n_u = h.shape[0] - 2
+        h_uu, h_ud, h_dd = h[:n_u, :n_u], h[:n_u, n_u:], h[n_u:, n_u:]
+        f_u, f_d = f[:n_u], f[n_u:]
+        g = rows.g[list(act)]
+        if len(act) == 2:
+            det = g[0, 0] * g[1, 1] - g[0, 1] * g[1, 0]
+            if abs(det) <= 1e-12:
+                return None
+            d0 = np.linalg.solve(g, rows.h[list(act)])
+            p_u, q_u = h_uu, f_u + h_ud @ d0
+        else:
+            gi = g[0] / np.linalg.norm(g[0])
+            d0 = gi * rows.h[act[0]] / np.linalg.norm(g[0])
+            nrm = np.array([-gi[1], gi[0]])  # along the row's line: d = d0 + nrm t
+            hn = h_ud @ nrm
+            s = float(nrm @ h_dd @ nrm)
+            p_u = h_uu - np.outer(hn, hn) / s
+            q_u = f_u + h_ud @ d0 - hn * float(nrm @ (h_dd @ d0 + f_d)) / s
+        scale = np.tile(mdl.u_limits, n_u // 2)
+        key = (rows.name, act)
+        v, lam, iters, ok = solve_ball_qp(
+            scale[:, None] * p_u * scale[None, :], scale * q_u, self._warm_start(k_s, key)
+        )
+        if not ok:
+            return None
+        self._warm[key] = (k_s, lam)
+        u = v * scale
+        if len(act) == 1:
+            t = -float(nrm @ (h_ud.T @ u + h_dd @ d0 + f_d)) / s
+            d = np.asarray(d0 + nrm * t, dtype=float)
+        else:
+            d = d0
+        if rows.violation(d) > ROW_TOL:
+            return None
+        grad = h_ud.T @ u + h_dd @ d + f_d  # stationarity: grad + g^T mu = 0
+        mu = np.linalg.lstsq(g.T, -grad, rcond=None)[0]
+        if np.any(mu < -MU_TOL * (1.0 + float(np.abs(grad).max()))):
+            return None
+        return u, d, lam, iters
+
+    def _clarabel(
+        self, k_s: int, theta: FloatArray, rows: RegionRows
+    ) -> tuple[FloatArray, FloatArray, FloatArray, int] | None:
+        """Last resort: the full cone program; ``(u, d, ball multipliers, iterations)`` or None."""
         mdl = self.mpc.model
         n_u = mdl.H[k_s].shape[0] - 2
         scale = np.concatenate([np.tile(mdl.u_limits, n_u // 2), np.ones(2)])
@@ -321,7 +473,17 @@ class RegionMPC:
             raise InputError("candidates", candidates, "at least one region")
         t0 = time.perf_counter()
         unc = self.mpc.solve_theta(k_s, theta, p_stance, p_next_ref, t0)
-        sols = [self.solve_region(k_s, theta, p_stance, p_next_ref, c, unc) for c in candidates]
+        sols = [self.solve_region(k_s, theta, p_stance, p_next_ref, candidates[0], unc)]
+        for c in candidates[1:]:
+            # the relaxed cost is a lower bound: a region that cannot beat the first by the
+            # margin (when the first is feasible) is not solved exactly
+            rel = self.relaxed(k_s, theta, c)
+            if rel is None:
+                sols.append(RegionSolution(unc, "", "infeasible", math.inf))
+            elif math.isfinite(sols[0].cost) and rel[3] >= sols[0].cost - switch_margin:
+                sols.append(RegionSolution(unc, c.name, "pruned", rel[3]))
+            else:
+                sols.append(self.solve_region(k_s, theta, p_stance, p_next_ref, c, unc, rel))
         best = choose_region(sols, switch_margin, first_reason)
         costs = {c.name: s.cost for c, s in zip(candidates, sols, strict=True)}
         chosen = replace(

@@ -341,10 +341,12 @@ def _region_metrics(
     landed = res.landed[~np.isnan(res.landed[:, 0])]
     off = sum(1 for p in landed if not region_of(scene, p))
     corr = MeanMax.of(np.linalg.norm((res.targets[:n] - res.planned[:n])[:, :2], axis=1))
+    own = {r.name: r for r in scene.terrain.regions}
     changes = []
     for i in range(n):
-        name = region_of(scene, res.targets[i])
-        if name != plan.regions[i + 1]:
+        planned = own.get(plan.regions[i + 1])
+        if planned is None or float(planned.signed_distance(res.targets[i, :2])) > 0.0:
+            name = region_of(scene, res.targets[i])
             changes.append({"step": i + 1, "planned": plan.regions[i + 1], "region": name})
     return off, corr, tuple(changes)
 
