@@ -84,21 +84,25 @@ def replay(plan, regions, calls, variant: str) -> tuple[np.ndarray, Counter]:  #
     times = np.zeros(len(calls))
     methods: Counter = Counter()
     nearby: dict[tuple[int, tuple[float, ...]], tuple[str, ...]] = {}
+    rows: dict[tuple[int, tuple[float, ...], str], object] = {}
     for j, (i, k, theta, stance, p_ref) in enumerate(calls):
         t0 = time.perf_counter()
         if variant == "free":
             mpc.solve_theta(k, theta, stance, p_ref)
         else:
             names = [plan.regions[i + 1]]
+            key = (i, tuple(np.round(stance, 4)))  # once per phase, as the loop does
             if variant == "nearby":
-                key = (i, tuple(np.round(stance, 4)))  # once per phase, as the loop does
                 if key not in nearby:
                     nearby[key] = regions_in_reach(
                         regions, stance, float(plan.headings[i]), plan.sides[i], robot
                     )
                 names += [n for n in nearby[key] if n != names[0]]
             heading = float(plan.headings[i + 1])
-            cands = [region_rows(by_name[n], stance, heading, robot) for n in names]
+            for n in names:
+                if (*key, n) not in rows:
+                    rows[(*key, n)] = region_rows(by_name[n], stance, heading, robot)
+            cands = [rows[(*key, n)] for n in names]
             rs = rmpc.solve(k, theta, stance, p_ref, cands, SWITCH_MARGIN)
             methods[rs.method] += 1
         times[j] = time.perf_counter() - t0

@@ -236,3 +236,29 @@ def test_bad_rows_name_the_field() -> None:
         RegionRows("x", np.zeros((2, 3)), np.zeros(2))
     with pytest.raises(InputError, match="regions"):
         RegionRows("x", np.zeros((2, 2)), np.zeros(3))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_pruned_candidates_cannot_beat_the_choice(model, seed: int) -> None:  # type: ignore[no-untyped-def]
+    """With several regions, the choice equals choose_region over every region solved exactly,
+    and a pruned region's reported cost is a lower bound of its exact cost."""
+    rng = np.random.default_rng(50 + seed)
+    theta = random_theta(rng, scale=[0.3, 1.5, 3.0][seed % 3])
+    k_s = int(rng.integers(0, model.n_ticks))
+    stance = np.array([0.3, -0.2, 0.05])
+    ref = np.array([stance[0] + theta[4], stance[1] + theta[5], 0.1])
+    g = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
+    cands = []
+    for j in range(4):
+        c = theta[4:6] + rng.normal(0, 0.12, 2)
+        cands.append(
+            RegionRows(f"r{j}", g, np.array([c[0] + 0.03, 0.03 - c[0], c[1] + 0.04, 0.04 - c[1]]))
+        )
+    rs = RegionMPC(MPC(model)).solve(k_s, theta, stance, ref, cands, 0.05)
+    exact = [RegionMPC(MPC(model)).solve_region(k_s, theta, stance, ref, c) for c in cands]
+    want = choose_region(exact, 0.05)
+    assert rs.region == want.region
+    if want.region:
+        assert rs.cost == pytest.approx(want.cost, rel=1e-9)
+    for c, e in zip(cands, exact, strict=True):
+        assert rs.costs[c.name] <= e.cost * (1 + 1e-9) + 1e-12

@@ -19,7 +19,7 @@ import numpy as np
 from footfall._geometry import inset_polygon, project_to_polygon, rot2
 from footfall._typing import FloatArray
 from footfall.control.mpc import MPC, MPCWeights, build_mpc
-from footfall.control.region_mpc import RegionMPC, region_rows, regions_in_reach
+from footfall.control.region_mpc import RegionMPC, RegionRows, region_rows, regions_in_reach
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
 from footfall.planning.plan import FootstepPlan
@@ -395,6 +395,9 @@ class MPCAdjuster(PlanFollower):
     choices: dict[int, RegionChoice] = field(default_factory=dict, repr=False)
     _frozen_torque: dict[int, FloatArray] = field(default_factory=dict, repr=False)
     _nearby: dict[int, tuple[str, ...]] = field(default_factory=dict, repr=False)
+    _row_cache: dict[tuple[int, str], tuple[FloatArray, RegionRows]] = field(
+        default_factory=dict, repr=False
+    )
 
     def __post_init__(self) -> None:
         if self.region_aware not in REGION_MODES:
@@ -476,11 +479,7 @@ class MPCAdjuster(PlanFollower):
         if self.region_aware == "nearby":
             names += [n for n in self._regions_nearby(phase, stance) if n != first]
         heading = float(plan.headings[phase + 1])
-        cands = [
-            region_rows(self.regions[n], stance, heading, plan.robot, self.landing_margin, rot)
-            for n in names
-            if n in self.regions
-        ]
+        cands = [self._rows(phase, n, stance, heading, rot) for n in names if n in self.regions]
         theta = np.concatenate([x_r, pr_r[:2] - ps_r[:2], xn_r])
         if not cands:  # the plan's region is unknown: the document's unconstrained MPC
             sol = self.mpc.solve_theta(k_s, theta, ps_r, pr_r)
@@ -505,6 +504,20 @@ class MPCAdjuster(PlanFollower):
         if self.limit_reach:
             target = self._limit_reach(target, stance, phase)
         return target, u
+
+    def _rows(
+        self, phase: int, name: str, stance: FloatArray, heading: float, rot: FloatArray
+    ) -> RegionRows:
+        """The rows of region ``name`` for ``phase``, rebuilt only when the stance foot moved."""
+        key = (phase, name)
+        hit = self._row_cache.get(key)
+        if hit is None or not np.array_equal(hit[0], stance):
+            rows = region_rows(
+                self.regions[name], stance, heading, self.plan.robot, self.landing_margin, rot
+            )
+            hit = (np.array(stance, dtype=float), rows)
+            self._row_cache[key] = hit
+        return hit[1]
 
     def _regions_nearby(self, phase: int, stance: FloatArray) -> tuple[str, ...]:
         """Regions within reach of the stance foot of ``phase`` (once per phase)."""

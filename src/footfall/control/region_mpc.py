@@ -251,6 +251,8 @@ class RegionMPC:
         self._k: list[FloatArray] = []  # u = u_0 + K d, (n_u, 2)
         self._m: list[FloatArray] = []  # M (2, 2)
         self._m_lin: list[FloatArray] = []  # m = m_lin theta, (2, 10)
+        self._m_inv: list[FloatArray] = []  # M^-1
+        self._lam_min: list[float] = []  # smallest eigenvalue of M
         for k_s in range(mdl.n_ticks):
             h, f = mdl.H[k_s], mdl.F[k_s]
             n_u = h.shape[0] - 2
@@ -260,7 +262,10 @@ class RegionMPC:
             m = h_dd + h_ud.T @ k
             self._u0.append(np.asarray(u0, dtype=float))
             self._k.append(np.asarray(k, dtype=float))
-            self._m.append(0.5 * (m + m.T))
+            m = 0.5 * (m + m.T)
+            self._m.append(m)
+            self._m_inv.append(np.asarray(np.linalg.inv(m), dtype=float))
+            self._lam_min.append(float(np.linalg.eigvalsh(m)[0]))
             self._m_lin.append(f[n_u:] + h_ud.T @ u0)
 
     def relaxed(
@@ -473,27 +478,70 @@ class RegionMPC:
             raise InputError("candidates", candidates, "at least one region")
         t0 = time.perf_counter()
         unc = self.mpc.solve_theta(k_s, theta, p_stance, p_next_ref, t0)
-        sols = [self.solve_region(k_s, theta, p_stance, p_next_ref, candidates[0], unc)]
+        first = self.solve_region(k_s, theta, p_stance, p_next_ref, candidates[0], unc)
+        sols = [first]
+        if len(candidates) > 1:
+            sols += self._others(
+                k_s, theta, p_stance, p_next_ref, candidates, first, unc, switch_margin
+            )
+        best = choose_region(sols, switch_margin, first_reason)
+        sol = best.solution
+        sol = MPCSolution(  # the time of the whole choice (faster than dataclasses.replace)
+            sol.k_s,
+            sol.torques,
+            sol.block_ticks,
+            sol.next_footstep,
+            sol.status,
+            sol.fallback,
+            time.perf_counter() - t0,
+            sol.iterations,
+            sol.multipliers,
+            sol.message,
+        )
+        costs = {c.name: x.cost for c, x in zip(candidates, sols, strict=True)}
+        if best.region:
+            self.mpc._last = sol  # warm start / fallback from what is applied
+        return RegionSolution(sol, best.region, best.method, best.cost, best.reason, costs)
+
+    def _others(
+        self,
+        k_s: int,
+        theta: FloatArray,
+        p_stance: FloatArray,
+        p_next_ref: FloatArray,
+        candidates: Sequence[RegionRows],
+        first: RegionSolution,
+        unc: MPCSolution,
+        switch_margin: float,
+    ) -> list[RegionSolution]:
+        """The candidates after the first, each solved only if it may beat the first by the
+        margin. Lower bounds: the first's cost when the first holds the unconstrained optimum
+        (the global one); else the bound-free relaxation's cost, which is the quadratic
+        ``q(d) = q(d_0) + 1/2 (d - d_0)^T M (d - d_0)`` in the footstep, so at least
+        ``q(d_0) + 1/2 lambda_min(M) v^2`` with ``v`` the largest row violation of its
+        minimiser ``d_0`` (rows are unit normals: ``v`` is at most the distance to the region),
+        and then the exact relaxation."""
+        out = []
+        bound_first = first.cost - switch_margin if math.isfinite(first.cost) else math.inf
+        if first.method == "unconstrained":
+            return [RegionSolution(unc, c.name, "pruned", first.cost) for c in candidates[1:]]
+        lin = self._m_lin[k_s] @ theta
+        d0 = -self._m_inv[k_s] @ lin
+        q0 = 0.5 * float(d0 @ lin) + self.cost(k_s, self._u0[k_s] @ theta, np.zeros(2), theta)
         for c in candidates[1:]:
-            # the relaxed cost is a lower bound: a region that cannot beat the first by the
-            # margin (when the first is feasible) is not solved exactly
+            viol = max(c.violation(d0), 0.0)
+            cheap = q0 + 0.5 * self._lam_min[k_s] * viol * viol
+            if cheap >= bound_first:
+                out.append(RegionSolution(unc, c.name, "pruned", cheap))
+                continue
             rel = self.relaxed(k_s, theta, c)
             if rel is None:
-                sols.append(RegionSolution(unc, "", "infeasible", math.inf))
-            elif math.isfinite(sols[0].cost) and rel[3] >= sols[0].cost - switch_margin:
-                sols.append(RegionSolution(unc, c.name, "pruned", rel[3]))
+                out.append(RegionSolution(unc, "", "infeasible", math.inf))
+            elif rel[3] >= bound_first:
+                out.append(RegionSolution(unc, c.name, "pruned", rel[3]))
             else:
-                sols.append(self.solve_region(k_s, theta, p_stance, p_next_ref, c, unc, rel))
-        best = choose_region(sols, switch_margin, first_reason)
-        costs = {c.name: s.cost for c, s in zip(candidates, sols, strict=True)}
-        chosen = replace(
-            best,
-            costs=costs,
-            solution=replace(best.solution, solve_time=time.perf_counter() - t0),
-        )
-        if chosen.region:
-            self.mpc._last = chosen.solution  # warm start / fallback from what is applied
-        return chosen
+                out.append(self.solve_region(k_s, theta, p_stance, p_next_ref, c, unc, rel))
+        return out
 
 
 def choose_region(

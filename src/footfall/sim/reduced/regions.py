@@ -18,7 +18,7 @@ import numpy as np
 from footfall._typing import FloatArray
 from footfall.control.adjusters import SWITCH_MARGIN
 from footfall.control.mpc import MPC, MPCSolution
-from footfall.control.region_mpc import RegionMPC, region_rows, regions_in_reach
+from footfall.control.region_mpc import RegionMPC, RegionRows, region_rows, regions_in_reach
 from footfall.planning.plan import FootstepPlan
 from footfall.terrain.region import Region
 
@@ -45,6 +45,7 @@ class RegionFeet:
     foot_width: float
     choices: dict[int, str] = field(default_factory=dict)
     _nearby: dict[int, tuple[str, ...]] = field(default_factory=dict, repr=False)
+    _rows: dict[tuple[int, str], RegionRows] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         self.region_mpc = RegionMPC(self.mpc)
@@ -69,11 +70,12 @@ class RegionFeet:
                 )
             names += [n for n in self._nearby[i] if n != first]
         heading = float(plan.headings[i + 1])
-        cands = [
-            region_rows(self.by_name[n], stance, heading, self._robot)
-            for n in names
-            if n in self.by_name
-        ]
+        cands = []
+        for n in names:
+            if n in self.by_name:
+                if (i, n) not in self._rows:  # the stance foot stays put for the phase
+                    self._rows[i, n] = region_rows(self.by_name[n], stance, heading, self._robot)
+                cands.append(self._rows[i, n])
         if not cands:
             return self.mpc.solve_theta(k, theta, stance, p_ref)
         reason = "planned" if cands[0].name == planned else "kept"
