@@ -53,3 +53,47 @@ def test_region_aware_walk_keeps_every_footstep_on_a_stone() -> None:
     corr = np.linalg.norm((res.targets - res.planned)[: plan.n_steps, :2], axis=1)
     assert m.correction_m.max == pytest.approx(corr.max(), abs=1e-12)
     assert 0.0 < m.correction_m.max < 0.1
+
+
+def test_bad_region_mode_names_the_field() -> None:
+    from footfall.errors import InputError
+
+    with pytest.raises(InputError, match="region_aware"):
+        WalkOptions(region_aware="anywhere")
+
+
+@pytest.mark.parametrize("mode", ["off", "planned"])
+def test_a_retargeted_swing_is_raised_over_the_regions_under_its_new_path(mode: str) -> None:
+    """A correction that moves the swing target across a higher stone raises the apex over it
+    while the sole is still rising (region-aware walks only); the height is checked with shapely
+    against the stones the sole's swept path crosses."""
+    from shapely.geometry import LineString
+
+    from footfall.sim.biped.walk import BipedWalk
+
+    scene = builtin_scene("stepping_stones")
+    plan = load_plan(PLAN, scene)
+    walker = BipedWalk(scene, plan, WalkOptions(region_aware=mode))
+    walker._begin_step(0)
+    apex0 = walker.swing.apex
+    # a target on stone4 (0.08 m high), far across stones 1-3, instead of the planned one
+    target = np.array([1.31, -0.14, 0.08])
+    walker._raise_swing(0.0, target)
+    start = walker.swing.start
+    robot = plan.robot
+    path = LineString([start[:2], target[:2]]).buffer(robot.foot_width / 2)
+    crossed = max(
+        float(np.max(r.height_at(r.vertices)))
+        for r in scene.terrain.regions
+        if Polygon(r.vertices).intersects(path)
+    )
+    clearance = WalkOptions().swing_clearance
+    if mode == "off":
+        assert walker.swing.apex == apex0
+    else:
+        assert walker.swing.apex >= crossed + clearance - 1e-9
+        assert walker.swing.apex > apex0
+    # late in the swing (the sole no longer rising) nothing changes
+    walker.swing.apex = apex0
+    walker._raise_swing(0.9 * robot.t_ss, target + 0.05)
+    assert walker.swing.apex == apex0
