@@ -97,3 +97,21 @@ def test_a_retargeted_swing_is_raised_over_the_regions_under_its_new_path(mode: 
     walker.swing.apex = apex0
     walker._raise_swing(0.9 * robot.t_ss, target + 0.05)
     assert walker.swing.apex == apex0
+
+
+@pytest.mark.parametrize("name", ["roll_ramps", "corridor_corner"])
+def test_new_scenes_are_walked_with_every_footstep_on_a_region(name: str) -> None:
+    """Smoke test of the issue's new scenes (plans of ``footfall walk`` stored in data/): the
+    region-aware walk reaches the goal and no landed sole centre is off the terrain (shapely)."""
+    scene = builtin_scene(name)
+    plan = load_plan(Path(__file__).parent / "data" / f"{name}_miqcqp.json", scene)
+    res = walk(scene, plan, WalkOptions(region_aware="planned"))
+    assert not res.metrics.fell and res.metrics.reached_goal
+    landed = res.landed[~np.isnan(res.landed[:, 0])]
+    for p in landed:
+        assert any(
+            Polygon(r.vertices).covers(Point(p[:2]))
+            and abs(float(r.height_at(p[:2])) - p[2]) <= ON_SURFACE_TOL
+            for r in scene.terrain.regions
+        ), p
+    assert res.metrics.footsteps_off_regions == 0
