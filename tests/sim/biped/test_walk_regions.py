@@ -99,7 +99,7 @@ def test_a_retargeted_swing_is_raised_over_the_regions_under_its_new_path(mode: 
     assert walker.swing.apex == apex0
 
 
-@pytest.mark.parametrize("name", ["roll_ramps", "corridor_corner"])
+@pytest.mark.parametrize("name", ["narrow_stones_gap", "roll_ramps", "corridor_corner"])
 def test_new_scenes_are_walked_with_every_footstep_on_a_region(name: str) -> None:
     """Smoke test of the issue's new scenes (plans of ``footfall walk`` stored in data/): the
     region-aware walk reaches the goal and no landed sole centre is off the terrain (shapely)."""
