@@ -204,6 +204,14 @@ _CONTROLLER_HELP = (
 )
 
 
+def _check_region_aware(region_aware: str) -> None:
+    """Refuse an unknown ``--region-aware`` before any planning."""
+    from footfall.control.adjusters import REGION_MODES
+
+    if region_aware not in REGION_MODES:
+        raise InputError("region_aware", region_aware, f"one of {', '.join(REGION_MODES)}")
+
+
 def _check_controller(controller: str) -> None:
     from footfall.sim.biped.options import CONTROLLERS
 
@@ -455,6 +463,7 @@ def walk_cmd(
     if controller is None:
         controller = ROBOT_CONTROLLERS.get(robot, DEFAULT_CONTROLLER)
     _check_controller(controller)
+    _check_region_aware(region_aware)
     if steps is not None and steps < 1:
         raise InputError("steps", steps, "an integer >= 1")
     push = non_negative("push", push)
