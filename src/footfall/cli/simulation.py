@@ -23,6 +23,12 @@ from footfall.cli._common import (
 from footfall.cli._progress import ProgressLog
 from footfall.errors import InputError
 
+_REGION_HELP = (
+    "How the MPC keeps the next footstep on the terrain (issue 23): off (document 000: free; "
+    "the MuJoCo walker keeps a uniform margin inside the planned region), planned (in the planned "
+    "region inset by the sole, same QP), nearby (or the best region within reach)."
+)
+
 
 # --- demo ---
 @app.command()
@@ -153,6 +159,7 @@ def simulate_command(
     engine: str = typer.Option(
         "auto", help="Loop engine: auto, compiled (numba) or python (reference)."
     ),
+    region_aware: str = typer.Option("off", "--region-aware", help=_REGION_HELP),
     out: Path = typer.Option(Path("out/simulate"), help="Output folder."),
 ) -> None:
     """Plan a scene, walk it in closed loop (MPC eq. 5.19 on the ALIP plant), write sim.json + figures."""
@@ -178,6 +185,7 @@ def simulate_command(
         placement_error=placement_error,
         seed=seed,
         engine=engine,
+        region_aware=region_aware,
     )
     sc = resolve_scene(scene)
     output_folder(out)
@@ -190,7 +198,7 @@ def simulate_command(
         from footfall.errors import InfeasibleError
 
         raise InfeasibleError(f"{planner} found no plan for {sc.name}: {plan.message}")
-    res = simulate(plan, opts, goal=sc.goal.position)
+    res = simulate(plan, opts, goal=sc.goal.position, regions=sc.terrain.regions)
     m = res.metrics
     write_json(out / "sim.json", run_report(sc.name, plan, opts, res))
     figs = save_sim_figures(res, out, sc.terrain)
@@ -210,6 +218,14 @@ _CONTROLLER_HELP = (
     "wbc: whole-body inverse dynamics, every joint torque-driven, the ALIP ankle torque as the "
     "commanded centre of pressure (500 Hz QP); servo: differential IK to joint position servos."
 )
+
+
+def _check_region_aware(region_aware: str) -> None:
+    """Refuse an unknown ``--region-aware`` before any planning."""
+    from footfall.control.adjusters import REGION_MODES
+
+    if region_aware not in REGION_MODES:
+        raise InputError("region_aware", region_aware, f"one of {', '.join(REGION_MODES)}")
 
 
 def _check_controller(controller: str) -> None:
@@ -247,6 +263,9 @@ def compare_command(
     placement_error: float = typer.Option(0.01, help="Landing error (std per axis) [m]."),
     mismatch: float = typer.Option(0.0, help="Mass/CoM-height mismatch fraction (uniform +-)."),
     rate: float = typer.Option(500.0, help="Control rate [Hz]."),
+    region_aware: str = typer.Option(
+        "off", "--region-aware", help="--sim reduced: " + _REGION_HELP
+    ),
     out: Path = typer.Option(Path("out/compare"), help="Output folder (plans cached in plans/)."),
     sim: str = typer.Option(
         "reduced",
@@ -305,6 +324,7 @@ def compare_command(
         placement_error=placement_error,
         mismatch=mismatch,
         control_rate=rate,
+        region_aware=region_aware,
     )
     scene_objs = {sc.name: sc for sc in map(resolve_scene, _list_arg(scenes))}
     output_folder(out)
@@ -426,6 +446,7 @@ def walk_cmd(
     controller: str | None = typer.Option(
         None, help=_CONTROLLER_HELP + " Default: the robot's (biped: wbc, g1: servo)."
     ),
+    region_aware: str = typer.Option("off", "--region-aware", help=_REGION_HELP),
     quiet: bool = typer.Option(
         False, "--quiet", help="No planning progress lines or status line (results still print)."
     ),
@@ -460,6 +481,7 @@ def walk_cmd(
     if controller is None:
         controller = ROBOT_CONTROLLERS.get(robot, DEFAULT_CONTROLLER)
     _check_controller(controller)
+    _check_region_aware(region_aware)
     if steps is not None and steps < 1:
         raise InputError("steps", steps, "an integer >= 1")
     push = non_negative("push", push)
@@ -483,9 +505,9 @@ def walk_cmd(
     if not plan.has_solution:
         console.print(f"{sc.name}: {planner} found no plan ({plan.status.value}). {plan.message}")
         raise typer.Exit(1)
-    opts = WalkOptions(controller=controller)
+    opts = WalkOptions(controller=controller, region_aware=region_aware)
     pushes = (random_push(seed, push, plan, opts),) if push > 0 else ()
-    opts = WalkOptions(controller=controller, pushes=pushes)
+    opts = WalkOptions(controller=controller, pushes=pushes, region_aware=region_aware)
     with console.status(f"walking {plan.n_steps} steps in MuJoCo ..."):
         res = walk(
             sc, plan, opts, model_params=model, video_path=out / "walk.mp4" if video else None

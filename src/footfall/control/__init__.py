@@ -5,6 +5,7 @@ from footfall.control.adjusters import (
     FootstepAdjuster,
     MPCAdjuster,
     PlanFollower,
+    RegionChoice,
     extend_plan,
     sole_torque_limits,
 )
@@ -17,6 +18,7 @@ from footfall.control.mpc import (
     build_mpc,
     solve_ball_qp,
 )
+from footfall.control.region_mpc import RegionMPC, RegionRows, RegionSolution, sole_inset_offsets
 
 __all__ = [
     "MPC",
@@ -27,8 +29,13 @@ __all__ = [
     "MPCStatus",
     "MPCWeights",
     "PlanFollower",
+    "RegionChoice",
+    "RegionMPC",
+    "RegionRows",
+    "RegionSolution",
     "build_mpc",
     "extend_plan",
+    "sole_inset_offsets",
     "sole_torque_limits",
     "solve_ball_qp",
 ]

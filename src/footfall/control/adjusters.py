@@ -19,6 +19,8 @@ import numpy as np
 from footfall._geometry import inset_polygon, project_to_polygon, rot2
 from footfall._typing import FloatArray
 from footfall.control.mpc import MPC, MPCWeights, build_mpc
+from footfall.control.region_mpc import RegionMPC, RegionRows, region_rows, regions_in_reach
+from footfall.errors import InputError
 from footfall.models.biped import BipedParams
 from footfall.planning.plan import FootstepPlan
 from footfall.terrain.region import Region
@@ -35,6 +37,47 @@ SOLE_TORQUE_SHARE = 0.9
 #: corrected footsteps stay this far inside the reach trapezoid [m]; the planners use its
 #: boundary (the first lateral step of the reactive plan lies on it), so no margin
 REACH_MARGIN = 0.0
+#: ways the MPC adjuster keeps the footstep on the terrain (:attr:`MPCAdjuster.region_aware`)
+REGION_MODES = ("off", "planned", "nearby")
+#: another region is chosen over the preferred one when its eq. (5.19a) cost is lower by more
+#: than this: the cost of a 10 cm footstep deviation at the default W (MPCWeights.w = 10)
+SWITCH_MARGIN = 0.1
+
+
+@dataclass(frozen=True)
+class RegionChoice:
+    """Where the region-aware MPC adjuster put one footstep (its last decision in the phase).
+
+    Attributes:
+        phase: single-support phase i (the footstep is p_{i+1}).
+        planned: the plan's region of the footstep.
+        region: the region chosen ("" when no region had a footstep the sole fits: the plan's
+            footstep is used).
+        reason: see :class:`footfall.control.region_mpc.RegionSolution`.
+        method: how the QP was solved (:data:`footfall.control.region_mpc.METHODS`).
+        correction_m: horizontal distance of the footstep from the plan's [m].
+        candidates: the regions whose QPs were solved.
+    """
+
+    phase: int
+    planned: str
+    region: str
+    reason: str
+    method: str
+    correction_m: float
+    candidates: tuple[str, ...]
+
+    def to_dict(self) -> dict[str, object]:
+        """The fields by name (JSON-ready)."""
+        return {
+            "phase": self.phase,
+            "planned": self.planned,
+            "region": self.region,
+            "reason": self.reason,
+            "method": self.method,
+            "correction_m": self.correction_m,
+            "candidates": list(self.candidates),
+        }
 
 
 class FootstepAdjuster(Protocol):
@@ -327,6 +370,15 @@ class MPCAdjuster(PlanFollower):
             (``region_margin`` inside, :meth:`footfall.control.mpc.MPC.solve_in_polygon`)
             instead of clamping the document's unconstrained footstep afterwards, so the ankle
             torque makes up for a correction the region does not allow.
+        region_aware: ``off`` (the above); ``planned``: the next footstep is kept in its planned
+            region inset exactly by the sole at its planned heading plus ``landing_margin``
+            (:class:`footfall.control.region_mpc.RegionMPC`; ``region_margin`` is then unused);
+            ``nearby``: as ``planned``, and when that region has no footstep the sole fits, or
+            another region within reach (its polygon meets the reach trapezoid of the stance
+            foot, its height within ``step_height_max``) costs less by ``switch_margin``, the
+            footstep goes there. :attr:`choices` records each phase's decision.
+        landing_margin: extra inset [m] of the regions beyond the sole (``region_aware``).
+        switch_margin: cost margin of a region switch (``nearby``).
     """
 
     control_dt: float = 0.01
@@ -336,13 +388,28 @@ class MPCAdjuster(PlanFollower):
     torque_limits: tuple[float, float] | None = None
     footstep_in_region: bool = True
     hold_frozen: bool = True
+    region_aware: str = "off"
+    landing_margin: float = 0.0
+    switch_margin: float = SWITCH_MARGIN
     mpc: MPC = field(init=False, repr=False)
+    choices: dict[int, RegionChoice] = field(default_factory=dict, repr=False)
     _frozen_torque: dict[int, FloatArray] = field(default_factory=dict, repr=False)
+    _nearby: dict[int, tuple[str, ...]] = field(default_factory=dict, repr=False)
+    _row_cache: dict[tuple[int, str], tuple[FloatArray, RegionRows]] = field(
+        default_factory=dict, repr=False
+    )
 
     def __post_init__(self) -> None:
+        if self.region_aware not in REGION_MODES:
+            raise InputError("region_aware", self.region_aware, f"one of {', '.join(REGION_MODES)}")
+        if not (math.isfinite(self.landing_margin) and self.landing_margin >= 0.0):
+            raise InputError("landing_margin", self.landing_margin, "a finite number >= 0 [m]")
+        if not (math.isfinite(self.switch_margin) and self.switch_margin >= 0.0):
+            raise InputError("switch_margin", self.switch_margin, "a finite number >= 0")
         super().__post_init__()
         mdl = build_mpc(self.plan.robot, self.weights, self.control_dt, None, self.torque_limits)
         self.mpc = MPC(mdl)
+        self.region_mpc = RegionMPC(self.mpc)
 
     def update(
         self, t: float, state: FloatArray, stance: FloatArray, phase: int
@@ -368,6 +435,12 @@ class MPCAdjuster(PlanFollower):
         )
         if phase in self._frozen and self.hold_frozen:
             return self._frozen[phase], self._frozen_torque[phase]
+        if self.region_aware != "off" and phase not in self._frozen:
+            target, u = self._region_aware(t, phase, args, rot, stance, ref_next)
+            target = self._maybe_freeze(t, phase, target)
+            if phase in self._frozen:
+                self._frozen_torque[phase] = u
+            return target, u
         if self.footstep_in_region and region is not None and phase not in self._frozen:
             a, b = region.halfspaces()
             sol = self.mpc.solve_in_polygon(*args, a @ rot, b - self.region_margin)
@@ -386,6 +459,78 @@ class MPCAdjuster(PlanFollower):
         if phase in self._frozen:
             self._frozen_torque[phase] = u
         return target, u
+
+    def _region_aware(
+        self,
+        t: float,
+        phase: int,
+        args: tuple[int, FloatArray, FloatArray, FloatArray, FloatArray],
+        rot: FloatArray,
+        stance: FloatArray,
+        ref_next: FloatArray,
+    ) -> tuple[FloatArray, FloatArray]:
+        """Footstep and torque of the region-aware MPC (``region_aware`` planned / nearby)."""
+        plan = self.plan
+        k_s, x_r, ps_r, pr_r, xn_r = args
+        planned = plan.regions[phase + 1]
+        first = self.choices[phase].region if phase in self.choices else planned
+        first = first or planned
+        names = [first]
+        if self.region_aware == "nearby":
+            names += [n for n in self._regions_nearby(phase, stance) if n != first]
+        heading = float(plan.headings[phase + 1])
+        cands = [self._rows(phase, n, stance, heading, rot) for n in names if n in self.regions]
+        theta = np.concatenate([x_r, pr_r[:2] - ps_r[:2], xn_r])
+        if not cands:  # the plan's region is unknown: the document's unconstrained MPC
+            sol = self.mpc.solve_theta(k_s, theta, ps_r, pr_r)
+            return _rotate_xy(rot, sol.next_footstep), rot @ sol.torques[0]
+        reason = "planned" if cands[0].name == planned else "kept"
+        rs = self.region_mpc.solve(k_s, theta, ps_r, pr_r, cands, self.switch_margin, reason)
+        u = rot @ rs.solution.torques[0]
+        if rs.region:
+            target = _rotate_xy(rot, rs.solution.next_footstep)
+            target[2] = float(self.regions[rs.region].height_at(target[:2]))
+        else:  # no region fits the sole: the plan's footstep, which the planner kept inside
+            target = np.array(ref_next, dtype=float)
+        self.choices[phase] = RegionChoice(
+            phase=phase,
+            planned=planned,
+            region=rs.region,
+            reason=rs.reason,
+            method=rs.method,
+            correction_m=float(np.linalg.norm(target[:2] - ref_next[:2])),
+            candidates=tuple(c.name for c in cands),
+        )
+        if self.limit_reach:
+            target = self._limit_reach(target, stance, phase)
+        return target, u
+
+    def _rows(
+        self, phase: int, name: str, stance: FloatArray, heading: float, rot: FloatArray
+    ) -> RegionRows:
+        """The rows of region ``name`` for ``phase``, rebuilt only when the stance foot moved."""
+        key = (phase, name)
+        hit = self._row_cache.get(key)
+        if hit is None or not np.array_equal(hit[0], stance):
+            rows = region_rows(
+                self.regions[name], stance, heading, self.plan.robot, self.landing_margin, rot
+            )
+            hit = (np.array(stance, dtype=float), rows)
+            self._row_cache[key] = hit
+        return hit[1]
+
+    def _regions_nearby(self, phase: int, stance: FloatArray) -> tuple[str, ...]:
+        """Regions within reach of the stance foot of ``phase`` (once per phase)."""
+        if phase not in self._nearby:
+            plan = self.plan
+            self._nearby[phase] = regions_in_reach(
+                tuple(self.regions.values()),
+                stance,
+                float(plan.headings[phase]),
+                plan.sides[phase],
+                plan.robot,
+            )
+        return self._nearby[phase]
 
 
 def _rotate_xy(rot: FloatArray, p: FloatArray) -> FloatArray:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import csv
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -18,11 +18,13 @@ from typing import Any
 import numpy as np
 
 from footfall._validate import check_fields, non_negative, positive
+from footfall.control.adjusters import REGION_MODES
 from footfall.errors import InputError
 from footfall.planning.cache import PlanCache, cached_plan
 from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
 from footfall.sim.pushes import Push
 from footfall.sim.reduced.closed_loop import SimOptions, simulate
+from footfall.terrain.region import Region
 from footfall.terrain.scene import Scene
 
 #: metrics written per trial (keys of SimMetrics.to_dict)
@@ -36,6 +38,7 @@ TRIAL_FIELDS = (
     "saturated_fraction",
     "footstep_dev_mean",
     "footstep_dev_max",
+    "footsteps_off_regions",
     "goal_error",
     "steps_taken",
     "mpc_fallbacks",
@@ -56,6 +59,8 @@ class TrialSpec:
         placement_error: landing error per axis [m].
         mismatch: true mass and CoM height are scaled by factors uniform in [1 - m, 1 + m].
         control_rate: MPC rate [Hz].
+        region_aware: the MPC's footstep region handling (``SimOptions.region_aware``; issue 23);
+            ``off`` is document 000's MPC.
     """
 
     push_max: float = 15.0
@@ -65,8 +70,11 @@ class TrialSpec:
     placement_error: float = 0.01
     mismatch: float = 0.0
     control_rate: float = 500.0
+    region_aware: str = "off"
 
     def __post_init__(self) -> None:
+        if self.region_aware not in REGION_MODES:
+            raise InputError("region_aware", self.region_aware, f"one of {', '.join(REGION_MODES)}")
         check_fields(
             self,
             non_negative,
@@ -97,6 +105,7 @@ class TrialSpec:
             pushes=(push,) if imp > 0 else (),
             placement_error=self.placement_error,
             seed=seed,
+            region_aware=self.region_aware,
         )
 
 
@@ -121,10 +130,17 @@ def comparison_plan(
 
 
 def run_trial(
-    scene_name: str, planner: str, plan: FootstepPlan, spec: TrialSpec, seed: int, goal: Any
+    scene_name: str,
+    planner: str,
+    plan: FootstepPlan,
+    spec: TrialSpec,
+    seed: int,
+    goal: Any,
+    regions: Sequence[Region] | None = None,
 ) -> dict[str, Any]:
-    """One seeded trial; returns a CSV row (a fall is a row with ``fell = True``)."""
-    res = simulate(plan, spec.options(plan, seed), goal=goal)
+    """One seeded trial; returns a CSV row (a fall is a row with ``fell = True``); ``regions``
+    (the scene's) add the region metrics and are needed by ``spec.region_aware``."""
+    res = simulate(plan, spec.options(plan, seed), goal=goal, regions=regions)
     m = res.metrics.to_dict()
     row: dict[str, Any] = {"scene": scene_name, "planner": planner, "trial": seed}
     row.update({k: m[k] for k in TRIAL_FIELDS})
@@ -274,14 +290,16 @@ def run_compare(
     rows: list[dict[str, Any]] = []
     if workers <= 1:
         for i, (s, p, plan, seed) in enumerate(jobs):
-            rows.append(run_trial(s, p, plan, spec, seed, scenes[s].goal.position))
+            sc = scenes[s]
+            rows.append(run_trial(s, p, plan, spec, seed, sc.goal.position, sc.terrain.regions))
             if progress:
                 progress("trials", i + 1, len(jobs))
     elif jobs:
         # The first trial runs here: it compiles (or loads) the simulation kernel once and leaves it
         # in numba's disk cache, so the workers load it instead of each compiling it at once.
         s0, p0, plan0, seed0 = jobs[0]
-        rows.append(run_trial(s0, p0, plan0, spec, seed0, scenes[s0].goal.position))
+        sc0 = scenes[s0]
+        rows.append(run_trial(s0, p0, plan0, spec, seed0, sc0.goal.position, sc0.terrain.regions))
         if progress:
             progress("trials", 1, len(jobs))
         # spawn: children import numpy afresh (single-threaded BLAS from the environment)

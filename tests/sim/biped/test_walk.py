@@ -148,6 +148,7 @@ def test_bad_walk_inputs_name_the_field(short_walk) -> None:  # type: ignore[no-
         ["--push", "nan"],
         ["--steps", "0"],
         ["--scene", "nowhere"],
+        ["--region-aware", "anywhere"],
     ],
 )
 def test_cli_walk_rejects_bad_input(args: list[str], tmp_path) -> None:  # type: ignore[no-untyped-def]

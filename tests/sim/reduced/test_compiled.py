@@ -72,7 +72,7 @@ def assert_same_run(ref: SimResult, fast: SimResult) -> None:
         if f.name in NOT_OUTCOMES:
             continue
         a, b = getattr(ref.metrics, f.name), getattr(fast.metrics, f.name)
-        if isinstance(a, bool | int):
+        if isinstance(a, bool | int) or a is None:
             assert a == b, f.name
         else:
             np.testing.assert_allclose(b, a, rtol=0, atol=ENGINE_TOL, err_msg=f.name)

@@ -114,6 +114,7 @@ def hand_made_run() -> tuple[SimpleNamespace, SimpleNamespace]:
         omega=4.0,
         f_len=0.2,
         f_wid=0.1,
+        regions=(),
     )
     trace = SimpleNamespace(
         samples=n,

@@ -25,6 +25,9 @@ from footfall.terrain.scene import Scene
 EDGE_TOL = 0.005
 #: the goal is reached when the final feet midpoint is this close to it in plan view [m]
 GOAL_TOL = 0.10
+#: a landed sole centre is on a region when it is inside its polygon in plan view and within
+#: this of its surface height [m] (the measured sole centre sits a few mm above the plane)
+ON_REGION_Z_TOL = 0.03
 
 
 class WalkRecord(Protocol):
@@ -211,6 +214,14 @@ class WalkMetrics:
         per_step: the measured offsets per single support (those with samples).
         sim_time_s: simulated time [s].
         wall_time_s: wall-clock time of the loop [s].
+        footsteps_off_regions: landed footsteps (planned and stopping) whose sole centre is
+            outside every region of the scene in plan view or off its surface by more than
+            ``ON_REGION_Z_TOL`` (issue 23).
+        correction_m: horizontal distance of the commanded footsteps from the plan's [m].
+        region_changes: planned steps whose commanded footstep lies in another region than the
+            plan's (by geometry: ``{"step", "planned", "region"}``, region "" for none).
+        region_choices: the region-aware adjuster's last decision per phase
+            (:class:`~footfall.control.adjusters.RegionChoice` as dicts; empty otherwise).
     """
 
     fell: bool
@@ -230,6 +241,10 @@ class WalkMetrics:
     per_step: tuple[StepZMP, ...]
     sim_time_s: float
     wall_time_s: float
+    footsteps_off_regions: int = 0
+    correction_m: MeanMax = MeanMax(math.nan, math.nan)
+    region_changes: tuple[dict[str, Any], ...] = ()
+    region_choices: tuple[dict[str, Any], ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """The metrics as JSON-ready nested dicts and lists (walk.json's ``metrics``)."""
@@ -251,6 +266,10 @@ class WalkMetrics:
             "per_step": [s.to_dict() for s in self.per_step],
             "sim_time_s": self.sim_time_s,
             "wall_time_s": self.wall_time_s,
+            "footsteps_off_regions": self.footsteps_off_regions,
+            "correction_m": self.correction_m.to_dict(),
+            "region_changes": list(self.region_changes),
+            "region_choices": list(self.region_choices),
         }
 
 
@@ -304,6 +323,34 @@ def _per_step(res: WalkRecord, plan: FootstepPlan, params: WalkerModel) -> tuple
     return tuple(out)
 
 
+def region_of(scene: Scene, p: FloatArray) -> str:
+    """Name of the region ``p`` (3,) [m] stands on (inside in plan view, within
+    ``ON_REGION_Z_TOL`` of its surface), "" for none."""
+    for r in scene.terrain.regions:
+        if float(r.signed_distance(p[:2])) <= 0.0:
+            if abs(float(r.height_at(p[:2])) - float(p[2])) <= ON_REGION_Z_TOL:
+                return r.name
+    return ""
+
+
+def _region_metrics(
+    res: WalkRecord, scene: Scene, plan: FootstepPlan
+) -> tuple[int, MeanMax, tuple[dict[str, Any], ...]]:
+    """Footsteps landed off every region, the corrections' sizes and their region changes."""
+    n = res.n_planned
+    landed = res.landed[~np.isnan(res.landed[:, 0])]
+    off = sum(1 for p in landed if not region_of(scene, p))
+    corr = MeanMax.of(np.linalg.norm((res.targets[:n] - res.planned[:n])[:, :2], axis=1))
+    own = {r.name: r for r in scene.terrain.regions}
+    changes = []
+    for i in range(n):
+        planned = own.get(plan.regions[i + 1])
+        if planned is None or float(planned.signed_distance(res.targets[i, :2])) > 0.0:
+            name = region_of(scene, res.targets[i])
+            changes.append({"step": i + 1, "planned": plan.regions[i + 1], "region": name})
+    return off, corr, tuple(changes)
+
+
 def summarise(
     res: WalkRecord, scene: Scene, plan: FootstepPlan, params: WalkerModel, t_steps_end: float
 ) -> WalkMetrics:
@@ -318,6 +365,7 @@ def summarise(
     final_mid = 0.5 * (res.feet[-1, 0] + res.feet[-1, 1])
     goal_err = float(np.linalg.norm(final_mid[:2] - scene.goal.position[:2]))
     all_landed = bool(np.all(done))
+    off, corr, changes = _region_metrics(res, scene, plan)
     return WalkMetrics(
         fell=res.fell,
         fall_time_s=res.fall_time if res.fell else None,
@@ -336,4 +384,7 @@ def summarise(
         per_step=_per_step(res, plan, params),
         sim_time_s=res.sim_time,
         wall_time_s=res.timing.get("total", math.nan),
+        footsteps_off_regions=off,
+        correction_m=corr,
+        region_changes=changes,
     )

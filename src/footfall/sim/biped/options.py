@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from footfall._validate import check_fields, non_negative, positive
-from footfall.control.adjusters import STOP_STEPS
+from footfall.control.adjusters import REGION_MODES, STOP_STEPS
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
 from footfall.planning.plan import FootstepPlan
@@ -100,6 +100,14 @@ class WalkOptions:
             :func:`footfall.sim.biped.plans.plan_for_walk` plans; 0 = the regions as they are.
             Without it the MPC may move a footstep below a riser toward it until the heel lands
             on the riser's edge.
+        region_aware: how the walker's MPC keeps footsteps on the terrain
+            (:attr:`footfall.control.adjusters.MPCAdjuster.region_aware`): ``off`` keeps each
+            footstep ``region_margin + landing_margin`` inside its planned region (a uniform
+            inset: on stones narrower than twice it, no correction at all); ``planned`` keeps it
+            in the planned region inset exactly by the sole plus ``landing_margin``; ``nearby``
+            also lets it move to another region within reach when that is cheaper or the planned
+            one has no room. With either, a swing whose target moves while the sole is still
+            rising is raised over the regions under the new path.
         passive_landing: the swing ankle goes limp (torque mode, zero torque) from the first
             contact of the swing sole during its descent until the double support, where the
             landing ankle is passive anyway. A stiff position-servoed ankle that meets the ground
@@ -137,10 +145,13 @@ class WalkOptions:
     closed_loop_ik: bool = True
     landing_margin: float = 0.02
     riser_tolerance: float = RISER_LANDING_TOLERANCE
+    region_aware: str = "off"
     passive_landing: bool = True
     check_robot: bool = True
 
     def __post_init__(self) -> None:
+        if self.region_aware not in REGION_MODES:
+            raise InputError("region_aware", self.region_aware, f"one of {', '.join(REGION_MODES)}")
         if self.controller not in CONTROLLERS:
             raise InputError("controller", self.controller, f"one of {', '.join(CONTROLLERS)}")
         if not isinstance(self.wbc_gains, WbcGains):

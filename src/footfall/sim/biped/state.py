@@ -53,6 +53,8 @@ class SwingState:
     apex: float = 0.0
     rise: float = SWING_SHARES[0]
     descend: float = 1.0 - SWING_SHARES[0]
+    #: the target (3,) [m] the apex was set for
+    apex_for: FloatArray = field(default_factory=lambda: np.zeros(3))
 
 
 @dataclass

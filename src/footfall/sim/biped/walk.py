@@ -92,6 +92,8 @@ CONTACT_FORCE_SHARE = 0.02
 FALL_HEIGHT_SHARE = 0.6
 #: ... or the torso tilts more than this [rad], or the pelvis or torso touches the terrain
 FALL_TILT = math.radians(40.0)
+#: a swing target that moved this far [m] from the one its apex was set for gets its apex checked
+SWING_RETARGET = 0.01
 
 
 class BipedWalk:
@@ -150,6 +152,8 @@ class BipedWalk:
             control_dt=self.dt,
             stop_steps=opts.stop_steps,
             torque_limits=sole_torque_limits(plan.robot),
+            region_aware=opts.region_aware,
+            landing_margin=opts.landing_margin,
         )
 
     def _init_state(self) -> None:
@@ -324,6 +328,22 @@ class BipedWalk:
         swing.rise, swing.descend = swing_shares(
             swing.apex - float(swing.start[2]), swing.apex - float(target[2]), self.t_ss
         )
+        swing.apex_for = np.array(target, dtype=float)
+
+    def _raise_swing(self, tp: float, nxt: FloatArray) -> None:
+        """A corrected target (``region_aware``) may lie across other edges than the planned
+        one: while the sole is still rising, raise the apex over the regions under the new path
+        (never lower it) and re-time the descent to the new target height."""
+        swing = self.swing
+        if self.opts.region_aware == "off" or tp / self.t_ss >= swing.rise:
+            return
+        if float(np.linalg.norm(nxt - swing.apex_for)) <= SWING_RETARGET:
+            return
+        half = (self.robot.foot_length / 2, self.robot.foot_width / 2)
+        apex = terrain_height_along(self.scene.terrain.regions, swing.start, nxt, *half)
+        swing.apex = max(swing.apex, apex + self.opts.swing_clearance)
+        _, swing.descend = swing_shares(0.0, swing.apex - float(nxt[2]), self.t_ss)
+        swing.apex_for = np.array(nxt, dtype=float)
 
     def _single_support(
         self, k: int, i: int, tp: float, stance: FloatArray, obs: Observation
@@ -342,6 +362,7 @@ class BipedWalk:
         else:
             x_meas = x_cv
         nxt, u = self.src.update(tp, x_meas, stance, i)
+        self._raise_swing(tp, nxt)
         self.log.targets[i] = nxt
         self.log.zmp_planned[k] = alip.zmp(np.zeros(2), u)
         fb = 1.0 if opts.ankle_torque else opts.com_feedback
@@ -619,6 +640,11 @@ class BipedWalk:
         log = self.log.trimmed(k_end, self.dt)
         t_goal = self.t_walk0 + self.n_planned * self.t_step
         metrics = summarise(log, self.scene, self.plan, self.sim.params, t_goal)
+        choices = getattr(self.src, "choices", None)
+        if choices:
+            metrics = dataclasses.replace(
+                metrics, region_choices=tuple(c.to_dict() for c in choices.values())
+            )
         # WalkLog's fields are WalkResult's measurements under the same names
         measured = {f.name: getattr(log, f.name) for f in dataclasses.fields(log)}
         return WalkResult(

@@ -48,6 +48,7 @@ from __future__ import annotations
 import functools
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -57,6 +58,7 @@ from numpy.typing import NDArray
 from footfall._geometry import rot2
 from footfall._typing import FloatArray
 from footfall._validate import check_fields, non_negative, positive
+from footfall.control.adjusters import REGION_MODES
 from footfall.control.mpc import (
     MPC,
     SOLVERS,
@@ -71,6 +73,8 @@ from footfall.models.alip import ALIP
 from footfall.models.biped import BipedParams
 from footfall.planning.plan import FootstepPlan
 from footfall.sim.pushes import Push
+from footfall.sim.reduced.regions import RegionFeet, region_metrics
+from footfall.terrain.region import Region
 
 #: ways to run the loop (:attr:`SimOptions.engine`)
 ENGINES = ("auto", "compiled", "python")
@@ -104,6 +108,10 @@ class SimOptions:
             compiled with numba, newton solver only; same trajectories up to rounding; its speed
             is measured by ``footfall bench sim``) or ``auto`` (compiled when numba is installed
             and the solver is ``newton``).
+        region_aware: ``off`` (document 000: the MPC moves the footstep freely), ``planned``
+            or ``nearby``: the footstep is kept in its planned region inset by the sole, or in
+            the best region within reach (:mod:`footfall.sim.reduced.regions`; needs the scene's
+            regions, runs the python engine).
     """
 
     control_rate: float = 500.0
@@ -121,6 +129,7 @@ class SimOptions:
     mpc_nodes: int | None = None
     solver: str = "newton"
     engine: str = "auto"
+    region_aware: str = "off"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "control_rate", positive("control_rate", self.control_rate))
@@ -154,6 +163,14 @@ class SimOptions:
             raise InputError("solver", self.solver, f"one of {', '.join(SOLVERS)}")
         if self.engine not in ENGINES:
             raise InputError("engine", self.engine, f"one of {', '.join(ENGINES)}")
+        if self.region_aware not in REGION_MODES:
+            raise InputError("region_aware", self.region_aware, f"one of {', '.join(REGION_MODES)}")
+        if self.engine == "compiled" and self.region_aware != "off":
+            raise InputError(
+                "engine",
+                self.engine,
+                "'python' or 'auto' with region_aware (the compiled kernel has no region rows)",
+            )
         if self.engine == "compiled" and self.solver != "newton":
             raise InputError(
                 "engine",
@@ -176,6 +193,7 @@ class SimOptions:
             "seed": self.seed,
             "solver": self.solver,
             "engine": self.engine,
+            "region_aware": self.region_aware,
         }
 
 
@@ -208,6 +226,9 @@ class SimMetrics:
         wall_time: wall time of the run [s].
         engine: the engine that ran the loop, ``python`` or ``compiled`` (solve times of the
             compiled engine are those of the compiled solve, read inside the kernel).
+        footsteps_off_regions: landed footsteps whose centre lies outside every region in plan
+            view (None without the scene's regions).
+        region_changes: indices of the landed footsteps outside their planned region.
     """
 
     fell: bool
@@ -233,12 +254,16 @@ class SimMetrics:
     sim_time: float
     wall_time: float
     engine: str
+    footsteps_off_regions: int | None = None
+    region_changes: tuple[int, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (NaN becomes None)."""
         out: dict[str, Any] = {}
         for k, v in asdict(self).items():
-            if isinstance(v, tuple):
+            if k == "region_changes":
+                out[k] = list(v)
+            elif isinstance(v, tuple):
                 out[k] = [None if not math.isfinite(x) else float(x) for x in v]
             elif isinstance(v, float) and not math.isfinite(v):
                 out[k] = None
@@ -380,6 +405,8 @@ class _Walk:
     decay: FloatArray  # exp(-omega T_r) per tick (M,)
     d0: FloatArray
     d_span: FloatArray
+    regions: tuple[Region, ...] = ()  # the scene's regions (region metrics, region_aware)
+    region_aware: str = "off"
 
 
 @dataclass
@@ -453,7 +480,12 @@ def _push_table(
     return push_tab
 
 
-def _prepare(plan: FootstepPlan, opts: SimOptions, goal: FloatArray | None) -> _Walk:
+def _prepare(
+    plan: FootstepPlan,
+    opts: SimOptions,
+    goal: FloatArray | None,
+    regions: tuple[Region, ...] = (),
+) -> _Walk:
     robot = plan.robot
     n = plan.n_steps
     mdl = _mpc_model(robot, opts)
@@ -520,6 +552,8 @@ def _prepare(plan: FootstepPlan, opts: SimOptions, goal: FloatArray | None) -> _
         decay=np.exp(-true.omega * (m_ticks - 1 - np.arange(m_ticks)) * dt),
         d0=d0,
         d_span=d_span,
+        regions=regions,
+        region_aware=opts.region_aware,
     )
 
 
@@ -555,6 +589,11 @@ class _PythonLoop:
         self.w = w
         self.tr = _new_trace(w)
         self.mpc = MPC(w.mdl, w.solver)
+        self.region_feet = (
+            RegionFeet(w.plan, w.regions, w.region_aware, self.mpc, w.f_len, w.f_wid)
+            if w.region_aware != "off"
+            else None
+        )
         self.x = np.array(w.plan.states[0, 0], dtype=float)
         self.feet = [np.array(w.plan.footsteps[0], dtype=float)]
         self.fell = False
@@ -593,7 +632,10 @@ class _PythonLoop:
         for k in range(w.m_ticks):
             theta[:4] = self.x
             theta[:4] += w.noise[i * w.m_ticks + k]
-            sol = self.mpc.solve_theta(k, theta, stance, p_ref)
+            if self.region_feet is None:
+                sol = self.mpc.solve_theta(k, theta, stance, p_ref)
+            else:
+                sol = self.region_feet.solve(i, k, theta, stance, p_ref)
             self.tr.solve_times[self.n_solve] = sol.solve_time
             self.n_solve += 1
             u = self._apply(i, stance, sol.torques[0], cth, sth)
@@ -769,6 +811,7 @@ def _result(w: _Walk, tr: _Trace, engine: str, wall0: float) -> SimResult:
         stopped = _in_hull(xi_final, corners)
     st = tr.solve_times if tr.solve_times.size else np.zeros(1)
     sat = tr.sat[sl][ss]
+    off, changed = region_metrics(w.regions, plan, feet_arr) if w.regions else (None, ())
     metrics = SimMetrics(
         fell=tr.fell,
         fall_time=tr.fall_time,
@@ -793,6 +836,8 @@ def _result(w: _Walk, tr: _Trace, engine: str, wall0: float) -> SimResult:
         sim_time=float(tr.time),
         wall_time=time.perf_counter() - wall0,
         engine=engine,
+        footsteps_off_regions=off,
+        region_changes=changed,
     )
     return SimResult(
         metrics=metrics,
@@ -828,7 +873,7 @@ def compiled_available() -> bool:
 
 def resolve_engine(options: SimOptions) -> str:
     """The engine :func:`simulate` runs for ``options``: ``auto`` is ``compiled`` when numba is
-    installed and the MPC solver is ``newton``, else ``python``.
+    installed, the MPC solver is ``newton`` and ``region_aware`` is off, else ``python``.
 
     Raises:
         SolverUnavailableError: ``engine="compiled"`` without numba.
@@ -842,13 +887,15 @@ def resolve_engine(options: SimOptions) -> str:
                 "(or SimOptions(engine='python'))"
             )
         return "compiled"
-    return "compiled" if options.solver == "newton" and compiled_available() else "python"
+    fast = options.solver == "newton" and options.region_aware == "off"
+    return "compiled" if fast and compiled_available() else "python"
 
 
 def simulate(
     plan: FootstepPlan,
     options: SimOptions | None = None,
     goal: FloatArray | None = None,
+    regions: Sequence[Region] | None = None,
 ) -> SimResult:
     """Walk ``plan`` in closed loop: MPC (eq. 5.19) on the ALIP plant with a rectangular sole.
 
@@ -860,6 +907,8 @@ def simulate(
         plan: a footstep plan with states (its robot is the controller's model).
         options: simulation options.
         goal: goal position (2,) or (3,) [m]; default the midpoint of the last two footsteps.
+        regions: the scene's regions: the region metrics are computed with them, and
+            ``options.region_aware`` needs them.
 
     Returns:
         A :class:`SimResult`. Falls are reported in the metrics, never raised.
@@ -873,8 +922,11 @@ def simulate(
     n = plan.n_steps
     if n < 1 or plan.states.shape[0] != n:
         raise InputError("plan", plan.message or plan.status, "a plan with at least one footstep")
+    regs = tuple(regions) if regions is not None else ()
+    if opts.region_aware != "off" and not regs:
+        raise InputError("regions", regions, "the scene's regions (SimOptions.region_aware)")
     engine = resolve_engine(opts)
-    w = _prepare(plan, opts, goal)
+    w = _prepare(plan, opts, goal, regs)
     tr = _walk_compiled(w) if engine == "compiled" else _walk_python(w)
     return _result(w, tr, engine, wall0)
 

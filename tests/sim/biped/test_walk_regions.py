@@ -1,0 +1,117 @@
+"""Region-aware corrections in MuJoCo (issue 23): the walker walks stepping_stones with the
+miqcqp plan of ``footfall walk`` (stored in data/, so the test does not plan for minutes) and a
+2 N s push, every footstep landing on a stone; the walk metrics' region counts are checked
+against shapely on the landed soles."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+mujoco = pytest.importorskip("mujoco")
+pytest.importorskip("mink")
+
+from shapely.geometry import Point, Polygon  # noqa: E402
+
+from footfall.planning.plan_file import load_plan  # noqa: E402
+from footfall.sim.biped.options import WalkOptions  # noqa: E402
+from footfall.sim.biped.plans import random_push  # noqa: E402
+from footfall.sim.biped.walk import walk  # noqa: E402
+from footfall.terrain import builtin_scene  # noqa: E402
+
+PLAN = Path(__file__).parent / "data" / "stepping_stones_miqcqp.json"
+#: the measured sole centre sits this close to the stone's surface [m]
+ON_SURFACE_TOL = 0.03
+
+
+def test_region_aware_walk_keeps_every_footstep_on_a_stone() -> None:
+    scene = builtin_scene("stepping_stones")
+    plan = load_plan(PLAN, scene)
+    opts = WalkOptions(region_aware="planned")
+    push = random_push(0, 20.0, plan, opts)  # 20 N for 0.1 s: 2 N s
+    res = walk(scene, plan, WalkOptions(region_aware="planned", pushes=(push,)))
+    m = res.metrics
+    assert not m.fell and m.reached_goal
+    polys = [(Polygon(r.vertices), r) for r in scene.terrain.regions]
+    landed = res.landed[~np.isnan(res.landed[:, 0])]
+    assert landed.shape[0] == plan.n_steps + opts.stop_steps
+    for p in landed:
+        on = [
+            r.name
+            for poly, r in polys
+            if poly.covers(Point(p[:2])) and abs(float(r.height_at(p[:2])) - p[2]) <= ON_SURFACE_TOL
+        ]
+        assert on, p
+    assert m.footsteps_off_regions == 0
+    # the adjuster recorded a choice per phase, every one on the planned stone
+    assert len(m.region_choices) == plan.n_steps + opts.stop_steps
+    assert all(c["region"] == c["planned"] for c in m.region_choices)
+    assert m.region_changes == ()
+    # corrections are the distances of the commanded footsteps from the plan
+    corr = np.linalg.norm((res.targets - res.planned)[: plan.n_steps, :2], axis=1)
+    assert m.correction_m.max == pytest.approx(corr.max(), abs=1e-12)
+    assert 0.0 < m.correction_m.max < 0.1
+
+
+def test_bad_region_mode_names_the_field() -> None:
+    from footfall.errors import InputError
+
+    with pytest.raises(InputError, match="region_aware"):
+        WalkOptions(region_aware="anywhere")
+
+
+@pytest.mark.parametrize("mode", ["off", "planned"])
+def test_a_retargeted_swing_is_raised_over_the_regions_under_its_new_path(mode: str) -> None:
+    """A correction that moves the swing target across a higher stone raises the apex over it
+    while the sole is still rising (region-aware walks only); the height is checked with shapely
+    against the stones the sole's swept path crosses."""
+    from shapely.geometry import LineString
+
+    from footfall.sim.biped.walk import BipedWalk
+
+    scene = builtin_scene("stepping_stones")
+    plan = load_plan(PLAN, scene)
+    walker = BipedWalk(scene, plan, WalkOptions(region_aware=mode))
+    walker._begin_step(0)
+    apex0 = walker.swing.apex
+    # a target on stone4 (0.08 m high), far across stones 1-3, instead of the planned one
+    target = np.array([1.31, -0.14, 0.08])
+    walker._raise_swing(0.0, target)
+    start = walker.swing.start
+    robot = plan.robot
+    path = LineString([start[:2], target[:2]]).buffer(robot.foot_width / 2)
+    crossed = max(
+        float(np.max(r.height_at(r.vertices)))
+        for r in scene.terrain.regions
+        if Polygon(r.vertices).intersects(path)
+    )
+    clearance = WalkOptions().swing_clearance
+    if mode == "off":
+        assert walker.swing.apex == apex0
+    else:
+        assert walker.swing.apex >= crossed + clearance - 1e-9
+        assert walker.swing.apex > apex0
+    # late in the swing (the sole no longer rising) nothing changes
+    walker.swing.apex = apex0
+    walker._raise_swing(0.9 * robot.t_ss, target + 0.05)
+    assert walker.swing.apex == apex0
+
+
+@pytest.mark.parametrize("name", ["narrow_stones_gap", "roll_ramps", "corridor_corner"])
+def test_new_scenes_are_walked_with_every_footstep_on_a_region(name: str) -> None:
+    """Smoke test of the issue's new scenes (plans of ``footfall walk`` stored in data/): the
+    region-aware walk reaches the goal and no landed sole centre is off the terrain (shapely)."""
+    scene = builtin_scene(name)
+    plan = load_plan(Path(__file__).parent / "data" / f"{name}_miqcqp.json", scene)
+    res = walk(scene, plan, WalkOptions(region_aware="planned"))
+    assert not res.metrics.fell and res.metrics.reached_goal
+    landed = res.landed[~np.isnan(res.landed[:, 0])]
+    for p in landed:
+        assert any(
+            Polygon(r.vertices).covers(Point(p[:2]))
+            and abs(float(r.height_at(p[:2])) - p[2]) <= ON_SURFACE_TOL
+            for r in scene.terrain.regions
+        ), p
+    assert res.metrics.footsteps_off_regions == 0
