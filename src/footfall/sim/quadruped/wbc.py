@@ -175,6 +175,11 @@ class QuadrupedWbc:
         )
         root = int(m.jnt_dofadr[mj.mj_name2id(m, mj.mjtObj.mjOBJ_JOINT, nm.ROOT_JOINT)])
         self.base_dofs = np.arange(root, root + 6)
+        #: constant task arrays: the joints' rows of qdd, their zero drift, a normal-force row
+        self._select = np.zeros((self.joint_dofs.size, self.model.nv))
+        self._select[np.arange(self.joint_dofs.size), self.joint_dofs] = 1.0
+        self._no_drift = np.zeros(self.joint_dofs.size)
+        self._normal_force = np.concatenate([self.normal, np.zeros(3)]).reshape(1, 6)
         self.failures = 0
         self.last_tau = np.zeros(len(sim.actuators))
         #: the last solved problem and its solution (None before the first solve)
@@ -193,7 +198,6 @@ class QuadrupedWbc:
         sim, d, g, ref = self.sim, self.sim.data, self.gains, self.ref
         k, w = ref.at(t)
         mass, bias = self.model.dynamics()
-        nv = self.model.nv
         stance = ref.contact[k] if w < 0.5 else ref.contact[k + 1]
         to_switch = ref.to_switch[k] - w * ref.dt
         touching = self._touching()
@@ -218,7 +222,7 @@ class QuadrupedWbc:
                         WrenchTask(
                             f"unload{leg}",
                             pt,
-                            np.concatenate([self.normal, np.zeros(3)]).reshape(1, 6),
+                            self._normal_force,
                             np.zeros(1),
                             g.unload_weight * share,
                             (name,),
@@ -247,16 +251,12 @@ class QuadrupedWbc:
         tasks.append(MotionTask("trunk", jac[:3], drift[:3], acc_lin, g.trunk_weight))
         tasks.append(MotionTask("trunk_rot", jac[3:], drift[3:], acc_ang, g.rot_weight))
         # joint posture
-        sel = np.zeros((self.joint_dofs.size, nv))
-        sel[np.arange(self.joint_dofs.size), self.joint_dofs] = 1.0
         q = d.qpos[sim.qpos_adr]
         qd = d.qvel[self.joint_dofs]
         acc_q = g.posture_kp * (_lerp(ref.joints, k, w) - q) + g.posture_kd * (
             _lerp(ref.joints_v, k, w) - qd
         )
-        tasks.append(
-            MotionTask("posture", sel, np.zeros(self.joint_dofs.size), acc_q, g.posture_weight)
-        )
+        tasks.append(MotionTask("posture", self._select, self._no_drift, acc_q, g.posture_weight))
         if points and g.cop_weight > 0:
             zp = float(np.mean([p[2] for p in points]))
             z = _lerp(ref.zmp, k, w)
