@@ -28,7 +28,8 @@ def study_command(
     ),
     builtin: str | None = typer.Option(
         None,
-        help="A built-in study instead of a file: section55 (the final MuJoCo study) or quick.",
+        help="A built-in study instead of a file: section55 (the final MuJoCo study), "
+        "section55_reduced (the same grid in the reduced-order loop) or quick.",
     ),
     quick: bool = typer.Option(False, "--quick", help="The tiny built-in study (about a minute)."),
     out: Path = typer.Option(Path("out/study"), help="Output folder (reruns resume it)."),
