@@ -45,7 +45,7 @@ MUTANTS[mpc]="footfall.control.mpc.xǁMPCWeightsǁmatrices__mutmut_* footfall.co
 # the MPC's solvers (the torque-disc QP's dual Newton method, the polygon QP through Clarabel,
 # MPC.solve* and the fallback), against the same tests
 SRC[mpc_solvers]=src/footfall/control/mpc.py
-TESTS[mpc_solvers]="tests/control/test_mpc.py tests/control/test_mpc_reference.py"
+TESTS[mpc_solvers]="tests/control/test_mpc.py tests/control/test_mpc_reference.py tests/control/test_mpc_solvers.py"
 MUTANTS[mpc_solvers]="footfall.control.mpc.x_solve_ball_qp__mutmut_* footfall.control.mpc.x__cold_start__mutmut_*
     footfall.control.mpc.x__ball_dual__mutmut_* footfall.control.mpc.x__newton_step__mutmut_*
     footfall.control.mpc.x__check_polygon__mutmut_* footfall.control.mpc.x__clarabel_in_polygon__mutmut_*
