@@ -62,25 +62,18 @@ def mean_ci(
         return m, m, m
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # BCa warns on near-degenerate samples; checked below
-        res = stats.bootstrap(
-            (x,),
-            np.mean,
-            confidence_level=level,
-            n_resamples=RESAMPLES,
-            method="BCa",
-            rng=np.random.default_rng(seed),
-        )
-        lo, hi = float(res.confidence_interval.low), float(res.confidence_interval.high)
-        if not (math.isfinite(lo) and math.isfinite(hi)):
+        for method in ("BCa", "percentile"):  # percentile where BCa is undefined
             res = stats.bootstrap(
                 (x,),
                 np.mean,
                 confidence_level=level,
                 n_resamples=RESAMPLES,
-                method="percentile",
+                method=method,
                 rng=np.random.default_rng(seed),
             )
             lo, hi = float(res.confidence_interval.low), float(res.confidence_interval.high)
+            if math.isfinite(lo) and math.isfinite(hi):
+                break
     return m, lo, hi
 
 

@@ -38,7 +38,6 @@ from footfall.control.wbc import (
 )
 from footfall.errors import InputError, SolverError
 from footfall.quadruped.gait import GaitTrajectory
-from footfall.sim.quadruped import names as nm
 from footfall.sim.wbc_model import MujocoWbcModel
 
 #: moment rows (mx, my) of the contact wrench: the horizontal moment about the ZMP
@@ -173,8 +172,6 @@ class QuadrupedWbc:
         self.joint_dofs = np.array(
             [int(m.jnt_dofadr[int(m.actuator_trnid[a, 0])]) for a in sim.actuators]
         )
-        root = int(m.jnt_dofadr[mj.mj_name2id(m, mj.mjtObj.mjOBJ_JOINT, nm.ROOT_JOINT)])
-        self.base_dofs = np.arange(root, root + 6)
         #: constant task arrays: the joints' rows of qdd, their zero drift, a normal-force row
         self._select = np.zeros((self.joint_dofs.size, self.model.nv))
         self._select[np.arange(self.joint_dofs.size), self.joint_dofs] = 1.0
