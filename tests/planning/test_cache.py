@@ -81,3 +81,19 @@ def test_a_cache_file_that_is_not_json_is_planned_again(tmp_path: Path) -> None:
     assert "discarded" in again.message
     np.testing.assert_allclose(again.footsteps, made.footsteps)
     assert json.loads(path.read_text())["status"] == made.status.value
+
+
+def test_a_planner_revision_makes_its_old_entries_miss(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    """A planner whose algorithm changed (its revision bumped) gets new keys; the others keep
+    theirs, so their (possibly minutes-long) plans stay served."""
+    from footfall.planning import cache as cache_mod
+
+    sc, opts = scene(SHORT_FLAT), PlannerOptions()
+    before = {p: plan_key(sc, p, None, opts) for p in ("reactive", "miqcqp")}
+    monkeypatch.setitem(cache_mod.PLANNER_REVISION, "reactive", 99)
+    assert plan_key(sc, "reactive", None, opts) != before["reactive"]
+    assert plan_key(sc, "miqcqp", None, opts) == before["miqcqp"]
+    monkeypatch.setitem(cache_mod.PLANNER_REVISION, "reactive", 1)
+    unrevised = plan_key(sc, "reactive", None, opts)
+    monkeypatch.setitem(cache_mod.PLANNER_REVISION, "reactive", 2)
+    assert plan_key(sc, "reactive", None, opts) != unrevised

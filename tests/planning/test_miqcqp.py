@@ -273,6 +273,29 @@ def test_reactive_baseline_comes_nearly_to_rest_on_the_goal() -> None:
     assert np.linalg.norm(com - sc.goal.position[:2]) < 0.1
 
 
+@pytest.mark.parametrize("name", ["discrete_steps", "stairs_slope_gap"])
+def test_reactive_baseline_ends_capturable_with_a_weak_ankle(name: str) -> None:
+    """With the MuJoCo biped's numbers (ankle torque bound 11.8 N m: the ZMP within 4 cm of the
+    sole centre) the reactive walk must brake before the goal: one final stance cannot stop a
+    0.5 m/s walk. The final state's divergent component of motion ``c + v / omega`` (computed
+    here from the ALIP definitions, eq. 5.1: v_x = L_y / (m z_H), v_y = -L_x / (m z_H)) must lie
+    near the midpoint of the final feet, where the robot can shift its CoM and stand. Before
+    the reactive planner braked, it ended 25 cm behind (discrete_steps) and 28 cm ahead
+    (stairs_slope_gap) of it, and every MuJoCo walk of the plan fell while stopping."""
+    sc = builtin_scene(name)
+    robot = replace(sc.robot, mass=30.1, com_height=0.6725, u_max=11.8)
+    plan = plan_reactive(sc, robot)
+    assert plan.status is SolveStatus.FEASIBLE, plan.message
+    assert check_plan(plan, sc).ok
+    x = plan.final_state
+    mzh = robot.mass * robot.com_height
+    omega = math.sqrt(robot.g / robot.com_height)
+    dcm = plan.footsteps[-1, :2] + x[:2] + np.array([x[3], -x[2]]) / mzh / omega
+    mid = 0.5 * (plan.footsteps[-1, :2] + plan.footsteps[-2, :2])
+    assert np.linalg.norm(dcm - mid) < 0.04, (dcm, mid)
+    assert np.linalg.norm(mid - sc.goal.position[:2]) < 1e-6
+
+
 @pytest.mark.parametrize(
     ("kwargs", "field"),
     [({"n_steps": 0}, "n_steps"), ({"n_steps": 2.5}, "n_steps"), ({"planner": "astar"}, "planner")],

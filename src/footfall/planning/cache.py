@@ -2,7 +2,8 @@
 
 A MIQCQP plan can take minutes; walks, comparisons and studies ask for the same plan again. The
 cache key is a SHA-256 digest of one canonical JSON document holding the scene (regions, start,
-goal, its robot: :func:`footfall.terrain.scene_to_dict`), the planner, the step count, the robot
+goal, its robot: :func:`footfall.terrain.scene_to_dict`), the planner and its revision
+(:data:`PLANNER_REVISION`), the step count, the robot
 the plan is made for and every planner option (weights, solver, its settings, time limit, gap,
 threads, margins): change any of them, or edit a scene file under the same name, and the plan is
 made again. The file name is the digest alone (``plan-<digest>.json``), so no name a user gave
@@ -33,6 +34,10 @@ from footfall.terrain.scene import Scene, robot_to_dict, scene_to_dict
 
 #: version of the key's layout and of the file format; bumping it makes every old entry a miss
 CACHE_VERSION = 2
+#: revision of a planner's algorithm, bumped when it makes another plan from the same inputs
+#: (reactive 2: it brakes before the goal). A planner not listed is at revision 1, which is left
+#: out of the key so that its entries stay valid.
+PLANNER_REVISION: dict[str, int] = {"reactive": 2}
 #: a cache file larger than this [bytes] is refused (a plan of 100 steps is ~200 kB)
 MAX_CACHE_FILE = 20_000_000
 
@@ -78,6 +83,8 @@ def plan_key(
         "robot": _plain(robot_to_dict(robot if robot is not None else scene.robot)),
         "options": opts,
     }
+    if PLANNER_REVISION.get(planner, 1) != 1:
+        doc["revision"] = PLANNER_REVISION[planner]
     text = json.dumps(doc, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
 

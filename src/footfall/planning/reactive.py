@@ -27,6 +27,10 @@ from footfall.terrain.scene import Scene
 
 #: nominal forward walking speed of the reactive planner [m/s]
 NOMINAL_SPEED = 0.5
+#: weight of the final state's momentum (as a velocity [m/s]) beside its DCM error [m]
+REST_MOMENTUM_WEIGHT = 0.1
+#: the aimed speed is at most the distance to the goal over this time [s]
+BRAKE_TIME = 1.5
 
 
 @dataclass(frozen=True)
@@ -152,8 +156,7 @@ def _add_step_cost(
     if goal.target is not None:
         for j in range(2):
             b.add_eq({int(p[j]): 1.0}, float(goal.target[j]), "target")
-    else:
-        assert goal.l_des is not None
+    if goal.l_des is not None:
         ad, _ = alip.discretize(robot.node_dt)
         ad_ss = np.linalg.matrix_power(ad, k_nodes - 1)
         # L at the end of the next phase: M_x x_K + M_p (p - stance), M = (ad_ss [A_r, B_r])[2:].
@@ -167,15 +170,27 @@ def _add_step_cost(
             offset = float(m_p[j] @ stance)
             b.add_square(row, float(goal.l_des[j]) + offset, 1.0 / mzh**2, "momentum")
     if goal.rest_at is not None:
-        # x+ = A_r x_K + B_r (p - stance) toward [rest_at - p, 0, 0] (both relative to p).
+        # x+ = A_r x_K + B_r (p - stance) (relative to p). Its divergent component of motion
+        # xi = c + v / omega (absolute) goes to ``rest_at``, its momentum to 0 (lighter): with
+        # the DCM between the feet the robot can shift its CoM there and stand.
+        rows, targets = [], []
         for j in range(4):
             row = {int(x[k_nodes - 1, jj]): float(a_r[j, jj]) for jj in range(4)}
             for jj in range(3):
                 coef = float(b_r[j, jj]) + (1.0 if j == jj and j < 2 else 0.0)
                 if coef != 0.0:
                     row[int(p[jj])] = row.get(int(p[jj]), 0.0) + coef
-            target_j = float(b_r[j] @ stance) + (float(goal.rest_at[j]) if j < 2 else 0.0)
-            b.add_square(row, target_j, 1.0 if j < 2 else 1.0 / mzh**2, "rest")
+            rows.append(row)
+            targets.append(float(b_r[j] @ stance) + (float(goal.rest_at[j]) if j < 2 else 0.0))
+        k_dcm = 1.0 / (mzh * alip.omega)
+        # v_x = L_y / (m z_H), v_y = -L_x / (m z_H)
+        for j, (jl, sign) in enumerate(((3, 1.0), (2, -1.0))):
+            row = dict(rows[j])
+            for key, val in rows[jl].items():
+                row[key] = row.get(key, 0.0) + sign * k_dcm * val
+            b.add_square(row, targets[j] + sign * k_dcm * targets[jl], 1.0, "rest dcm")
+        for j in (2, 3):
+            b.add_square(rows[j], targets[j], REST_MOMENTUM_WEIGHT / mzh**2, "rest")
 
 
 def _periodic_lateral_momentum(robot: BipedParams) -> float:
@@ -203,7 +218,6 @@ def _aim(
     within reach, else aim at the forward and lateral momentum of a nominal gait toward the
     goal. The very last step (the stance foot already on its goal spot) ends at rest."""
     nxt_side = side.other
-    mzh = robot.mass * robot.com_height
     to_goal = scene.goal.position[:2] - stance[:2]
     dist = float(np.linalg.norm(to_goal))
     desired_th = math.atan2(to_goal[1], to_goal[0]) if dist > 0.5 else theta_goal
@@ -215,14 +229,26 @@ def _aim(
         # Goal feet within reach: step onto them.
         new_th = heading + max(-robot.theta_max, min(robot.theta_max, theta_goal - heading))
         last = bool(np.linalg.norm(stance[:2] - feet_goal[side]) < 1e-6)
-        rest = scene.goal.position[:2] if last else None
-        return new_th, _Goal(target=target_goal, rest_at=rest)
-    speed = min(NOMINAL_SPEED, dist / (2 * (robot.t_ss + robot.t_ds)))
+        if last:
+            return new_th, _Goal(target=target_goal, rest_at=scene.goal.position[:2])
+        return new_th, _Goal(
+            target=target_goal, l_des=_nominal_momentum(robot, new_th, nxt_side, dist)
+        )
+    return new_th, _Goal(l_des=_nominal_momentum(robot, new_th, nxt_side, dist))
+
+
+def _nominal_momentum(
+    robot: BipedParams, heading: float, nxt_side: Side, dist: float
+) -> FloatArray:
+    """(L_x, L_y) [kg m^2/s] to aim at the end of the next single support: the nominal speed,
+    slowed down within ``BRAKE_TIME`` of the goal ``dist`` [m] away, and the lateral momentum of
+    a periodic gait."""
+    mzh = robot.mass * robot.com_height
+    speed = min(NOMINAL_SPEED, dist / BRAKE_TIME)
     # At the end of a left stance the CoM moves right (v_y < 0), so L_x = -m z_H v_y > 0;
     # (L_x, L_y) rotates with the heading like a vector.
     lx_mag = _periodic_lateral_momentum(robot)
-    l_des = rot2(new_th) @ np.array([nxt_side.sign * lx_mag, mzh * speed])
-    return new_th, _Goal(l_des=l_des)
+    return rot2(heading) @ np.array([nxt_side.sign * lx_mag, mzh * speed])
 
 
 def plan_reactive(
