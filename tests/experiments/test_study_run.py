@@ -337,3 +337,39 @@ def test_cli_writes_the_table_the_summary_and_the_figures(tmp_path: Path, plans:
     assert "Verdict" in md and "miqcqp - kinematic" in md
     assert (out / "fragility.png").stat().st_size > 0
     assert (out / "summary.json").is_file() and (out / "cells.csv").is_file()
+
+
+def test_rows_of_a_plan_that_changed_are_walked_again(
+    tmp_path: Path, plans: Path, reference: Any
+) -> None:
+    """A row records the digest of the plan it walked. When a planner makes another plan (here:
+    the reactive rows claim another plan; a table from before the column existed has none), the
+    rerun walks exactly those trials again and the table ends as the uninterrupted run's."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    out = _out(tmp_path, plans, "stale")
+    run_study(_design(), out, workers=1)
+    table = pq.read_table(out / "trials.parquet")
+    rows = table.to_pylist()
+    n_reactive = sum(r["planner"] == "reactive" for r in rows)
+    assert 0 < n_reactive < len(rows)
+    assert all(isinstance(r["plan"], str) and len(r["plan"]) == 16 for r in rows)
+    for r in rows:
+        if r["planner"] == "reactive":
+            r["plan"] = "0" * 16
+            r["success"] = not r["success"]  # a stale row's numbers must not survive
+    pq.write_table(pa.Table.from_pylist(rows, schema=table.schema), out / "trials.parquet")
+    lines: list[str] = []
+    stale = run_study(_design(), out, workers=1, limit=1, say=lines.append)
+    assert stale.ran == 1 and any(f"{n_reactive} walk(s)" in s for s in lines)
+    # the rows still stale are not reported
+    assert len(stale.rows) == len(rows) - n_reactive + 1
+    again = run_study(_design(), out, workers=1)
+    assert again.ran == n_reactive - 1
+    assert _comparable(again.rows) == _comparable(reference.rows)
+    # a table without the plan column (written before it existed) is read; its rows are rerun
+    pq.write_table(table.drop(["plan"]), out / "trials.parquet")
+    old = run_study(_design(), out, workers=1)
+    assert old.ran == N_WALKS
+    assert _comparable(old.rows) == _comparable(reference.rows)

@@ -8,7 +8,9 @@ modes (the same walk, one row flagged ``smallest_n`` and ``equal_n``).
 Executors: ``local`` (this process for one worker, else a process pool) and ``ray`` (a local
 ``ray.init`` with ``workers`` CPUs, or an existing cluster at ``address``). Rows are stored as they
 arrive (:class:`~footfall.experiments.study.store.TrialStore`); trials already in the folder are
-skipped, so an interrupted study resumes where it stopped.
+skipped, so an interrupted study resumes where it stopped. A row names the plan it walked
+(:func:`~footfall.experiments.study.trials.plan_digest`): when a planner now makes another plan
+(its code changed), that planner's trials are walked again and their old rows replaced.
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from typing import Any
 from footfall.errors import InputError
 from footfall.experiments.study.design import Disturbance, StudyDesign
 from footfall.experiments.study.store import TrialStore
-from footfall.experiments.study.trials import Trial, run_trial, trial_key
+from footfall.experiments.study.trials import Trial, plan_digest, run_trial, trial_key
 from footfall.planning.plan import FootstepPlan
 from footfall.planning.run import SearchMonitor
 from footfall.terrain.scene import Scene, builtin_scene
@@ -314,15 +316,29 @@ def run_study(
     store = TrialStore(out, design)
     plans = make_plans(design, out / "plans", say, monitor_for)
     trials = make_trials(design, plans)
+    digests: dict[int, str] = {}  # one digest per plan object, not per trial
+    for t in trials:
+        digests.setdefault(id(t.plan), plan_digest(t.plan))
+
+    def done_(t: Trial) -> bool:
+        return store.done(t.key, digests[id(t.plan)])
+
     for t in trials:  # a walk run by an earlier study may serve a step mode added since
         r = store.rows.get(t.key)
-        if r is not None and (t.smallest_n > r["smallest_n"] or t.equal_n > r["equal_n"]):
+        if (
+            r is not None
+            and done_(t)
+            and (t.smallest_n > r["smallest_n"] or t.equal_n > r["equal_n"])
+        ):
             smallest, equal = r["smallest_n"] or t.smallest_n, r["equal_n"] or t.equal_n
             store.add(r | {"smallest_n": smallest, "equal_n": equal})
-    todo = [t for t in trials if not store.done(t.key)]
+    todo = [t for t in trials if not done_(t)]
+    stale = sum(1 for t in todo if t.key in store.rows)
+    if stale and say:
+        say(f"{stale} walk(s) in the table walked another plan than today's: walking them again")
     if limit is not None:
         todo = todo[:limit]
-    done = len(trials) - len([t for t in trials if not store.done(t.key)])
+    done = len(trials) - len([t for t in trials if not done_(t)])
     t0 = time.perf_counter()
     ran = 0
     try:
@@ -333,6 +349,7 @@ def run_study(
                 progress(done + ran, len(trials), row)
     finally:
         store.close()
-    keys = {t.key for t in trials}
+    # rows of this study's trials that walked today's plans (a stale row waits for its rerun)
+    keys = {t.key for t in trials if done_(t)}
     rows = [store.rows[k] for k in sorted(store.rows) if k in keys]
     return StudyRun(rows, plans, len(trials), ran, time.perf_counter() - t0)

@@ -18,7 +18,7 @@ from typing import Any
 
 from footfall.errors import InputError
 from footfall.experiments.study.design import StudyDesign
-from footfall.experiments.study.trials import COLUMNS
+from footfall.experiments.study.trials import COLUMNS, OPTIONAL_COLUMNS
 
 TABLE = "trials.parquet"
 PARTS = "trials.parts"
@@ -60,9 +60,10 @@ def read_rows(path: Path) -> list[dict[str, Any]]:
     except (OSError, pa.ArrowException) as e:
         raise InputError("trials file", str(path), f"a readable Parquet table ({e})") from None
     missing = [n for n, _ in COLUMNS if n not in table.column_names]
-    if missing:
+    if [n for n in missing if n not in OPTIONAL_COLUMNS]:
         raise InputError("trials file", str(path), f"the study columns (missing {missing})")
-    return table.select([n for n, _ in COLUMNS]).to_pylist()
+    rows = table.select([n for n, _ in COLUMNS if n not in missing]).to_pylist()
+    return [{n: r.get(n) for n, _ in COLUMNS} for r in rows]
 
 
 def write_rows(path: Path, rows: list[dict[str, Any]]) -> Path:
@@ -120,10 +121,14 @@ class TrialStore:
         self.flushed_at = time.monotonic()
         self.n_parts = 0
 
-    def done(self, key: str) -> bool:
+    def done(self, key: str, plan: str | None = None) -> bool:
         """Whether the trial ``key`` has a row (errors included: rerun them with a new folder or
-        by deleting their rows; a trial that raises is expected to raise again)."""
-        return key in self.rows
+        by deleting their rows; a trial that raises is expected to raise again) and, with
+        ``plan`` (:func:`~footfall.experiments.study.trials.plan_digest`), whether that row
+        walked this plan: a row of another plan, or of an unknown one (a table written before
+        rows named their plan), is walked again and replaced."""
+        row = self.rows.get(key)
+        return row is not None and (plan is None or row["plan"] == plan)
 
     def add(self, row: dict[str, Any]) -> None:
         """Keep a finished row; write a part file every ``FLUSH_ROWS`` rows or ``FLUSH_SECONDS``."""

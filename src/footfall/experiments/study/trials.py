@@ -8,11 +8,14 @@ trial.
 
 from __future__ import annotations
 
+import hashlib
 import math
 import time
 import traceback
 from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
 
 from footfall.experiments.study.design import Disturbance, StudyDesign
 from footfall.planning.plan import FootstepPlan
@@ -25,6 +28,7 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("scene", "string"),
     ("planner", "string"),
     ("n_steps", "int64"),
+    ("plan", "string"),
     ("smallest_n", "bool"),
     ("equal_n", "bool"),
     ("push_impulse", "float64"),
@@ -44,6 +48,8 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("wall_time", "float64"),
     ("error", "string"),
 )
+#: columns a table written before they existed may lack (read as None)
+OPTIONAL_COLUMNS = ("plan",)
 #: the columns that vary between runs of the same trial (left out when runs are compared)
 RUN_DEPENDENT = ("wall_time",)
 
@@ -73,6 +79,18 @@ class Trial:
     impulse: float
     disturbance: Disturbance
     design: StudyDesign
+
+
+def plan_digest(plan: FootstepPlan) -> str:
+    """16 hex digits that change whenever the walked plan does: its planner, footsteps,
+    headings, sides, regions, ALIP states, torques and final state (rounded to 1e-9). A row
+    records the digest of the plan it walked, so a study rerun after a planner changed walks
+    that planner's trials again instead of keeping rows of a plan it no longer makes."""
+    h = hashlib.sha256()
+    h.update(f"{plan.planner}|{plan.sides}|{plan.regions}".encode())
+    for arr in (plan.footsteps, plan.headings, plan.states, plan.torques, plan.final_state):
+        h.update((np.round(np.asarray(arr, dtype=float), 9) + 0.0).tobytes())  # -0.0 -> 0.0
+    return h.hexdigest()[:16]
 
 
 def trial_key(scene: str, planner: str, n_steps: int, impulse: float, seed: int) -> str:
@@ -155,6 +173,7 @@ def run_trial(trial: Trial) -> dict[str, Any]:
         "scene": trial.scene.name,
         "planner": trial.planner,
         "n_steps": int(trial.plan.n_steps),
+        "plan": plan_digest(trial.plan),
         "smallest_n": trial.smallest_n,
         "equal_n": trial.equal_n,
         "push_impulse": float(trial.impulse),
