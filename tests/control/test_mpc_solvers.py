@@ -157,6 +157,113 @@ def test_inactive_discs_leave_the_unconstrained_optimum() -> None:
     np.testing.assert_allclose(v, np.linalg.solve(p, -q), atol=1e-12)
 
 
+def _backtracking_case(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """A torque-disc QP on which the full Newton step is rejected at least once (ill-conditioned
+    P, large q; seeds chosen by ``_trace`` below, which checks that they still are)."""
+    rng = np.random.default_rng(seed)
+    n = 2 * int(rng.integers(1, 6))
+    a = rng.normal(size=(n, n))
+    p = a @ a.T + 10 ** rng.uniform(-3, 1) * np.eye(n)
+    q = rng.normal(size=n) * 10 ** rng.uniform(-1, 2)
+    lam0 = None if rng.random() < 0.5 else rng.uniform(0, 10 ** rng.uniform(-2, 3), n // 2)
+    return p, q, lam0
+
+
+def _trace(monkeypatch: pytest.MonkeyPatch, p, q, lam0):  # type: ignore[no-untyped-def]
+    """Run ``solve_ball_qp`` recording every evaluation of the dual and every Newton step.
+
+    Returns the result and the iterations as ``(base, step, trials)``: ``base`` = (lam, s, v, phi)
+    the iterate, ``step`` the Newton direction, ``trials`` the evaluations of the line search in
+    order (the last one is accepted). A solve that evaluates the dual 2000 times is stopped (a
+    line search that never ends must fail the test, not hang it)."""
+    from footfall.control import mpc
+
+    events: list[tuple[str, object]] = []
+    real_dual, real_step = mpc._ball_dual, mpc._newton_step
+
+    def dual(pp, qq, lam):  # type: ignore[no-untyped-def]
+        if len(events) > 2000:
+            raise RuntimeError("the line search does not end")
+        out = real_dual(pp, qq, lam)
+        events.append(("dual", (np.array(lam, dtype=float), *out)))
+        return out
+
+    def step(*args):  # type: ignore[no-untyped-def]
+        out = real_step(*args)
+        events.append(("step", np.array(out)))
+        return out
+
+    monkeypatch.setattr(mpc, "_ball_dual", dual)
+    monkeypatch.setattr(mpc, "_newton_step", step)
+    result = mpc.solve_ball_qp(p, q, lam0)
+    iterations = []
+    base = events[0][1]
+    i = 1
+    while i < len(events):
+        assert events[i][0] == "step"
+        direction = events[i][1]
+        trials = []
+        i += 1
+        while i < len(events) and events[i][0] == "dual":
+            trials.append(events[i][1])
+            i += 1
+        iterations.append((base, direction, trials))
+        base = trials[-1]
+    return result, iterations
+
+
+@pytest.mark.parametrize("seed", [12, 15, 18, 20, 25])
+def test_line_search_backtracks_by_halving_and_accepts_by_armijo(
+    seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The dual line search of ``solve_ball_qp``, checked step by step against its rule written
+    here: trial k is ``max(lam + 2^-k d, 0)``; a trial is accepted iff
+    ``phi_new <= phi + 1e-4 grad.(lam_new - lam)`` (grad = (1 - ||v_j||^2) / 2 from the dual's own
+    v) or the predicted decrease is below rounding; the dual objective never increases; the
+    answer matches SLSQP. Every seed here makes the full step fail at least once (random
+    problems of the other tests never do, which left the backtracking untested)."""
+    p, q, lam0 = _backtracking_case(seed)
+    (v, _, it, ok), iterations = _trace(monkeypatch, p, q, lam0)
+    assert ok and len(iterations) == it
+    assert any(len(trials) > 1 for _, _, trials in iterations), "no backtracking on this seed"
+    for (lam_b, _, v_b, phi_b), d, trials in iterations:
+        grad = 0.5 * (1.0 - np.sum(v_b.reshape(-1, 2) ** 2, axis=1))
+        for k, (lam_t, _, _, phi_t) in enumerate(trials):
+            np.testing.assert_allclose(lam_t, np.maximum(lam_b + 0.5**k * d, 0.0), rtol=0, atol=0)
+            dec = float(grad @ (lam_t - lam_b))
+            armijo = phi_t <= phi_b + 1e-4 * dec or abs(dec) <= 1e-13 * (1.0 + abs(phi_b))
+            assert armijo == (k == len(trials) - 1), (k, len(trials), phi_t, phi_b, dec)
+        assert trials[-1][3] <= phi_b + 1e-12 * (1.0 + abs(phi_b))
+    ref = _slsqp(p, q)
+    assert _objective(p, q, v) <= ref.fun + 1e-8 * (1.0 + abs(ref.fun))
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_secular_step_is_exact_for_separable_active_discs(
+    seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With ``P`` block-diagonal of ``p_j I`` blocks, each disc alone has ``||v_j|| =
+    ||q_j|| / (p_j + lambda_j)``: ``1 / ||v_j|| - 1`` is linear in ``lambda_j``, so the secular
+    Newton step (Newton on that function) lands on the optimum ``lambda_j = ||q_j|| - p_j`` from
+    any positive warm start in one full step when every disc is active (``||q_j|| > p_j``), up to
+    the step's 1e-12 regulariser; the answer is the closed form ``v_j = -q_j / ||q_j||``. A step
+    rescaled otherwise (plain Newton on the dual gradient, another factor) lands elsewhere."""
+    rng = np.random.default_rng(300 + seed)
+    n_b = int(rng.integers(1, 6))
+    pj = 10 ** rng.uniform(-1, 1, n_b)
+    q = rng.normal(size=2 * n_b)
+    q *= np.repeat(pj * rng.uniform(2.0, 20.0, n_b) / np.linalg.norm(q.reshape(-1, 2), axis=1), 2)
+    lam0 = rng.uniform(0.01, 30.0, n_b)
+    qn = np.linalg.norm(q.reshape(-1, 2), axis=1)
+    (v, lam, it, ok), iterations = _trace(monkeypatch, np.diag(np.repeat(pj, 2)), q, lam0)
+    assert ok and 1 <= it <= 2
+    _, _, first_trials = iterations[0]
+    assert len(first_trials) == 1  # the full step is taken
+    np.testing.assert_allclose(first_trials[0][0], qn - pj, rtol=1e-6)
+    np.testing.assert_allclose(lam, qn - pj, rtol=1e-9)
+    np.testing.assert_allclose(v, -q / np.repeat(qn, 2), atol=1e-9)
+
+
 def _polygon_case(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
     rng = np.random.default_rng(200 + seed)
     n_u = 4
