@@ -62,6 +62,16 @@ def test_builtin_studies_load(name: str) -> None:
     assert {"quick", "section55"} <= set(BUILTIN_STUDIES)
 
 
+def test_region_aware_reaches_the_fingerprint_only_when_on() -> None:
+    """Folders of studies run before the field existed (all ``off``) keep their fingerprint; a
+    region-aware study cannot resume a folder of walks without it."""
+    base = {"name": "s", "simulator": "reduced"}
+    off = study_from_dict(base)
+    assert off.region_aware == "off" and "region_aware" not in off.fingerprint()
+    on = study_from_dict(base | {"region_aware": "planned"})
+    assert on.fingerprint() == off.fingerprint() | {"region_aware": "planned"}
+
+
 def test_builtin_study_values() -> None:
     quick, s55 = builtin_study("quick"), builtin_study("section55")
     assert quick.simulator == "reduced" and quick.controller is None
@@ -91,6 +101,8 @@ def test_builtin_study_values() -> None:
         ({"push_duration": 0.0}, "push_duration"),
         ({"time_limit": float("nan")}, "time_limit"),
         ({"seeds": 10**7}, "seeds"),
+        ({"region_aware": "maybe"}, "region_aware"),
+        ({"region_aware": 1}, "region_aware"),
     ],
 )
 def test_bad_values_name_their_field(data: dict[str, Any], field: str) -> None:

@@ -21,7 +21,7 @@ import footfall
 from footfall.experiments.study import COLUMNS, Disturbance, StudyDesign, run_study
 from footfall.experiments.study import trials as trials_mod
 from footfall.experiments.study.design import study_from_dict
-from footfall.experiments.study.runner import make_plans
+from footfall.experiments.study.runner import make_plans, make_trials
 from footfall.experiments.study.trials import RUN_DEPENDENT
 
 SRC = str(Path(footfall.__file__).resolve().parents[1])
@@ -373,3 +373,24 @@ def test_rows_of_a_plan_that_changed_are_walked_again(
     old = run_study(_design(), out, workers=1)
     assert old.ran == N_WALKS
     assert _comparable(old.rows) == _comparable(reference.rows)
+
+
+@pytest.mark.parametrize("mode", ["off", "planned", "nearby"])
+def test_region_aware_reaches_the_walker(
+    mode: str, plans: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The study's ``region_aware`` is the option the reduced-order walker runs with."""
+    from footfall.sim.reduced import closed_loop
+
+    seen: list[str] = []
+    real = closed_loop.simulate
+
+    def spy(plan, opts, **kw):  # type: ignore[no-untyped-def]
+        seen.append(opts.region_aware)
+        return real(plan, opts, **kw)
+
+    monkeypatch.setattr(closed_loop, "simulate", spy)
+    design = _design(region_aware=mode, planners=["miqcqp"], push_levels=[], level_seeds=0)
+    entries = make_plans(design, plans)
+    rows = [trials_mod.run_trial(t) for t in make_trials(design, entries)[:1]]
+    assert seen == [mode] and rows[0]["error"] is None

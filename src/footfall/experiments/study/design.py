@@ -115,6 +115,10 @@ class StudyDesign:
         noise_pos: reduced only: CoM position estimate noise [m].
         noise_vel: reduced only: CoM velocity estimate noise [m/s].
         placement_error: reduced only: landing error per axis [m].
+        region_aware: how the walkers' MPC keeps the next footstep on the terrain
+            (``WalkOptions.region_aware`` / ``SimOptions.region_aware``): ``off`` (document 000's
+            free footstep, the default), ``planned`` (in the planned region inset by the sole) or
+            ``nearby`` (or the best region within reach).
     """
 
     name: str
@@ -135,6 +139,7 @@ class StudyDesign:
     noise_pos: float = 0.0
     noise_vel: float = 0.0
     placement_error: float = 0.0
+    region_aware: str = "off"
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
@@ -181,6 +186,10 @@ class StudyDesign:
             self, "initial_impulse", non_negative("initial_impulse", self.initial_impulse)
         )
         object.__setattr__(self, "time_limit", positive("time_limit", self.time_limit))
+        from footfall.control.adjusters import REGION_MODES
+
+        if not isinstance(self.region_aware, str) or self.region_aware not in REGION_MODES:
+            raise InputError("region_aware", self.region_aware, f"one of {', '.join(REGION_MODES)}")
         n = self.max_trials()
         if n > MAX_TRIALS:
             raise InputError("seeds", self.seeds, f"a study of at most {MAX_TRIALS} walks ({n})")
@@ -224,7 +233,10 @@ class StudyDesign:
             "noise_vel",
             "placement_error",
         )
-        return {k: getattr(self, k) for k in keys}
+        out = {k: getattr(self, k) for k in keys}
+        if self.region_aware != "off":  # absent when off: folders from before the field stay valid
+            out["region_aware"] = self.region_aware
+        return out
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data (the YAML schema)."""

@@ -128,8 +128,11 @@ def _reduced(trial: Trial) -> dict[str, Any]:
         placement_error=design.placement_error,
         pushes=pushes,
         seed=trial.disturbance.seed,
+        region_aware=design.region_aware,
     )
-    m = simulate(trial.plan, opts, goal=trial.scene.goal.position).metrics
+    # the regions only when the MPC needs them (the off rows stay those of earlier studies)
+    regions = trial.scene.terrain.regions if design.region_aware != "off" else None
+    m = simulate(trial.plan, opts, goal=trial.scene.goal.position, regions=regions).metrics
     return {
         "push_step": step,
         "push_time": t_push,
@@ -150,7 +153,10 @@ def _mujoco(trial: Trial) -> dict[str, Any]:
     base = WalkOptions(controller=str(trial.design.controller))
     start = base.settle_time + base.shift_time
     pushes, step, t_push = _pushes(trial, start)
-    res = walk(trial.scene, trial.plan, WalkOptions(controller=base.controller, pushes=pushes))
+    opts = WalkOptions(
+        controller=base.controller, pushes=pushes, region_aware=trial.design.region_aware
+    )
+    res = walk(trial.scene, trial.plan, opts)
     m = res.metrics
     return {
         "push_step": step,
