@@ -13,6 +13,7 @@ handed to ``_Search``, and the search then has to report them as the module docs
 from __future__ import annotations
 
 import dataclasses
+import heapq
 import math
 import time
 from collections.abc import Callable
@@ -459,6 +460,70 @@ def test_evaluate_retries_a_failed_condensed_node_on_the_full_model() -> None:
     assert search.heap[0].bound == pytest.approx(res.bound, rel=1e-6)
 
 
+class _Recording:
+    """The real node relaxation, recording every solve as ``(allowed, full)``."""
+
+    def __init__(self, relax: HullRelaxation) -> None:
+        self.inner = relax
+        self.calls: list[tuple[Allowed, bool]] = []
+
+    def solve(self, allowed: Allowed, full: bool = False) -> _Relaxation:
+        self.calls.append((allowed, full))
+        return self.inner.solve(allowed, full=full)
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(self.inner, name)
+
+
+def _off_the_disc(res: _Relaxation) -> _Relaxation:
+    """``res`` with x0 = 3: the member rows of the optimal branch (x0 >= 1, x1 <= 0.5) still hold,
+    the disc ||x|| <= 3 does not (as when a condensed model drops a cone)."""
+    assert res.x is not None
+    x = res.x.copy()
+    x[0] = 3.0
+    return dataclasses.replace(res, x=x)
+
+
+def test_evaluate_solves_an_integral_node_again_on_the_full_model() -> None:
+    """A condensed relaxation point whose member choice is integral but infeasible: the node is
+    solved again on the full model, once, and its point is the incumbent."""
+    prob = hand_problem()
+    structure = bnb.analyse(prob, settings=NO_PROBING)
+    rec = _Recording(HullRelaxation(structure, settings=NO_PROBING))
+    search = _Search(structure, SolverOptions(bnb=NO_PROBING), time.perf_counter(), rec)  # type: ignore[arg-type]
+    z, w = structure.groups[0].members, structure.groups[1].members
+    fixed = ((z[1],), (w[0],))
+    bad = _off_the_disc(rec.inner.solve(fixed))
+    assert bad.x is not None and prob.violation(bad.x) > search.settings.feas_tol
+    assert search.evaluate(fixed, -math.inf, 2, False, bad) is None
+    assert rec.calls == [(fixed, True)]
+    assert search.inc_obj == pytest.approx(HAND_OPT, rel=1e-6)
+    assert search.heap == []
+
+
+def test_evaluate_solves_a_full_integral_node_with_every_group_fixed() -> None:
+    """The same on the full model: the assignment is solved with every group fixed."""
+    prob = hand_problem()
+    search = _search(prob, SolverOptions(bnb=NO_PROBING))
+    z, w = search.s.groups[0].members, search.s.groups[1].members
+    fixed = ((z[1],), (w[0],))
+    bad = _off_the_disc(search.relax.solve(fixed, full=True))
+    assert search.evaluate(fixed, -math.inf, 2, True, bad) is None
+    assert fixed in search.tried
+    assert search.inc_obj == pytest.approx(HAND_OPT, rel=1e-6)
+    assert search.heap == []
+
+
+def test_evaluate_keeps_nodes_of_equal_bound_in_order() -> None:
+    search = _search(hand_problem(), SolverOptions(bnb=NO_PROBING))
+    allowed, res = _root(search)
+    for depth in range(3):
+        assert search.evaluate(allowed, -math.inf, depth, False, res) is res
+    assert search.nodes == 3
+    # best first, ties in the order they came
+    assert [heapq.heappop(search.heap).depth for _ in range(3)] == [0, 1, 2]
+
+
 # ------------------------------------------------------------------- faults in the relaxation
 class _Faulty:
     """A node relaxation whose solves fail (Clarabel status "Injected") when ``fail(allowed,
@@ -496,6 +561,7 @@ def test_condensed_failures_are_retried_on_the_full_model(regions: int, seed: in
     )
     assert search.relax.condensed is not None  # the condensed model is the one that fails
     res = search.run()
+    assert res.stats["condensed"] is True
     assert faulty.injected > 0
     assert res.status is SolveStatus.OPTIMAL
     assert res.stats["failed_nodes"] == {}
