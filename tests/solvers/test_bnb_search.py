@@ -517,11 +517,29 @@ def test_evaluate_solves_a_full_integral_node_with_every_group_fixed() -> None:
 def test_evaluate_keeps_nodes_of_equal_bound_in_order() -> None:
     search = _search(hand_problem(), SolverOptions(bnb=NO_PROBING))
     allowed, res = _root(search)
-    for depth in range(3):
+    for depth in range(5):
         assert search.evaluate(allowed, -math.inf, depth, False, res) is res
-    assert search.nodes == 3
-    # best first, ties in the order they came
-    assert [heapq.heappop(search.heap).depth for _ in range(3)] == [0, 1, 2]
+    assert search.nodes == 5
+    # best first, ties in the order they came (five nodes: a heap of equal keys pops them
+    # out of order)
+    assert [heapq.heappop(search.heap).depth for _ in range(5)] == [0, 1, 2, 3, 4]
+
+
+def test_evaluate_keeps_a_node_solved_again_at_its_depth() -> None:
+    """A root whose condensed point looks integral but breaks the disc: solved again on the full
+    model, where it is fractional, it is kept with its depth, on the full model, at the full
+    relaxation's bound."""
+    search = _search(hand_problem(), SolverOptions(bnb=NO_PROBING))
+    allowed, res = _root(search)
+    full = search.relax.solve(allowed, full=True)
+    fake = dataclasses.replace(res, bound=res.bound - 1.0, x=HAND_X.copy())
+    assert fake.x is not None
+    fake.x[0] = 3.0  # x0 >= 1 and x1 <= 0.5 hold, ||x|| <= 3 does not
+    kept = search.evaluate(allowed, -math.inf, 4, False, fake)
+    assert kept is not None and kept.status == "solved"
+    assert search.incumbent is None
+    assert [(nd.depth, nd.full) for nd in search.heap] == [(4, True)]
+    assert search.heap[0].bound == full.bound
 
 
 # ------------------------------------------------------------------- faults in the relaxation
