@@ -3,11 +3,12 @@
 # Slow and outside CI. Results and the survivors' analysis: benchmarks/MUTATION.md.
 # Needs the mutation extra: .venv/bin/pip install -e ".[dev,mutation]".
 #
-#   benchmarks/mutation.sh [module ...]     # default: every module below
+#   benchmarks/mutation.sh [module ...]     # default: the first seven modules below
 #
-# Modules: lip alip check lip_walk mpc stability metrics. Each runs in a scratch copy of the
-# working tree (mutmut writes ./mutants and reads [tool.mutmut] from pyproject.toml), whose
-# [tool.mutmut] only_mutate / pytest_add_cli_args_test_selection are replaced by the module's.
+# Modules: lip alip check lip_walk mpc stability metrics (the default), mpc_solvers, bnb. Each
+# runs in a scratch copy of the working tree (mutmut writes ./mutants and reads [tool.mutmut]
+# from pyproject.toml), whose [tool.mutmut] only_mutate / pytest_add_cli_args_test_selection
+# are replaced by the module's.
 # Env: PYTHON (default .venv/bin/python of the repository), MUTMUT_JOBS (default nproc),
 # MUTATION_OUT (default benchmarks/mutation-out: per-module logs and `mutmut results`).
 set -euo pipefail
@@ -50,6 +51,14 @@ MUTANTS[mpc_solvers]="footfall.control.mpc.x_solve_ball_qp__mutmut_* footfall.co
     footfall.control.mpc.x__ball_dual__mutmut_* footfall.control.mpc.x__newton_step__mutmut_*
     footfall.control.mpc.x__check_polygon__mutmut_* footfall.control.mpc.x__clarabel_in_polygon__mutmut_*
     footfall.control.mpc.xǁMPCǁ*__mutmut_*"
+
+# the branch-and-bound search's optimality logic (incumbents, the gap, node evaluation, the
+# result's status, bound and gap), against its fast tests (SCIP on tiny instances, a hand-built
+# MIQCQP); the rest of search.py (the loops, the worker pool) needs the slow bnb-vs-SCIP tests
+SRC[bnb]=src/footfall/solvers/bnb/search.py
+TESTS[bnb]="tests/solvers/test_bnb_search.py"
+MUTANTS[bnb]="footfall.solvers.bnb.search.xǁ_Searchǁoffer__mutmut_* footfall.solvers.bnb.search.xǁ_Searchǁgap_of__mutmut_*
+    footfall.solvers.bnb.search.xǁ_Searchǁevaluate__mutmut_* footfall.solvers.bnb.search.xǁ_Searchǁresult__mutmut_*"
 
 run_one() {
     local name=$1 src=${SRC[$1]} tests=${TESTS[$1]} only=${MUTANTS[$1]:-}
