@@ -141,7 +141,7 @@ def test_iteration_limit_reports_no_convergence_and_returns_a_feasible_point() -
     _, _, it_full, ok = solve_ball_qp(p, q)
     assert ok and it_full >= 2
     v, _, it, ok0 = solve_ball_qp(p, q, max_iter=0)
-    assert not ok0 and it == 0
+    assert ok0 is False and it == 0  # a bool, as documented (not merely falsy)
     assert np.all(np.linalg.norm(v.reshape(-1, 2), axis=1) <= 1.0 + 1e-12)
     # a loose tolerance stops earlier than a tight one
     _, _, it_loose, ok_loose = solve_ball_qp(p, q, tol=1e-2)
@@ -262,6 +262,88 @@ def test_secular_step_is_exact_for_separable_active_discs(
     np.testing.assert_allclose(first_trials[0][0], qn - pj, rtol=1e-6)
     np.testing.assert_allclose(lam, qn - pj, rtol=1e-9)
     np.testing.assert_allclose(v, -q / np.repeat(qn, 2), atol=1e-9)
+
+
+def _wide_case(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """As :func:`_backtracking_case` with ``q`` up to 1000: a few of these make the secular step
+    point uphill on the dual (seeds chosen with ``_secular_step`` below, which checks them)."""
+    rng = np.random.default_rng(seed)
+    n = 2 * int(rng.integers(1, 6))
+    a = rng.normal(size=(n, n))
+    p = a @ a.T + 10 ** rng.uniform(-3, 1) * np.eye(n)
+    q = rng.normal(size=n) * 10 ** rng.uniform(-1, 3)
+    lam0 = None if rng.random() < 0.5 else rng.uniform(0, 10 ** rng.uniform(-2, 3), n // 2)
+    return p, q, lam0
+
+
+def _secular_step(lam: np.ndarray, v: np.ndarray, s: np.ndarray) -> np.ndarray | None:
+    """The secular Newton direction of the free multipliers, from the module docstring's
+    formula (the dual Hessian ``H_jl = v_j^T S_jl v_l`` and the gradient rescaled per block by
+    ``2 ||v_j||^2 / (1 + ||v_j||)``); None when some multiplier is held at 0."""
+    vb = v.reshape(-1, 2)
+    grad = 0.5 * (1.0 - np.sum(vb**2, axis=1))
+    if np.any((lam <= 1e-3) & (grad > 0.0)):
+        return None
+    n_b = lam.shape[0]
+    hess = np.array(
+        [
+            [vb[j] @ s[2 * j : 2 * j + 2, 2 * k : 2 * k + 2] @ vb[k] for k in range(n_b)]
+            for j in range(n_b)
+        ]
+    )
+    nrm = np.linalg.norm(vb, axis=1)
+    return -np.linalg.solve(hess, grad * 2.0 * nrm**2 / (1.0 + nrm))
+
+
+@pytest.mark.parametrize("seed", [145, 229, 578])
+def test_an_uphill_secular_step_falls_back_to_newton(
+    seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Where the secular step is not a descent direction of the dual (checked here from its
+    formula), the step taken is: every Newton direction of the solve goes downhill
+    (``grad . d < 0``), and the answer matches SLSQP."""
+    p, q, lam0 = _wide_case(seed)
+    (v, _, it, ok), iterations = _trace(monkeypatch, p, q, lam0)
+    assert ok and len(iterations) == it
+    uphill = 0
+    for (lam_b, s_b, v_b, _), d, _ in iterations:
+        grad = 0.5 * (1.0 - np.sum(v_b.reshape(-1, 2) ** 2, axis=1))
+        sec = _secular_step(lam_b, v_b, s_b)
+        if sec is not None and grad @ sec >= 0.0:
+            uphill += 1
+        assert grad @ d < 0.0
+    assert uphill >= 1, "the secular step never points uphill on this seed"
+    ref = _slsqp(p, q)
+    assert _objective(p, q, v) <= ref.fun + 1e-8 * (1.0 + abs(ref.fun))
+
+
+def test_a_line_search_that_finds_no_decrease_takes_a_tiny_step_and_goes_on(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A first direction that goes uphill (the Newton step reversed, injected): every trial fails
+    the Armijo test, the search halves down to alpha < 1e-10 (2^-34 of the step), takes that
+    tiny step and continues with the true Newton steps to the same answer as an undisturbed
+    solve."""
+    from footfall.control import mpc
+
+    p, q, lam0 = _backtracking_case(12)
+    v_ref, lam_ref, _, ok_ref = solve_ball_qp(p, q, lam0)
+    real_step = mpc._newton_step
+    calls = {"n": 0}
+
+    def reversed_first(*args):  # type: ignore[no-untyped-def]
+        d = real_step(*args)
+        calls["n"] += 1
+        return -d if calls["n"] == 1 else d
+
+    monkeypatch.setattr(mpc, "_newton_step", reversed_first)
+    (v, lam, _, ok), iterations = _trace(monkeypatch, p, q, lam0)
+    (lam_b, _, _, _), d, trials = iterations[0]
+    assert len(trials) == 35  # alpha = 1, 1/2, ..., 2^-34 < 1e-10
+    np.testing.assert_allclose(trials[-1][0], np.maximum(lam_b + 0.5**34 * d, 0.0), rtol=0, atol=0)
+    assert ok and ok_ref
+    np.testing.assert_allclose(v, v_ref, atol=1e-8)
+    np.testing.assert_allclose(lam, lam_ref, rtol=1e-6, atol=1e-9)
 
 
 def _polygon_case(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
