@@ -102,10 +102,13 @@ def test_a_retargeted_swing_is_raised_over_the_regions_under_its_new_path(mode: 
 @pytest.mark.parametrize("name", ["narrow_stones_gap", "roll_ramps", "corridor_corner"])
 def test_new_scenes_are_walked_with_every_footstep_on_a_region(name: str) -> None:
     """Smoke test of the issue's new scenes (plans of ``footfall walk`` stored in data/): the
-    region-aware walk reaches the goal and no landed sole centre is off the terrain (shapely)."""
+    walker's default (region-aware: ``planned``) reaches the goal and no landed sole centre is
+    off the terrain (shapely)."""
     scene = builtin_scene(name)
     plan = load_plan(Path(__file__).parent / "data" / f"{name}_miqcqp.json", scene)
-    res = walk(scene, plan, WalkOptions(region_aware="planned"))
+    opts = WalkOptions()
+    assert opts.region_aware == "planned"
+    res = walk(scene, plan, opts)
     assert not res.metrics.fell and res.metrics.reached_goal
     landed = res.landed[~np.isnan(res.landed[:, 0])]
     for p in landed:
