@@ -5,7 +5,7 @@
 #
 #   benchmarks/mutation.sh [module ...]     # default: the first seven modules below
 #
-# Modules: lip alip check lip_walk mpc stability metrics (the default), mpc_solvers, bnb. Each
+# Modules: lip alip check lip_walk mpc stability metrics (the default), mpc_solvers, mpc_rest, bnb. Each
 # runs in a scratch copy of the working tree (mutmut writes ./mutants and reads [tool.mutmut]
 # from pyproject.toml), whose [tool.mutmut] only_mutate / pytest_add_cli_args_test_selection
 # are replaced by the module's.
@@ -46,7 +46,7 @@ MUTANTS[mpc]="footfall.control.mpc.xǁMPCWeightsǁmatrices__mutmut_* footfall.co
 # the MPC's solvers (the torque-disc QP's dual Newton method, the polygon QP through Clarabel,
 # MPC.solve* and the fallback), against the same tests
 SRC[mpc_solvers]=src/footfall/control/mpc.py
-TESTS[mpc_solvers]="tests/control/test_mpc.py tests/control/test_mpc_reference.py tests/control/test_mpc_solvers.py"
+TESTS[mpc_solvers]="tests/control/test_mpc.py tests/control/test_mpc_reference.py tests/control/test_mpc_solvers.py tests/control/test_mpc_results.py"
 MUTANTS[mpc_solvers]="footfall.control.mpc.x_solve_ball_qp__mutmut_* footfall.control.mpc.x__cold_start__mutmut_*
     footfall.control.mpc.x__ball_dual__mutmut_* footfall.control.mpc.x__newton_step__mutmut_*
     footfall.control.mpc.x__check_polygon__mutmut_* footfall.control.mpc.x__clarabel_in_polygon__mutmut_*
@@ -59,6 +59,14 @@ SRC[bnb]=src/footfall/solvers/bnb/search.py
 TESTS[bnb]="tests/solvers/test_bnb_search.py"
 MUTANTS[bnb]="footfall.solvers.bnb.search.xǁ_Searchǁoffer__mutmut_* footfall.solvers.bnb.search.xǁ_Searchǁgap_of__mutmut_*
     footfall.solvers.bnb.search.xǁ_Searchǁevaluate__mutmut_* footfall.solvers.bnb.search.xǁ_Searchǁresult__mutmut_*"
+
+# the rest of mpc.py: weight and torque-limit checks, padding and cost of the condensed model
+SRC[mpc_rest]=src/footfall/control/mpc.py
+TESTS[mpc_rest]="tests/control/test_mpc.py tests/control/test_mpc_reference.py tests/control/test_mpc_solvers.py tests/control/test_mpc_results.py"
+MUTANTS[mpc_rest]="footfall.control.mpc.xǁMPCWeightsǁ__post_init____mutmut_* footfall.control.mpc.x_pad_condensed__mutmut_*
+    footfall.control.mpc.x__torque_limits__mutmut_* footfall.control.mpc.xǁCondensedMPCǁcost__mutmut_*
+    footfall.control.mpc.x__check_int__mutmut_* footfall.control.mpc.xǁCondensedMPCǁblock_of_tick__mutmut_*
+    footfall.control.mpc.xǁCondensedMPCǁn_blocks__mutmut_*"
 
 run_one() {
     local name=$1 src=${SRC[$1]} tests=${TESTS[$1]} only=${MUTANTS[$1]:-}

@@ -1,0 +1,168 @@
+"""What an MPC solve (eq. 5.19) hands back besides its optimum: the fields of ``MPCSolution`` for
+a normal, a polygon-constrained and a fallback solve, the fallback's reasons, and the errors of
+bad arguments with their field, value and expected text (issue 24).
+
+References: the model's own blocking tables (``block_ticks``, ``n_blocks``; checked against an
+independent statement in ``test_mpc.py``), a wall clock read around each call for the solve
+times, and the inputs given (stance foot, reference height) for the footstep's echoed parts.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from footfall.control import MPC, MPCStatus, MPCWeights, build_mpc
+from footfall.control import mpc as mpc_mod
+from footfall.control.mpc import CondensedMPC
+from footfall.errors import InputError
+from footfall.models.biped import BipedParams
+
+ROBOT = BipedParams(n_nodes=10)
+RATE_DT = 0.004
+
+
+@pytest.fixture(scope="module")
+def model() -> CondensedMPC:
+    return build_mpc(ROBOT, MPCWeights(), RATE_DT)
+
+
+def _args(seed: int, k_s: int) -> tuple:
+    """A solve's arguments with a stance foot off the origin (so its x, y and z differ)."""
+    rng = np.random.default_rng(seed)
+    mzh = ROBOT.mass * ROBOT.com_height
+    x = np.array([*rng.normal(0, 0.05, 2), *(rng.normal(0, 0.3, 2) * mzh)])
+    stance = np.array([0.7, -0.3, 0.05])
+    ref = stance + np.array([0.25, 0.2, 0.08])
+    x_ref = np.array([*rng.normal(0, 0.05, 2), *(rng.normal(0, 0.3, 2) * mzh)])
+    return (k_s, x, stance, ref, x_ref)
+
+
+def _timed(fn, *args):  # type: ignore[no-untyped-def]
+    t0 = time.perf_counter()
+    out = fn(*args)
+    return out, time.perf_counter() - t0
+
+
+def test_a_solve_reports_its_tick_blocks_and_time(model: CondensedMPC) -> None:
+    k_s = 17
+    sol, wall = _timed(MPC(model).solve, *_args(1, k_s))
+    assert sol.status is MPCStatus.OPTIMAL and sol.fallback is False and sol.message == ""
+    assert sol.k_s == k_s
+    np.testing.assert_array_equal(sol.block_ticks, model.block_ticks[k_s])
+    n_b = model.n_blocks(k_s)
+    assert sol.torques.shape == (n_b, 2) and sol.multipliers.shape == (n_b,)
+    assert np.all(sol.multipliers >= 0.0)
+    assert isinstance(sol.iterations, int) and sol.iterations >= 0
+    assert 0.0 < sol.solve_time <= wall
+    # the footstep is the stance foot plus the optimised step, at the reference's height
+    stance, ref = _args(1, k_s)[2], _args(1, k_s)[3]
+    assert sol.next_footstep[2] == ref[2]
+    assert abs(sol.next_footstep[1] - stance[1]) < 0.6  # a step from y = -0.3, not from z
+    np.testing.assert_array_equal(sol.torque, sol.torques[0])
+
+
+def test_a_polygon_solve_reports_the_same_fields(model: CondensedMPC) -> None:
+    """A polygon that cuts the free footstep off (the constrained Clarabel path)."""
+    k_s = 5
+    args = _args(2, k_s)
+    free = MPC(model).solve(*args)
+    a = np.array([[1.0, 0.0]])
+    b = np.array([free.next_footstep[0] - 0.05])
+    sol, wall = _timed(MPC(model).solve_in_polygon, *args, a, b)
+    assert sol.status is MPCStatus.OPTIMAL and sol.fallback is False and sol.message == ""
+    assert sol.k_s == k_s
+    np.testing.assert_array_equal(sol.block_ticks, model.block_ticks[k_s])
+    n_b = model.n_blocks(k_s)
+    assert sol.torques.shape == (n_b, 2) and sol.multipliers.shape == (n_b,)
+    assert np.all(sol.multipliers >= -1e-9)
+    assert isinstance(sol.iterations, int) and sol.iterations > 0
+    assert 0.0 < sol.solve_time <= wall
+    assert sol.next_footstep[0] == pytest.approx(b[0], abs=1e-6)  # on the cut
+    assert sol.next_footstep[2] == args[3][2]
+    assert abs(sol.next_footstep[1] - free.next_footstep[1]) < 0.1
+    # the torque discs hold, with the torques in newton metres (not scaled)
+    lim = model.u_limits
+    assert np.all(np.hypot(sol.torques[:, 0] / lim[0], sol.torques[:, 1] / lim[1]) <= 1 + 1e-9)
+    assert np.abs(sol.torques).max() > 1.0
+
+
+def test_fallbacks_say_why_and_report_their_fields(
+    model: CondensedMPC, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    mpc = MPC(model)
+    k0 = 3
+    good = mpc.solve(*_args(3, k0))
+    # non-finite measurement, nothing to shift at the first solve of a fresh MPC
+    fresh = MPC(model)
+    args = _args(3, 0)
+    first, wall = _timed(fresh.solve, 0, np.full(4, np.nan), *args[2:])
+    assert first.fallback is True and first.status is MPCStatus.FALLBACK
+    assert first.message == "non-finite measurement or reference"
+    assert first.k_s == 0 and fresh.n_fallbacks == 1
+    np.testing.assert_array_equal(first.block_ticks, model.block_ticks[0])
+    n_b = model.n_blocks(0)
+    np.testing.assert_array_equal(first.torques, np.zeros((n_b, 2)))
+    np.testing.assert_array_equal(first.multipliers, np.zeros(n_b))
+    np.testing.assert_array_equal(first.next_footstep, args[3])
+    assert 0.0 < first.solve_time <= wall
+    # a non-finite reference footstep falls back to the stance foot
+    nan_ref = fresh.solve(0, args[1], args[2], np.full(3, np.nan), args[4])
+    np.testing.assert_array_equal(nan_ref.next_footstep, args[2])
+    assert fresh.n_fallbacks == 2
+
+    # a solver that does not converge, later in the phase: the good solution shifted
+    def no_convergence(p, q, lam0=None, *a, **k):  # type: ignore[no-untyped-def]
+        n = q.shape[0]
+        return np.zeros(n), np.zeros(n // 2), 7, False
+
+    monkeypatch.setattr(mpc_mod, "solve_ball_qp", no_convergence)
+    k_s = 30
+    big = _args(3, k_s)
+    big = (k_s, big[1] * 50.0, *big[2:])  # torque bounds active: the ball QP is called
+    late = mpc.solve(*big)
+    assert late.fallback is True and late.message == "solver did not converge"
+    assert late.k_s == k_s and mpc.n_fallbacks == 1
+    shift = model.first_block[k_s] - model.first_block[k0]
+    assert shift > 0
+    np.testing.assert_array_equal(late.torques, good.torques[shift:])
+    np.testing.assert_array_equal(late.multipliers, good.multipliers[shift:])
+    np.testing.assert_array_equal(late.block_ticks, model.block_ticks[k_s])
+
+    def broken(*a, **k):  # type: ignore[no-untyped-def]
+        raise np.linalg.LinAlgError("singular dual Hessian (info 3)")
+
+    monkeypatch.setattr(mpc_mod, "solve_ball_qp", broken)
+    err = mpc.solve(*big)
+    assert err.fallback is True and mpc.n_fallbacks == 2
+    assert err.message == "solver error: singular dual Hessian (info 3)"
+    assert err.k_s == k_s
+
+
+def test_bad_arguments_name_field_value_and_expected(model: CondensedMPC) -> None:
+    with pytest.raises(InputError) as e:
+        MPC("not a model")  # type: ignore[arg-type]
+    assert (e.value.field, e.value.value) == ("condensed", "not a model")
+    assert e.value.expected == "a CondensedMPC from build_mpc"
+    with pytest.raises(InputError) as e:
+        MPC(model, solver="osqp")
+    assert (e.value.field, e.value.value) == ("solver", "osqp")
+    assert e.value.expected == "one of newton, clarabel"
+    mpc = MPC(model)
+    ok = _args(4, 0)[1:]
+    with pytest.raises(InputError) as e:
+        mpc.solve(model.n_ticks, *ok)
+    assert (e.value.field, e.value.value) == ("k_s", model.n_ticks)
+    assert e.value.expected == f"an integer tick in [0, {model.n_ticks})"
+    for i, (name, n) in enumerate(
+        (("x_measured", 4), ("p_stance", 3), ("p_next_ref", 3), ("x_next_ref", 4))
+    ):
+        bad = list(ok)
+        bad[i] = np.zeros(n + 1)
+        with pytest.raises(InputError) as e:
+            mpc.solve(0, *bad)
+        assert e.value.field == name
+        assert e.value.value == [0.0] * (n + 1)
+        assert e.value.expected == f"shape ({n},)"
