@@ -166,3 +166,53 @@ def test_bad_arguments_name_field_value_and_expected(model: CondensedMPC) -> Non
         assert e.value.field == name
         assert e.value.value == [0.0] * (n + 1)
         assert e.value.expected == f"shape ({n},)"
+
+
+def test_weights_errors_and_stored_values() -> None:
+    for name in ("q_pos", "q_vel", "qf_pos", "qf_vel", "qf_dcm"):
+        with pytest.raises(InputError) as e:
+            MPCWeights(**{name: -1.0})
+        assert (e.value.field, e.value.value) == (f"weights.{name}", -1.0)
+        assert e.value.expected == "a finite number >= 0"
+        with pytest.raises(InputError) as e:
+            MPCWeights(**{name: float("inf")})
+        assert e.value.field == f"weights.{name}"
+    for name in ("r", "w"):
+        with pytest.raises(InputError) as e:
+            MPCWeights(**{name: 0.0})
+        assert (e.value.field, e.value.value) == (f"weights.{name}", 0.0)
+    w = MPCWeights(r=2, w=3)  # integers are stored as the floats they are
+    assert (w.r, w.w) == (2.0, 3.0) and isinstance(w.r, float) and isinstance(w.w, float)
+
+
+def test_torque_limit_errors_and_small_valid_limits() -> None:
+    with pytest.raises(InputError) as e:
+        build_mpc(ROBOT, torque_limits="ab")  # type: ignore[arg-type]
+    assert (e.value.field, e.value.value) == ("torque_limits", "ab")
+    assert e.value.expected == "two numbers (U_x, U_y) [N m]"
+    for bad in ((0.0, 1.0), (1.0, -2.0), (1.0, float("nan")), (1.0,)):
+        with pytest.raises(InputError) as e:
+            build_mpc(ROBOT, torque_limits=bad)  # type: ignore[arg-type]
+        assert (e.value.field, e.value.value) == ("torque_limits", bad)
+        assert e.value.expected == "two finite numbers (U_x, U_y) > 0 [N m]"
+    small = build_mpc(ROBOT, MPCWeights(), RATE_DT, torque_limits=(0.5, 0.25))
+    np.testing.assert_array_equal(small.u_limits, [0.5, 0.25])
+    with pytest.raises(InputError) as e:
+        build_mpc(ROBOT, n_nodes=1)
+    assert (e.value.field, e.value.value) == ("n_nodes", 1)
+    assert e.value.expected == "an integer >= 2"
+    for bad_n in (3.0, True):  # a float or a bool is not a node count, even when integral
+        with pytest.raises(InputError) as e:
+            build_mpc(ROBOT, n_nodes=bad_n)  # type: ignore[arg-type]
+        assert e.value.field == "n_nodes"
+
+
+def test_block_of_tick_follows_the_node_grid(model: CondensedMPC) -> None:
+    """Tick k belongs to the last block whose first tick ``round(j M / (K - 1))`` is <= k (the
+    blocking of eq. 5.12b's node intervals on the control ticks, stated independently)."""
+    m, k_nodes = model.n_ticks, model.n_nodes
+    edges = [round(j * m / (k_nodes - 1)) for j in range(k_nodes)]
+    for k in range(m):
+        expected = max(j for j in range(k_nodes - 1) if edges[j] <= k)
+        assert model.block_of_tick(k) == expected, k
+        assert isinstance(model.block_of_tick(k), int)
