@@ -98,7 +98,9 @@ PY
         "$PYTHON" -m mutmut run --max-children "$JOBS" $only) >"$OUT/$name.log" 2>&1 || true
     t1=$(date +%s)
     local keep='.'
-    [ -n "$only" ] && keep=$(printf '%s\n' $only | sed 's/\*$//' | paste -sd'|')
+    # the fnmatch patterns as regular expressions ("." literal, "*" any text): a "*" inside a
+    # pattern (xǁMPCǁ*__mutmut_*) must match method names, not repeat the character before it
+    [ -n "$only" ] && keep=$(printf '%s\n' $only | sed 's/\./\\./g; s/\*/.*/g' | paste -sd'|')
     (cd "$work" && "$PYTHON" -m mutmut results --all true) 2>&1 \
         | grep -E "^ *($keep)" >"$OUT/$name.results" || true
     echo "wall time: $((t1 - t0)) s" | tee -a "$OUT/$name.log"

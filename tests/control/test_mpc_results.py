@@ -216,3 +216,85 @@ def test_block_of_tick_follows_the_node_grid(model: CondensedMPC) -> None:
         expected = max(j for j in range(k_nodes - 1) if edges[j] <= k)
         assert model.block_of_tick(k) == expected, k
         assert isinstance(model.block_of_tick(k), int)
+
+
+def test_a_non_integer_tick_is_named_with_its_value(model: CondensedMPC) -> None:
+    with pytest.raises(InputError) as e:
+        MPC(model).solve(1.5, *_args(5, 0)[1:])  # type: ignore[arg-type]
+    assert (e.value.field, e.value.value) == ("k_s", 1.5)
+    assert e.value.expected == f"an integer tick in [0, {model.n_ticks})"
+
+
+def test_free_and_bounded_solves_report_their_multipliers_and_iterations(
+    model: CondensedMPC,
+) -> None:
+    """The unconstrained optimum scales linearly with the state (eq. 5.19 without the discs), so
+    a state scaled until the free torques reach 1.2 x their disc must come back on the disc
+    (not accepted as it is), with at least one Newton iteration and a positive multiplier; a
+    state small enough to stay inside gives zero multipliers, one per block, and 0 iterations."""
+    k_s = 40
+    args = _args(6, k_s)
+    wide = build_mpc(ROBOT, MPCWeights(), RATE_DT, torque_limits=(1e6, 1e6))
+    free = MPC(wide).solve(*args)  # the discs never bind: the unconstrained optimum
+    lim = model.u_limits
+    scaled = np.hypot(free.torques[:, 0] / lim[0], free.torques[:, 1] / lim[1]).max()
+    n_b = model.n_blocks(k_s)
+    for factor, active in ((1.2 / scaled, True), (0.5 / scaled, False)):
+        x = args[1] * factor
+        ref = args[4] * factor
+        p_ref = args[2] + (args[3] - args[2]) * factor
+        sol = MPC(model).solve(k_s, x, args[2], p_ref, ref)
+        norms = np.hypot(sol.torques[:, 0] / lim[0], sol.torques[:, 1] / lim[1])
+        assert sol.multipliers.shape == (n_b,)
+        if active:
+            assert norms.max() == pytest.approx(1.0, abs=1e-6)
+            assert sol.iterations >= 1 and sol.multipliers.max() > 0.0
+        else:
+            assert norms.max() <= 0.5 + 1e-9
+            assert sol.iterations == 0
+            np.testing.assert_array_equal(sol.multipliers, np.zeros(n_b))
+
+
+def test_clarabel_backend_answers_each_new_state_and_prints_nothing(
+    model: CondensedMPC, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """The Clarabel backend keeps one solver per tick and updates its linear term: a second
+    state at the same tick must get its own answer (a fresh MPC's), and its ball multipliers
+    are the Newton backend's (both are the duals of the same scaled discs)."""
+    k_s = 12
+    a1 = _args(7, k_s)
+    a2 = (k_s, a1[1] * 40.0, *a1[2:])  # torque discs active
+    cached = MPC(model, solver="clarabel")
+    cached.solve(*a1)
+    second = cached.solve(*a2)
+    fresh = MPC(model, solver="clarabel").solve(*a2)
+    np.testing.assert_allclose(second.torques, fresh.torques, atol=1e-3)  # interior-point tol
+    newton = MPC(model).solve(*a2)
+    np.testing.assert_allclose(second.torques, newton.torques, atol=1e-3)
+    assert newton.multipliers.max() > 0.0
+    np.testing.assert_allclose(second.multipliers, newton.multipliers, rtol=1e-3, atol=1e-6)
+    assert capfd.readouterr().out == ""
+
+
+def test_the_last_solution_after_a_polygon_solve_and_a_reset(model: CondensedMPC) -> None:
+    """A fallback returns the last good solution shifted by the blocks that passed (here from
+    block 1 to block 2): after a polygon solve that solution is the polygon one; after
+    ``reset`` there is none (zero torques)."""
+    k0, k_s = 15, 25
+    assert (model.first_block[k0], model.first_block[k_s]) == (1, 2)
+    mpc = MPC(model)
+    args = _args(8, k0)
+    free = mpc.solve(*args)
+    a = np.array([[1.0, 0.0]])
+    b = np.array([free.next_footstep[0] - 0.05])
+    poly = mpc.solve_in_polygon(*args, a, b)
+    assert poly.next_footstep[0] == pytest.approx(b[0], abs=1e-6)
+    bad = mpc.solve(k_s, np.full(4, np.nan), *args[2:])
+    assert bad.fallback
+    np.testing.assert_array_equal(bad.next_footstep, poly.next_footstep)
+    np.testing.assert_array_equal(bad.torques, poly.torques[1:])
+    mpc.reset()
+    after = mpc.solve(k_s, np.full(4, np.nan), *args[2:])
+    np.testing.assert_array_equal(after.torques, np.zeros((model.n_blocks(k_s), 2)))
+    good = mpc.solve(*_args(8, k_s))
+    assert not good.fallback
