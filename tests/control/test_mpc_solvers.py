@@ -157,14 +157,17 @@ def test_inactive_discs_leave_the_unconstrained_optimum() -> None:
     np.testing.assert_allclose(v, np.linalg.solve(p, -q), atol=1e-12)
 
 
-def _backtracking_case(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+def _backtracking_case(
+    seed: int, q_decades: float = 2.0
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """A torque-disc QP on which the full Newton step is rejected at least once (ill-conditioned
-    P, large q; seeds chosen by ``_trace`` below, which checks that they still are)."""
+    P, ``q`` up to ``10^q_decades``; seeds chosen by ``_trace`` below, which checks that they
+    still are)."""
     rng = np.random.default_rng(seed)
     n = 2 * int(rng.integers(1, 6))
     a = rng.normal(size=(n, n))
     p = a @ a.T + 10 ** rng.uniform(-3, 1) * np.eye(n)
-    q = rng.normal(size=n) * 10 ** rng.uniform(-1, 2)
+    q = rng.normal(size=n) * 10 ** rng.uniform(-1, q_decades)
     lam0 = None if rng.random() < 0.5 else rng.uniform(0, 10 ** rng.uniform(-2, 3), n // 2)
     return p, q, lam0
 
@@ -267,13 +270,7 @@ def test_secular_step_is_exact_for_separable_active_discs(
 def _wide_case(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """As :func:`_backtracking_case` with ``q`` up to 1000: a few of these make the secular step
     point uphill on the dual (seeds chosen with ``_secular_step`` below, which checks them)."""
-    rng = np.random.default_rng(seed)
-    n = 2 * int(rng.integers(1, 6))
-    a = rng.normal(size=(n, n))
-    p = a @ a.T + 10 ** rng.uniform(-3, 1) * np.eye(n)
-    q = rng.normal(size=n) * 10 ** rng.uniform(-1, 3)
-    lam0 = None if rng.random() < 0.5 else rng.uniform(0, 10 ** rng.uniform(-2, 3), n // 2)
-    return p, q, lam0
+    return _backtracking_case(seed, q_decades=3.0)
 
 
 def _secular_step(lam: np.ndarray, v: np.ndarray, s: np.ndarray) -> np.ndarray | None:
