@@ -332,13 +332,12 @@ def run_study(
         ):
             smallest, equal = r["smallest_n"] or t.smallest_n, r["equal_n"] or t.equal_n
             store.add(r | {"smallest_n": smallest, "equal_n": equal})
-    todo = [t for t in trials if not done_(t)]
-    stale = sum(1 for t in todo if t.key in store.rows)
+    pending = [t for t in trials if not done_(t)]
+    stale = sum(1 for t in pending if t.key in store.rows)
     if stale and say:
         say(f"{stale} walk(s) in the table walked another plan than today's: walking them again")
-    if limit is not None:
-        todo = todo[:limit]
-    done = len(trials) - len([t for t in trials if not done_(t)])
+    todo = pending if limit is None else pending[:limit]
+    done = len(trials) - len(pending)
     t0 = time.perf_counter()
     ran = 0
     try:
