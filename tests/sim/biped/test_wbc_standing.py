@@ -19,6 +19,7 @@ from footfall.sim.biped.plant import BipedSim  # noqa: E402
 from footfall.sim.biped.state import Command  # noqa: E402
 from footfall.sim.biped.wbc import BipedWbc, CopTarget  # noqa: E402
 from footfall.terrain.resolve import resolve_scene  # noqa: E402
+from tests.sim.mj_reference import inverse_dynamics_without_constraints  # noqa: E402
 
 #: mj_inverse's generalised force vs S^T tau + sum J(p)^T f [N, N m] (issue 19: 1e-6)
 INVERSE_TOL = 1e-6
@@ -79,14 +80,7 @@ def check_solution(sim: BipedSim, wbc: BipedWbc, sides: tuple[Side, ...]) -> Non
     assert sol is not None
     nv = m.nv
     # --- inverse dynamics: M qacc + bias - passive = S^T tau + sum J(p)^T f
-    d2 = mujoco.MjData(m)
-    d2.qpos[:], d2.qvel[:], d2.qacc[:] = d.qpos, d.qvel, sol.qacc
-    flags = m.opt.disableflags
-    m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
-    try:
-        mujoco.mj_inverse(m, d2)
-    finally:
-        m.opt.disableflags = flags
+    inverse = inverse_dynamics_without_constraints(m, d, sol.qacc)
     gen = np.zeros(nv)
     gen[sim.joint_dof] += sol.torque
     jp, jr = np.zeros((3, nv)), np.zeros((3, nv))
@@ -132,7 +126,7 @@ def check_solution(sim: BipedSim, wbc: BipedWbc, sides: tuple[Side, ...]) -> Non
             local = rot.T @ ((fn @ pts) / fn.sum() - sole)
             assert abs(local[0]) <= sim.params.foot_length / 2 + 1e-9
             assert abs(local[1]) <= sim.params.foot_width / 2 + 1e-9
-    np.testing.assert_allclose(d2.qfrc_inverse, gen, atol=INVERSE_TOL)
+    np.testing.assert_allclose(inverse, gen, atol=INVERSE_TOL)
     # --- torques within the model's force range
     lo, hi = m.actuator_forcerange[sim.actuators].T
     assert np.all(sol.torque >= lo - CONE_TOL) and np.all(sol.torque <= hi + CONE_TOL)
