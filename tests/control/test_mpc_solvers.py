@@ -134,10 +134,14 @@ def test_warm_start_from_the_solution_converges_at_once_and_cold_takes_steps() -
     np.testing.assert_allclose(v3, v, atol=1e-7)
 
 
-def test_iteration_limit_reports_no_convergence_and_returns_a_feasible_point() -> None:
+def _several_iterations_case() -> tuple[np.ndarray, np.ndarray]:
+    """A 5-disc problem (poorly conditioned P, large q) that takes several Newton iterations."""
     rng = np.random.default_rng(12)
-    p = _random_pd(rng, 10, cond=0.01)
-    q = rng.normal(0, 50, 10)
+    return _random_pd(rng, 10, cond=0.01), rng.normal(0, 50, 10)
+
+
+def test_iteration_limit_reports_no_convergence_and_returns_a_feasible_point() -> None:
+    p, q = _several_iterations_case()
     _, _, it_full, ok = solve_ball_qp(p, q)
     assert ok and it_full >= 2
     v, _, it, ok0 = solve_ball_qp(p, q, max_iter=0)
@@ -432,9 +436,7 @@ def test_secular_newton_takes_far_fewer_iterations_than_plain_newton(
 
 def test_iteration_limit_is_exact() -> None:
     """A problem that converges in k iterations converges with max_iter = k, not with k - 1."""
-    rng = np.random.default_rng(12)
-    p = _random_pd(rng, 10, cond=0.01)
-    q = rng.normal(0, 50, 10)
+    p, q = _several_iterations_case()
     v, _, k, ok = solve_ball_qp(p, q)
     assert ok and k >= 2
     v_k, _, it_k, ok_k = solve_ball_qp(p, q, max_iter=k)
