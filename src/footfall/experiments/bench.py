@@ -520,7 +520,7 @@ def benchmark_quadruped(
 
     base = QuadrupedSim(robot, slope)
     ref = plan.sample(0.01, with_zmp=False)
-    base.set_pose(ref.body_pos[0], ref.body_pitch, ref.joints[0])
+    base.set_pose(ref.body_pos[0], float(ref.body_pitch[0]), ref.joints[0])
     steps = round(res.sim_time / base.model.opt.timestep)
     t0 = time.perf_counter()
     for _ in range(steps):

@@ -19,8 +19,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from footfall._typing import FloatArray
-from footfall._validate import non_negative, positive
+from footfall._validate import finite, non_negative, positive
 from footfall.errors import InputError
+from footfall.quadruped.ground import PlaneGround, QuadrupedGround, Stairs, VaryingSlope
 from footfall.quadruped.kinematics import (
     body_rotation,
     foot_in_leg_frame,
@@ -69,6 +70,14 @@ class GaitParams:
         posture: body posture mode (sec. 2).
         height: body-centre height h_B above the foot-centre plane [m]; None = robot default.
         hold_time: standing time after the last shift [s].
+        side_slope: inclination of the slope across the walking direction [rad] (positive: the
+            left side higher); the body stays level across it, legs vertical (beyond document
+            001, whose slope only rises along the walk).
+        ground: a ground other than the plane (:class:`~footfall.quadruped.ground.VaryingSlope`
+            or :class:`~footfall.quadruped.ground.Stairs`); ``slope``, ``body_pitch`` and
+            ``side_slope`` must then be 0 and the body follows the local plane of its feet.
+        body_ratio: with ``ground``: the body pitches by this fraction of the local plane's
+            inclination (the compromise posture of fig. 7 applied locally; 0 keeps it level).
     """
 
     slope: float
@@ -82,6 +91,9 @@ class GaitParams:
     posture: BodyPosture = BodyPosture.COMPROMISE
     height: float | None = None
     hold_time: float = 0.5
+    side_slope: float = 0.0
+    ground: QuadrupedGround | None = None
+    body_ratio: float = 2.0 / 3.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "step", positive("step", self.step))
@@ -98,6 +110,40 @@ class GaitParams:
             object.__setattr__(self, "height", positive("height", self.height))
         # validates slope and body angle (body angle within [0, slope]) early
         SlopePosture(self.slope, self.body_pitch, 1.0, self.posture)
+        ratio = finite("body_ratio", self.body_ratio)
+        if not 0.0 <= ratio <= 1.0:
+            raise InputError("body_ratio", ratio, "a fraction of the local inclination in [0, 1]")
+        object.__setattr__(self, "body_ratio", ratio)
+        if self.ground is None:
+            PlaneGround(self.slope, self.side_slope)  # validates the side slope
+            return
+        if not isinstance(self.ground, VaryingSlope | Stairs):
+            raise InputError(
+                "ground", type(self.ground).__name__, "a VaryingSlope or Stairs (or None: plane)"
+            )
+        for name in ("slope", "body_pitch", "side_slope"):
+            if getattr(self, name) != 0.0:
+                raise InputError(name, getattr(self, name), "0 when a ground is given")
+        if self.posture is BodyPosture.PARALLEL:
+            raise InputError(
+                "posture", self.posture.value, "compromise or horizontal on this ground"
+            )
+
+    @property
+    def terrain(self) -> QuadrupedGround:
+        """The ground walked: ``ground``, or the plane of ``slope`` and ``side_slope``."""
+        if self.ground is not None:
+            return self.ground
+        return PlaneGround(self.slope, self.side_slope)
+
+    def pitch_for(self, plane: tuple[float, float, float]) -> float:
+        """Body pitch [rad] on the local plane ``z = a + b x + c y`` of the feet: the given
+        ``body_pitch`` on the document's plane, ``body_ratio`` times its inclination otherwise."""
+        if self.ground is None:
+            return self.body_pitch
+        if self.posture is BodyPosture.HORIZONTAL:
+            return 0.0
+        return self.body_ratio * math.atan(plane[1])
 
 
 @dataclass(frozen=True)
@@ -116,6 +162,9 @@ class GaitPhase:
         zmp_target: ZMP target the preceding shift aimed at, shape (2,) [m].
         target_margin: margin of that target in the support triangles it serves [m].
         cycle: gait cycle index.
+        pitch_start: body pitch at the start [rad] (nose up positive).
+        pitch_end: body pitch at the end [rad]; it changes only in shifts, with the same time
+            law as the body position.
     """
 
     kind: PhaseKind
@@ -129,6 +178,8 @@ class GaitPhase:
     zmp_target: FloatArray | None = None
     target_margin: float = math.nan
     cycle: int = 0
+    pitch_start: float = 0.0
+    pitch_end: float = 0.0
 
     @property
     def t1(self) -> float:
@@ -143,7 +194,8 @@ class GaitTrajectory:
     Attributes:
         t: times, shape (T,) [s].
         body_pos: body centre in ``{W}``, shape (T, 3) [m].
-        body_pitch: body angle beta_B [rad] (constant).
+        body_pitch: body angle beta_B to the horizontal, shape (T,) [rad] (constant on the
+            document's plane; it follows the local plane on other grounds).
         feet: foot centres in ``{W}``, shape (T, 4, 3) [m], ``LEGS`` order.
         contact: planned stance flags, shape (T, 4).
         joints: joint angles, shape (T, 12) [rad], ``LEGS`` x (abad, pitch, knee).
@@ -155,7 +207,7 @@ class GaitTrajectory:
 
     t: FloatArray
     body_pos: FloatArray
-    body_pitch: float
+    body_pitch: FloatArray
     feet: FloatArray
     contact: NDArray[np.bool_]
     joints: FloatArray
@@ -189,9 +241,15 @@ class GaitPlan:
         """Foot centres at t = 0, shape (4, 3) [m]."""
         return self.phases[0].feet_start
 
+    @property
+    def ground(self) -> QuadrupedGround:
+        """The ground walked (see :attr:`GaitParams.terrain`)."""
+        return self.params.terrain
+
     def contact_point(self, foot_centre: FloatArray) -> FloatArray:
         """Ground contact point of a spherical foot: centre minus radius along the normal."""
-        return foot_centre - self.robot.foot_radius * self.posture.slope_normal
+        n = self.ground.normal(float(foot_centre[0]), float(foot_centre[1]))
+        return foot_centre - self.robot.foot_radius * n
 
     def sample(self, dt: float = 0.01, with_zmp: bool = True) -> GaitTrajectory:
         """Sample the plan every ``dt`` seconds (see :class:`GaitTrajectory`)."""
@@ -233,8 +291,23 @@ def check_reachability(robot: QuadrupedRobot, params: GaitParams) -> SlopePostur
             steep for this body angle), with the steepest feasible slope in the message.
     """
     h = params.height if params.height is not None else robot.stance_height
-    post = SlopePosture(params.slope, params.body_pitch, h, params.posture)
+    if params.ground is not None:
+        # the posture where the walk starts; the body then follows the feet's local plane
+        b0 = params.ground.inclination(0.0)
+        post = SlopePosture(b0, params.pitch_for((0.0, math.tan(b0), 0.0)), h, params.posture)
+    else:
+        post = SlopePosture(params.slope, params.body_pitch, h, params.posture)
     if _neutral_ok(robot, post):
+        body, pitch, feet = _initial_stance(robot, params, post)
+        if not _legs_ok(robot, body, pitch, feet):
+            fld = "side_slope" if params.ground is None else "ground"
+            raise InputError(
+                fld,
+                getattr(params, fld) if params.ground is None else type(params.ground).__name__,
+                "a ground whose neutral stance is in the leg workspace (legs vertical, body "
+                f"{h:.3f} m above it; usable leg length {robot.min_leg_length:.3f}-"
+                f"{robot.max_leg_length:.3f} m)",
+            )
         return post
     if not _neutral_ok(robot, SlopePosture(0.0, 0.0, h, params.posture)):
         raise InputError("height", h, "a body height the legs reach on flat ground")
@@ -252,9 +325,44 @@ def check_reachability(robot: QuadrupedRobot, params: GaitParams) -> SlopePostur
     )
 
 
+@dataclass(frozen=True)
+class _Local:
+    """The body's pose rule over one stance: height ``height`` above the plane
+    ``z = a + b x + c y`` of the feet, pitch ``pitch`` [rad]."""
+
+    plane: tuple[float, float, float]
+    height: float
+    pitch: float
+
+    def body_position(self, x: float, y: float) -> FloatArray:
+        a, b, c = self.plane
+        return np.array([x, y, a + b * x + c * y + self.height])
+
+
+def _local(params: GaitParams, post: SlopePosture, points: FloatArray) -> _Local:
+    """The pose rule over the foot centres ``points`` (N, 3): the ground's local plane."""
+    plane = params.terrain.local_plane(points)
+    return _Local(plane, post.height, params.pitch_for(plane))
+
+
+def _initial_stance(
+    robot: QuadrupedRobot, params: GaitParams, post: SlopePosture
+) -> tuple[FloatArray, float, FloatArray]:
+    """Body centre (3,), pitch [rad] and neutral foot centres (4, 3) at the start: the body
+    ``h_B`` above the origin, each hip's ray along the posture's leg direction meeting the
+    foot-centre surface (document 001's neutral footholds on its plane)."""
+    ground = params.terrain
+    body = np.array([0.0, 0.0, post.height])
+    pitch = post.body_pitch
+    rot = body_rotation(pitch)
+    d = post.leg_direction()
+    feet = np.array([ground.drop(body + rot @ robot.hip_offset(leg), d) for leg in LEGS])
+    return body, pitch, feet
+
+
 def _body_for_com(
     robot: QuadrupedRobot,
-    post: SlopePosture,
+    local: _Local,
     target: FloatArray,
     feet: FloatArray,
     step: float,
@@ -265,8 +373,8 @@ def _body_for_com(
         InputError: named ``step`` when that body position is outside the leg workspace.
     """
     # the trunk carries 80 % of the mass, so the target itself is a close first guess
-    body = post.body_position(float(target[0]), float(target[1]))
-    rot = body_rotation(post.body_pitch)
+    body = local.body_position(float(target[0]), float(target[1]))
+    rot = body_rotation(local.pitch)
     hips = robot.hip_offsets()
     for _ in range(_COM_ITERATIONS):
         try:
@@ -278,9 +386,9 @@ def _body_for_com(
                 f"a step for which the body can reach the ZMP target "
                 f"({target[0]:.3f}, {target[1]:.3f}) m: leg out of reach ({exc.expected})",
             ) from None
-        com = whole_body_com(robot, body, post.body_pitch, q)
+        com = whole_body_com(robot, body, local.pitch, q)
         xy = body[:2] + (target - com[:2])
-        body = post.body_position(float(xy[0]), float(xy[1]))
+        body = local.body_position(float(xy[0]), float(xy[1]))
     return body
 
 
@@ -327,22 +435,31 @@ def plan_gait(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
 def _plan(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
     """:func:`plan_gait` without the search for the largest feasible step."""
     post = check_reachability(robot, params)
-    u = post.slope_direction
+    ground = params.terrain
+    if isinstance(ground, Stairs) and ground.edge_margin < robot.foot_radius:
+        raise InputError(
+            "ground.edge_margin",
+            ground.edge_margin,
+            f"at least the foot radius {robot.foot_radius}",
+        )
     order = swing_order(params.strategy)
-    body = post.body_position()
-    feet = post.neutral_feet(robot, body)
+    body, pitch, feet = _initial_stance(robot, params, post)
+    r = robot.foot_radius
     for j, leg in enumerate(order):
         # steady state: a leg lands S/2 ahead of its neutral point at mid-swing of the cycle
-        feet[leg.idx] += u * params.step * ((j + 0.5) / 4.0 - 0.5)
+        feet[leg.idx] = ground.advance(feet[leg.idx], params.step * ((j + 0.5) / 4.0 - 0.5), r)
 
     phases: list[GaitPhase] = []
     t = 0.0
     for cycle in range(params.cycles):
         for group in swing_groups(params.strategy):
-            body, t = _shift_and_swing(robot, post, params, group, cycle, feet, body, t, phases)
-    _centre_and_hold(robot, post, params, feet, body, t, phases)
+            body, pitch, t = _shift_and_swing(
+                robot, post, params, group, cycle, feet, (body, pitch), t, phases
+            )
+    _centre_and_hold(robot, post, params, feet, (body, pitch), t, phases)
     plan = GaitPlan(robot, params, post, tuple(phases))
     _check_plan_reach(plan)
+    _check_swing_clearance(plan)
     return plan
 
 
@@ -353,25 +470,29 @@ def _shift_and_swing(
     group: tuple[Leg, ...],
     cycle: int,
     feet: FloatArray,
-    body: FloatArray,
+    pose: tuple[FloatArray, float],
     t: float,
     phases: list[GaitPhase],
-) -> tuple[FloatArray, float]:
+) -> tuple[FloatArray, float, float]:
     """Append one body shift to the ZMP target of the support triangles of ``group`` (sec. 3),
-    then the swing of each leg of the group (one step along the slope) to ``phases``.
+    then the swing of each leg of the group (one step along the ground) to ``phases``.
 
-    ``feet`` (4, 3) [m] is updated to the landed feet. Returns the body position [m] after the
-    shift and the time [s] after the last swing.
+    ``pose`` is the body position (3,) [m] and pitch [rad] before the shift; the shift ends at
+    the pitch of the local plane through the feet before and after the group's swings. ``feet``
+    (4, 3) [m] is updated to the landed feet. Returns the body position [m] and pitch [rad]
+    after the shift and the time [s] after the last swing.
     """
-    u = post.slope_direction
+    ground, r = params.terrain, robot.foot_radius
+    body, pitch = pose
     tri_feet = feet.copy()
     triangles = []
     for leg in group:
         stance = [i for i in range(4) if i != leg.idx]
         triangles.append(support_polygon(tri_feet[stance]))
-        tri_feet[leg.idx] = tri_feet[leg.idx] + u * params.step
+        tri_feet[leg.idx] = ground.advance(tri_feet[leg.idx], params.step, r)
     target, margin = zmp_target(triangles)
-    new_body = _body_for_com(robot, post, target, feet, params.step)
+    local = _local(params, post, np.vstack([feet, tri_feet]))
+    new_body = _body_for_com(robot, local, target, feet, params.step)
     phases.append(
         GaitPhase(
             PhaseKind.SHIFT,
@@ -383,12 +504,14 @@ def _shift_and_swing(
             zmp_target=target,
             target_margin=margin,
             cycle=cycle,
+            pitch_start=pitch,
+            pitch_end=local.pitch,
         )
     )
     t += params.shift_period
-    body = new_body
+    body, pitch = new_body, local.pitch
     for leg in group:
-        land = feet[leg.idx] + u * params.step
+        land = tri_feet[leg.idx]
         phases.append(
             GaitPhase(
                 PhaseKind.SWING,
@@ -402,11 +525,13 @@ def _shift_and_swing(
                 zmp_target=target,
                 target_margin=margin,
                 cycle=cycle,
+                pitch_start=pitch,
+                pitch_end=pitch,
             )
         )
         t += params.swing_period
         feet[leg.idx] = land
-    return body, t
+    return body, pitch, t
 
 
 def _centre_and_hold(
@@ -414,14 +539,16 @@ def _centre_and_hold(
     post: SlopePosture,
     params: GaitParams,
     feet: FloatArray,
-    body: FloatArray,
+    pose: tuple[FloatArray, float],
     t: float,
     phases: list[GaitPhase],
 ) -> None:
     """Append the final shift of the CoM over the centre of the four feet, and the standing hold
     (when ``params.hold_time`` > 0), to ``phases``."""
+    body, pitch = pose
     centre = feet[:, :2].mean(axis=0)
-    final = _body_for_com(robot, post, centre, feet, params.step)
+    local = _local(params, post, feet)
+    final = _body_for_com(robot, local, centre, feet, params.step)
     phases.append(
         GaitPhase(
             PhaseKind.SHIFT,
@@ -432,6 +559,8 @@ def _centre_and_hold(
             feet.copy(),
             zmp_target=centre,
             cycle=params.cycles - 1,
+            pitch_start=pitch,
+            pitch_end=local.pitch,
         )
     )
     t += params.shift_period
@@ -445,24 +574,28 @@ def _centre_and_hold(
                 final,
                 feet.copy(),
                 cycle=params.cycles - 1,
+                pitch_start=local.pitch,
+                pitch_end=local.pitch,
             )
         )
 
 
 def _check_plan_reach(plan: GaitPlan) -> None:
     """Every phase's start and end configuration must be reachable (IK), else name ``step``."""
-    robot, rot = plan.robot, body_rotation(plan.posture.body_pitch)
-    bodies, feet, when = [], [], []
+    robot = plan.robot
+    bodies, feet, pitches, when = [], [], [], []
     for ph in plan.phases:
         feet_end = ph.feet_start.copy()
         if ph.leg is not None and ph.foot_end is not None:
             feet_end[ph.leg.idx] = ph.foot_end
         bodies += [ph.body_start, ph.body_end]
         feet += [ph.feet_start, feet_end]
+        pitches += [ph.pitch_start, ph.pitch_end]
         when += [ph, ph]
     body_arr, feet_arr = np.array(bodies), np.array(feet)
+    rots = _rotations(np.array(pitches))
     for i, leg in enumerate(LEGS):
-        p_leg = (feet_arr[:, i] - body_arr) @ rot - robot.hip_offset(leg)
+        p_leg = _to_body(rots, feet_arr[:, i] - body_arr) - robot.hip_offset(leg)
         try:
             leg_ik(robot, p_leg, leg)
         except InputError as exc:
@@ -474,6 +607,39 @@ def _check_plan_reach(plan: GaitPlan) -> None:
                 f"a step whose body shifts stay in the leg workspace ({ph.kind.value} at "
                 f"t={ph.t0:.2f} s: {exc.field} expected {exc.expected})",
             ) from None
+
+
+def _rotations(pitch: FloatArray) -> FloatArray:
+    """Body rotations of nose-up pitches (T,): shape (T, 3, 3) (rotations about y by -pitch)."""
+    c, s = np.cos(-pitch), np.sin(-pitch)
+    rot = np.zeros((pitch.shape[0], 3, 3))
+    rot[:, 0, 0], rot[:, 0, 2], rot[:, 1, 1], rot[:, 2, 0], rot[:, 2, 2] = c, s, 1.0, -s, c
+    return rot
+
+
+def _to_body(rot: FloatArray, v: FloatArray) -> FloatArray:
+    """World vectors (T, 3) in the body frames ``rot`` (T, 3, 3): ``rot[t].T @ v[t]``."""
+    return np.einsum("tji,tj->ti", rot, v)
+
+
+def _check_swing_clearance(plan: GaitPlan) -> None:
+    """Every swing foot stays above the ground (no foot cuts a step edge), else name
+    ``swing_height``."""
+    ref = plan.sample(0.01, with_zmp=False)
+    ground, r = plan.ground, plan.robot.foot_radius
+    for i, leg in enumerate(LEGS):
+        swing = np.flatnonzero(~ref.contact[:, i])
+        if swing.size == 0:
+            continue
+        gap = ground.clearance(ref.feet[swing, i], r)
+        k = int(np.argmin(gap))
+        if gap[k] < -1e-6:
+            raise InputError(
+                "swing_height",
+                f"{plan.params.swing_height:.3f} m",
+                f"a swing that clears the ground: leg {leg.value} at t={ref.t[swing[k]]:.2f} s "
+                f"is {-gap[k]:.3f} m too low (x = {ref.feet[swing[k], i, 0]:.3f} m)",
+            )
 
 
 def _unreachable(robot: QuadrupedRobot, p_leg: FloatArray, leg: Leg) -> bool:
@@ -492,12 +658,11 @@ def sample_plan(plan: GaitPlan, dt: float = 0.01, with_zmp: bool = True) -> Gait
     rotational inertia is neglected. ``z_p`` is the mean height of the stance contact points.
     """
     dt = positive("dt", dt)
-    robot, post = plan.robot, plan.posture
-    pitch = post.body_pitch
-    rot = body_rotation(pitch)
+    robot = plan.robot
     t = np.arange(0.0, plan.duration + 0.5 * dt, dt)
     n = t.shape[0]
     body = np.empty((n, 3))
+    pitch = np.empty(n)
     feet = np.empty((n, 4, 3))
     contact = np.ones((n, 4), dtype=bool)
     phase_idx = np.empty(n, dtype=int)
@@ -511,34 +676,47 @@ def sample_plan(plan: GaitPlan, dt: float = 0.01, with_zmp: bool = True) -> Gait
         tau = np.clip((t[sel] - ph.t0) / ph.duration, 0.0, 1.0)
         s = _quintic(tau)[:, None]
         body[sel] = ph.body_start + s * (ph.body_end - ph.body_start)
+        pitch[sel] = ph.pitch_start + s[:, 0] * (ph.pitch_end - ph.pitch_start)
         feet[sel] = ph.feet_start
         if ph.kind is PhaseKind.SWING and ph.leg is not None and ph.foot_end is not None:
             i = ph.leg.idx
+            chord = ph.foot_end - ph.feet_start[i]
             profile = SwingProfile(
-                float(np.linalg.norm(ph.foot_end - ph.feet_start[i])),
-                plan.params.swing_height,
-                ph.duration,
+                float(np.linalg.norm(chord)), plan.params.swing_height, ph.duration
             )
             mid = 0.5 * (ph.feet_start[i] + ph.foot_end)
-            # eq. (13): {G} origin = centre of the step expressed in the leg frame
-            origin = foot_in_leg_frame(robot, ph.leg, ph.body_start, pitch, mid)
-            p_leg = swing_in_leg_frame(profile, t[sel] - ph.t0, post.beta_delta, origin)
+            # eq. (13): {G} origin = centre of the step expressed in the leg frame; {G}'s x axis
+            # along the step (the slope beta_S on the document's plane), beta_Delta = its angle
+            # above the body's
+            origin = foot_in_leg_frame(robot, ph.leg, ph.body_start, ph.pitch_start, mid)
+            beta_delta = _step_angle(plan, chord) - ph.pitch_start
+            p_leg = swing_in_leg_frame(profile, t[sel] - ph.t0, beta_delta, origin)
+            rot = body_rotation(ph.pitch_start)
             feet[sel, i] = ph.body_start + (robot.hip_offset(ph.leg) + p_leg) @ rot.T
             contact[sel, i] = False
     joints = np.empty((n, 12))
+    rots = _rotations(pitch)
     for i, leg in enumerate(LEGS):
-        p_leg = (feet[:, i] - body) @ rot - robot.hip_offset(leg)
+        p_leg = _to_body(rots, feet[:, i] - body) - robot.hip_offset(leg)
         joints[:, 3 * i : 3 * i + 3] = leg_ik(robot, p_leg, leg)
-    com, zmp, margin = _com_and_zmp(plan, t, body, feet, contact, joints, with_zmp)
+    com, zmp, margin = _com_and_zmp(plan, t, body, pitch, feet, contact, joints, with_zmp)
     return GaitTrajectory(t, body, pitch, feet, contact, joints, com, zmp, margin, phase_idx)
 
 
+def _step_angle(plan: GaitPlan, chord: FloatArray) -> float:
+    """Angle of a step above the horizontal [rad]: the slope beta_S itself on the document's
+    plane, the chord's elevation on other grounds."""
+    if plan.params.ground is None:
+        return plan.posture.slope
+    return math.atan2(float(chord[2]), float(np.hypot(chord[0], chord[1])))
+
+
 def _point_masses(
-    plan: GaitPlan, body: FloatArray, joints: FloatArray
+    plan: GaitPlan, body: FloatArray, pitch: FloatArray, joints: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
     """Point masses (trunk, per leg hip/thigh/shank), positions shape (T, 13, 3), masses (13,)."""
     robot = plan.robot
-    rot = body_rotation(plan.posture.body_pitch)
+    rot = _rotations(pitch)
     n = body.shape[0]
     pos = np.empty((n, 13, 3))
     masses = np.empty(13)
@@ -548,7 +726,9 @@ def _point_masses(
         pts = leg_points(robot, joints[:, 3 * i : 3 * i + 3])
         knee, foot = pts[:, 0], pts[:, 1]
         local = np.stack([np.zeros_like(knee), 0.5 * knee, 0.5 * (knee + foot)], axis=1)
-        pos[:, 1 + 3 * i : 4 + 3 * i] = body[:, None, :] + (local + robot.hip_offset(leg)) @ rot.T
+        pos[:, 1 + 3 * i : 4 + 3 * i] = body[:, None, :] + np.einsum(
+            "tij,tkj->tki", rot, local + robot.hip_offset(leg)
+        )
         masses[1 + 3 * i : 4 + 3 * i] = (robot.hip_mass, robot.thigh_mass, robot.shank_mass)
     return pos, masses
 
@@ -557,12 +737,13 @@ def _com_and_zmp(
     plan: GaitPlan,
     t: FloatArray,
     body: FloatArray,
+    pitch: FloatArray,
     feet: FloatArray,
     contact: NDArray[np.bool_],
     joints: FloatArray,
     with_zmp: bool,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    pos, masses = _point_masses(plan, body, joints)
+    pos, masses = _point_masses(plan, body, pitch, joints)
     total = float(masses.sum())
     com = np.einsum("tkj,k->tj", pos, masses) / total
     n = t.shape[0]
@@ -572,7 +753,6 @@ def _com_and_zmp(
     acc = np.gradient(np.gradient(pos, dt, axis=0), dt, axis=0)
     p_dot = np.einsum("tkj,k->tj", acc, masses)
     l_dot = np.einsum("tkj,k->tj", np.cross(pos, acc), masses)
-    contacts = feet - plan.robot.foot_radius * plan.posture.slope_normal
     zmp = np.empty((n, 2))
     margin = np.empty(n)
     # within a phase the stance feet do not move, so one polygon and one z_p serve the phase
@@ -582,7 +762,7 @@ def _com_and_zmp(
         if sel.size == 0:
             continue
         stance = np.flatnonzero(contact[sel[0]])
-        pts = contacts[sel[0], stance]
+        pts = np.array([plan.contact_point(feet[sel[0], i]) for i in stance])
         z_p = float(pts[:, 2].mean())
         zmp[sel] = zmp_from_momentum(total, com[sel], p_dot[sel], l_dot[sel], z_p)
         margin[sel] = stability_margins(zmp[sel], support_polygon(pts))

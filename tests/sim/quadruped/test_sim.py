@@ -75,7 +75,7 @@ def test_static_stance_cop_matches_com_projection_on_the_slope() -> None:
     plan = plan_gait(ROBOT, GaitParams(SLOPE, math.radians(10.0), cycles=1))
     s = QuadrupedSim(ROBOT, SLOPE)
     ref = plan.sample(0.01, with_zmp=False)
-    s.set_pose(ref.body_pos[0], ref.body_pitch, ref.joints[0])
+    s.set_pose(ref.body_pos[0], float(ref.body_pitch[0]), ref.joints[0])
     for _ in range(1000):  # 2 s standing
         mujoco.mj_step(s.model, s.data)
     pts, frc, idx, trunk_hit = s.contacts()

@@ -43,10 +43,10 @@ def _one_tick(t: float) -> tuple[QuadrupedSim, QuadrupedWbc]:
     plan = _plan(15.0, 10.0)
     ref = plan.sample(0.01)
     sim = QuadrupedSim(plan.robot, plan.posture.slope)
-    sim.set_pose(ref.body_pos[0], ref.body_pitch, ref.joints[0])
+    sim.set_pose(ref.body_pos[0], float(ref.body_pitch[0]), ref.joints[0])
     sim.data.qvel[:] = np.random.default_rng(0).normal(0.0, 0.05, sim.model.nv)
     mujoco.mj_forward(sim.model, sim.data)
-    wbc = QuadrupedWbc(sim, ref, plan.posture.slope_normal, QuadrupedWbcGains())
+    wbc = QuadrupedWbc(sim, ref, plan.ground, QuadrupedWbcGains())
     wbc.torques(t)
     return sim, wbc
 
@@ -65,7 +65,7 @@ def test_qp_solution_satisfies_mujoco_inverse_dynamics_and_the_contacts(t: float
     gen[dofs] += sol.torque
     jp, jr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
     jdp, jdr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
-    normal = np.asarray(wbc.normal)
+    normal = sim.ground.normal(0.0, 0.0)
     mu = float(m.geom_friction[sim.foot_geoms[0], 0])
     t1 = np.cross(normal, [0.0, 1.0, 0.0])
     t1 /= np.linalg.norm(t1)
@@ -190,14 +190,14 @@ def test_the_friction_setting_is_the_contacts_friction(friction: float) -> None:
     plan = _plan(15.0, 10.0, cycles=1)
     ref = plan.sample(0.01)
     sim = QuadrupedSim(plan.robot, plan.posture.slope, SimSettings(friction=friction))
-    sim.set_pose(ref.body_pos[0], ref.body_pitch, ref.joints[0])
+    sim.set_pose(ref.body_pos[0], float(ref.body_pitch[0]), ref.joints[0])
     for _ in range(50):
         mujoco.mj_step(sim.model, sim.data)
     d = sim.data
     feet = set(sim.foot_geoms)
     mus = [float(d.contact[i].friction[0]) for i in range(d.ncon) if set(d.contact[i].geom) & feet]
     assert len(mus) >= 4 and np.allclose(mus, friction)
-    wbc = QuadrupedWbc(sim, ref, plan.posture.slope_normal, QuadrupedWbcGains())
+    wbc = QuadrupedWbc(sim, ref, plan.ground, QuadrupedWbcGains())
     assert wbc.friction == pytest.approx(friction)
 
 

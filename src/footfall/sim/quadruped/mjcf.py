@@ -5,8 +5,9 @@ and shank are straight links of the robot's lengths, masses sit at the hip and a
 midpoints (explicit ``<inertial>``), the foot is a sphere whose centre is the planner's foot point.
 Joints are driven by position actuators.
 
-Scenes: a plane sloped by ``slope`` rising along +x (``slope_scene``) or a flight of stairs
-(``stairs_scene``). The foot-centre plane of the planner passes through the world origin, so the
+Scenes: a plane sloped by ``slope`` rising along +x (``slope_scene``), a flight of stairs
+(``stairs_scene``), or any :mod:`footfall.quadruped.ground` (``ground_scene``: also side slopes and
+varying slopes, the latter as a chain of thin boxes). The foot-centre plane of the planner passes through the world origin, so the
 ground plane is placed one foot radius below it along its normal.
 
 MuJoCo notes (measured for this issue): angles are in radians only with
@@ -24,6 +25,7 @@ import numpy as np
 
 from footfall._validate import positive
 from footfall.errors import InputError
+from footfall.quadruped.ground import PlaneGround, QuadrupedGround, VaryingSlope
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
 from footfall.sim._mjcf import (
     GRID_TEXTURE,
@@ -57,10 +59,70 @@ def slope_floor_xml(slope: float, foot_radius: float) -> str:
     )
 
 
-def stairs_xml(
-    rise: float, run: float, steps: int, width: float, start_x: float, foot_radius: float
+def side_slope_floor_xml(ground: PlaneGround, foot_radius: float) -> str:
+    """Plane of ``ground`` (a slope with a side slope), one foot radius below its foot-centre
+    plane (which passes through the origin)."""
+    n = ground.normal(0.0, 0.0)
+    pos = -foot_radius * n
+    return (
+        f'<geom name="{nm.FLOOR_GEOM}" type="plane" size="40 8 0.1" pos="{fmt(*pos)}" '
+        f'zaxis="{fmt(*n)}" material="ground" '
+        f'contype="{nm.GROUND_CONTYPE}" conaffinity="{nm.GROUND_CONAFFINITY}"/>'
+    )
+
+
+#: length of one plank of a varying slope [m] (the inclination changes by well under 1 degree)
+PLANK_LENGTH = 0.05
+#: thickness of a plank [m]
+PLANK_THICKNESS = 0.1
+
+
+def varying_slope_xml(
+    ground: VaryingSlope, foot_radius: float, x_range: tuple[float, float]
 ) -> str:
-    """A flat floor and ``steps`` boxes rising by ``rise`` every ``run`` metres from ``start_x``."""
+    """A varying slope over ``x_range`` [m] as a chain of thin boxes ("planks") whose top faces
+    form the polyline through the ground points under foot centres every :data:`PLANK_LENGTH`:
+    the ground is the foot-centre curve offset by one foot radius along its normal."""
+    x0, x1 = x_range
+    n = max(2, math.ceil((x1 - x0) / PLANK_LENGTH) + 1)
+    xs = np.linspace(x0, x1, n)
+    pts = []
+    for x in xs:
+        b = ground.inclination(float(x))
+        pts.append(
+            (
+                x + foot_radius * math.sin(b),
+                ground.centre_height(float(x)) - foot_radius * math.cos(b),
+            )
+        )
+    parts = []
+    for k in range(n - 1):
+        (ax, az), (bx, bz) = pts[k], pts[k + 1]
+        length = math.hypot(bx - ax, bz - az)
+        phi = math.atan2(bz - az, bx - ax)
+        # box centre half a thickness below the segment's midpoint, along its normal
+        cx = 0.5 * (ax + bx) + 0.5 * PLANK_THICKNESS * math.sin(phi)
+        cz = 0.5 * (az + bz) - 0.5 * PLANK_THICKNESS * math.cos(phi)
+        name = nm.FLOOR_GEOM if k == 0 else f"{nm.PLANK_GEOM_PREFIX}{k}"
+        parts.append(
+            f'<geom name="{name}" type="box" size="{fmt(length / 2, 8.0, PLANK_THICKNESS / 2)}" '
+            f'pos="{fmt(cx, 0.0, cz)}" quat="{fmt(*_quat_about_y(-phi))}" material="ground" '
+            f'contype="{nm.GROUND_CONTYPE}" conaffinity="{nm.GROUND_CONAFFINITY}"/>'
+        )
+    return "\n    ".join(parts)
+
+
+def stairs_xml(
+    rise: float,
+    run: float,
+    steps: int,
+    width: float,
+    start_x: float,
+    foot_radius: float,
+    landing: float = 0.0,
+) -> str:
+    """A flat floor and ``steps`` boxes rising by ``rise`` every ``run`` metres from ``start_x``;
+    the top step reaches ``landing`` metres further (a landing)."""
     rise = positive("stairs.rise", rise)
     run = positive("stairs.run", run)
     if steps < 1:
@@ -73,8 +135,8 @@ def stairs_xml(
     for k in range(steps):
         top = (k + 1) * rise - foot_radius
         x0 = start_x + k * run
-        # each box reaches from the floor to its tread and to the end of the flight
-        length = (steps - k) * run
+        # each box reaches from the floor to its tread and to the end of the flight (landing)
+        length = (steps - k) * run + landing
         parts.append(
             f'<geom name="{nm.STAIR_GEOM_PREFIX}{k}" type="box" '
             f'size="{fmt(length / 2, width / 2, (top + foot_radius) / 2)}" '
@@ -186,7 +248,36 @@ def stairs_scene(
     steps: int = 6,
     start_x: float = 0.8,
     settings: SimSettings | None = None,
+    landing: float = 0.0,
 ) -> str:
     """MJCF of the robot in front of a flight of ``steps`` stairs (rise/run in metres)."""
-    ground = stairs_xml(rise, run, steps, 3.0 * robot.body_width, start_x, robot.foot_radius)
+    ground = stairs_xml(
+        rise, run, steps, 3.0 * robot.body_width, start_x, robot.foot_radius, landing
+    )
     return quadruped_mjcf(robot, ground, settings)
+
+
+def ground_scene(
+    robot: QuadrupedRobot,
+    ground: QuadrupedGround,
+    settings: SimSettings | None = None,
+    x_range: tuple[float, float] = (-3.0, 12.0),
+) -> str:
+    """MJCF of the robot on ``ground`` (:mod:`footfall.quadruped.ground`); a varying slope is
+    built over ``x_range`` [m]."""
+    r = robot.foot_radius
+    if isinstance(ground, PlaneGround):
+        if ground.side_slope == 0.0:
+            return slope_scene(robot, ground.slope, settings)
+        return quadruped_mjcf(robot, side_slope_floor_xml(ground, r), settings)
+    if isinstance(ground, VaryingSlope):
+        return quadruped_mjcf(robot, varying_slope_xml(ground, r, x_range), settings)
+    return stairs_scene(
+        robot,
+        ground.rise,
+        ground.run,
+        ground.steps,
+        ground.start_x,
+        settings,
+        landing=ground.landing,
+    )

@@ -11,6 +11,7 @@ TRUNK_GEOM = "trunk_box"
 ROOT_JOINT = "root"
 FLOOR_GEOM = "floor"
 STAIR_GEOM_PREFIX = "stair_"
+PLANK_GEOM_PREFIX = "plank_"
 TRACK_CAMERA = "track"
 
 #: collision bits: the ground collides with feet and trunk, robot parts never with each other

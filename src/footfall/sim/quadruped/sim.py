@@ -24,11 +24,12 @@ from footfall._typing import FloatArray
 from footfall._validate import positive
 from footfall.errors import FootfallError, InputError
 from footfall.quadruped.gait import GaitParams, GaitPlan, GaitTrajectory, PhaseKind, plan_gait
+from footfall.quadruped.ground import PlaneGround, QuadrupedGround
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
 from footfall.quadruped.stability import centre_of_pressure, stability_margin, support_polygon
 from footfall.sim.pushes import Push
 from footfall.sim.quadruped import names as nm
-from footfall.sim.quadruped.mjcf import SimSettings, slope_scene
+from footfall.sim.quadruped.mjcf import SimSettings, ground_scene
 
 #: a foot counts as in contact when it carries more than this fraction of the robot's weight
 CONTACT_FORCE_FRACTION = 0.01
@@ -220,7 +221,11 @@ class QuadrupedSim:
     """MuJoCo model + data of the robot on a slope, with handles resolved once by name."""
 
     def __init__(
-        self, robot: QuadrupedRobot, slope: float, settings: SimSettings | None = None
+        self,
+        robot: QuadrupedRobot,
+        slope: float | QuadrupedGround,
+        settings: SimSettings | None = None,
+        x_range: tuple[float, float] = (-3.0, 12.0),
     ) -> None:
         try:
             import mujoco  # optional dependency: footfall[sim]
@@ -232,7 +237,10 @@ class QuadrupedSim:
         self.mujoco = mujoco
         self.robot = robot
         self.settings = settings if settings is not None else SimSettings()
-        self.model = mujoco.MjModel.from_xml_string(slope_scene(robot, slope, self.settings))
+        #: the ground (a number is the document's slope [rad])
+        self.ground = slope if not isinstance(slope, int | float) else PlaneGround(float(slope))
+        xml = ground_scene(robot, self.ground, self.settings, x_range)
+        self.model = mujoco.MjModel.from_xml_string(xml)
         self.data = mujoco.MjData(self.model)
         m = self.model
         obj = mujoco.mjtObj
@@ -407,17 +415,19 @@ class _Recorder:
             self.cop[k], _ = centre_of_pressure(pts[loaded], frc[loaded], z_p)
             # each foot touches at one point (sphere on plane), so the feet's points span it
             self.margin[k] = stability_margin(self.cop[k], support_polygon(pts[loaded]))
-        normal = self.plan.posture.slope_normal
+        ground = self.plan.ground
         for j in range(idx.size):
+            normal = ground.normal(float(pts[j, 0]), float(pts[j, 1]))
             self.slip_vel[k, idx[j]] = sim.contact_slip_velocity(idx[j], pts[j], normal)
         if math.isnan(self.fallen_at) and (trunk_hit or self._fallen(k)):
             self.fallen_at = float(self.t[k])
 
     def _fallen(self, k: int) -> bool:
-        """Trunk tilted past FALL_TILT from its planned pitch, or too low above the slope."""
+        """Trunk tilted past FALL_TILT from its planned pitch, or too low above the ground."""
         post = self.plan.posture
-        tilt = abs(self.trunk_pitch[k] - self.planned.body_pitch)
-        low = self.trunk_pos[k, 2] - post.plane_height(float(self.trunk_pos[k, 0]))
+        tilt = abs(self.trunk_pitch[k] - self.planned.body_pitch[k])
+        x, y = float(self.trunk_pos[k, 0]), float(self.trunk_pos[k, 1])
+        low = self.trunk_pos[k, 2] - self.plan.ground.centre_height(x, y)
         return bool(tilt > FALL_TILT or low < FALL_HEIGHT_FRACTION * post.height)
 
 
@@ -476,7 +486,7 @@ def _track_wbc(
     from footfall.sim.quadruped.wbc import QuadrupedWbc
 
     m, d, mj = sim.model, sim.data, sim.mujoco
-    wbc = QuadrupedWbc(sim, rec.planned, rec.plan.posture.slope_normal, gains)
+    wbc = QuadrupedWbc(sim, rec.planned, rec.plan.ground, gains)
     substeps = max(1, round(control_dt / m.opt.timestep))
     frame_every = max(1, round(1.0 / (VIDEO_FPS * control_dt)))
     t_start = float(rec.t[0])
@@ -548,9 +558,10 @@ def simulate(
         from footfall.sim.quadruped.wbc import QuadrupedWbcGains, check_gains
 
         wbc_gains = QuadrupedWbcGains() if wbc_gains is None else check_gains(wbc_gains)
-    sim = QuadrupedSim(plan.robot, plan.posture.slope, settings)
     ref = plan.sample(control_dt)
-    sim.set_pose(ref.body_pos[0], ref.body_pitch, ref.joints[0])
+    x = ref.feet[:, :, 0]
+    sim = QuadrupedSim(plan.robot, plan.ground, settings, (float(x.min()) - 2, float(x.max()) + 2))
+    sim.set_pose(ref.body_pos[0], float(ref.body_pitch[0]), ref.joints[0])
     video = _Video(sim, video_path, video_size)
     rec = _Recorder(sim, plan, ref)
 
@@ -656,7 +667,8 @@ def summarise(plan: GaitPlan, res: Measured, fallen_at: float = math.nan) -> Qua
     ref = res.planned
     post = plan.posture
     prm = plan.params
-    u = post.slope_direction
+    # up the document's slope; along +x (the walking direction) on other grounds
+    u = post.slope_direction if prm.ground is None else np.array([1.0, 0.0, 0.0])
     along = res.trunk_pos @ u
     distance = float(along[-1] - along[0])
     duration = float(res.t[-1] - res.t[0])

@@ -38,6 +38,7 @@ from footfall.control.wbc import (
 )
 from footfall.errors import InputError, SolverError
 from footfall.quadruped.gait import GaitTrajectory
+from footfall.quadruped.ground import PlaneGround, QuadrupedGround
 from footfall.sim.wbc_model import MujocoWbcModel
 
 #: moment rows (mx, my) of the contact wrench: the horizontal moment about the ZMP
@@ -119,9 +120,14 @@ class _Reference:
             nxt = np.where(changed, ref.t[k + 1], nxt)
             self.to_switch[k] = nxt - ref.t[k]
         self.zmp = ref.zmp
-        c, s = math.cos(-ref.body_pitch), math.sin(-ref.body_pitch)
-        #: planned trunk orientation: nose-up pitch is a rotation about y by -pitch
-        self.rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+        #: planned trunk pitch (T,) [rad]
+        self.pitch = ref.body_pitch
+
+    def rot(self, k: int, w: float) -> FloatArray:
+        """Planned trunk orientation at (k, w): nose-up pitch is a rotation about y by -pitch."""
+        p = (1.0 - w) * self.pitch[k] + w * self.pitch[k + 1]
+        c, s = math.cos(-p), math.sin(-p)
+        return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
     def at(self, t: float) -> tuple[int, float]:
         """Sample index k and weight w of time ``t``: value = (1 - w) x[k] + w x[k + 1]."""
@@ -140,12 +146,12 @@ class QuadrupedWbc:
     Args:
         sim: the :class:`~footfall.sim.quadruped.sim.QuadrupedSim` (its actuators become motors).
         ref: the sampled gait plan.
-        normal: unit normal of the slope (3,).
+        ground: the ground walked (its normal at each contact).
         gains: task gains and weights.
     """
 
     def __init__(
-        self, sim: Any, ref: GaitTrajectory, normal: FloatArray, gains: QuadrupedWbcGains
+        self, sim: Any, ref: GaitTrajectory, ground: QuadrupedGround, gains: QuadrupedWbcGains
     ) -> None:
         mj, m = sim.mujoco, sim.model
         self.sim = sim
@@ -154,17 +160,9 @@ class QuadrupedWbc:
         self.ctrl = WholeBodyController()
         self.ref = _Reference(ref)
         self.gains = gains
-        self.normal = np.asarray(normal, dtype=float)
-        # Gravity's pull along the slope points at an edge of the friction pyramid (where it
-        # reaches Coulomb's cone, mu) rather than at a face (mu / sqrt(2)): the first face
-        # direction is the downhill direction turned 45 degrees about the normal.
-        down = np.array([0.0, 0.0, -1.0]) - self.normal * (-self.normal[2])
-        if np.linalg.norm(down) > 1e-9:
-            down /= np.linalg.norm(down)
-            side = np.cross(self.normal, down)
-            self.tangent: FloatArray | None = (down + side) / math.sqrt(2.0)
-        else:  # flat ground: no preferred direction
-            self.tangent = None
+        self.ground = ground
+        #: one normal and pyramid orientation for the whole walk on a plane (the common case)
+        self._plane = _surface(ground.normal(0.0, 0.0)) if isinstance(ground, PlaneGround) else None
         self.friction = float(m.geom_friction[sim.foot_geoms[0], 0])
         self.radius = float(m.geom_size[sim.foot_geoms[0], 0])
         self.foot_bodies = [int(m.site_bodyid[s]) for s in sim.foot_sites]
@@ -176,7 +174,6 @@ class QuadrupedWbc:
         self._select = np.zeros((self.joint_dofs.size, self.model.nv))
         self._select[np.arange(self.joint_dofs.size), self.joint_dofs] = 1.0
         self._no_drift = np.zeros(self.joint_dofs.size)
-        self._normal_force = np.concatenate([self.normal, np.zeros(3)]).reshape(1, 6)
         self.failures = 0
         self.last_tau = np.zeros(len(sim.actuators))
         #: the last solved problem and its solution (None before the first solve)
@@ -204,13 +201,14 @@ class QuadrupedWbc:
             centre = d.site_xpos[sim.foot_sites[leg]]
             early = touching[leg] and to_switch[leg] <= g.touchdown_window
             if stance[leg] or early:
-                pt = centre - self.radius * self.normal
+                normal, tangent, normal_force = self._plane or _surface(
+                    self.ground.normal(float(centre[0]), float(centre[1]))
+                )
+                pt = centre - self.radius * normal
                 jac, drift = self.model.frame(self.foot_bodies[leg], pt)
                 name = f"foot{leg}"
                 contacts.append(
-                    Contact.point(
-                        name, jac[:3], drift[:3], pt, self.normal, self.friction, 0.0, self.tangent
-                    )
+                    Contact.point(name, jac[:3], drift[:3], pt, normal, self.friction, 0.0, tangent)
                 )
                 points.append(pt)
                 if stance[leg] and g.unload_time > 0 and to_switch[leg] < g.unload_time:
@@ -219,7 +217,7 @@ class QuadrupedWbc:
                         WrenchTask(
                             f"unload{leg}",
                             pt,
-                            self._normal_force,
+                            normal_force,
                             np.zeros(1),
                             g.unload_weight * share,
                             (name,),
@@ -243,7 +241,7 @@ class QuadrupedWbc:
             - g.trunk_kd * (vel[:3] - _lerp(ref.body_v, k, w))
         )
         rot = d.xmat[sim.trunk].reshape(3, 3)
-        err = rotation_log(ref.rot @ rot.T)
+        err = rotation_log(ref.rot(k, w) @ rot.T)
         acc_ang = g.rot_kp * err - g.rot_kd * vel[3:]
         tasks.append(MotionTask("trunk", jac[:3], drift[:3], acc_lin, g.trunk_weight))
         tasks.append(MotionTask("trunk_rot", jac[3:], drift[3:], acc_ang, g.rot_weight))
@@ -280,6 +278,23 @@ class QuadrupedWbc:
         self.last_tau = sol.torque
         self.last_problem, self.last = problem, sol
         return np.asarray(sol.torque)
+
+
+def _surface(normal: FloatArray) -> tuple[FloatArray, FloatArray | None, FloatArray]:
+    """Contact normal (3,), friction pyramid orientation and the normal-force wrench row (1, 6).
+
+    Gravity's pull along a slope points at an edge of the friction pyramid (where it reaches
+    Coulomb's cone, mu) rather than at a face (mu / sqrt(2)): the first face direction is the
+    downhill direction turned 45 degrees about the normal (None on level ground: no preferred
+    direction).
+    """
+    n = np.asarray(normal, dtype=float)
+    down = np.array([0.0, 0.0, -1.0]) - n * (-n[2])
+    tangent = None
+    if np.linalg.norm(down) > 1e-9:
+        down /= np.linalg.norm(down)
+        tangent = (down + np.cross(n, down)) / math.sqrt(2.0)
+    return n, tangent, np.concatenate([n, np.zeros(3)]).reshape(1, 6)
 
 
 def check_gains(gains: object) -> QuadrupedWbcGains:
