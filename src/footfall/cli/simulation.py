@@ -3,8 +3,11 @@
 
 from __future__ import annotations
 
+import math
 import os
+from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import typer
 
@@ -52,18 +55,27 @@ def demo(out: Path = typer.Option(Path("out/demo"), help="Output folder.")) -> N
 # --- quadruped (document 001) ---
 @app.command("quadruped")
 def quadruped_cmd(
-    slope_deg: float = typer.Option(
-        15.0, help="Slope angle beta_S [deg]; negative walks downhill."
+    slope_deg: float | None = typer.Option(
+        None, help="Slope angle beta_S [deg]; negative walks downhill. [default: 15]"
     ),
-    body_deg: float = typer.Option(
-        10.0, help="Body angle beta_B to the horizontal [deg], between 0 and the slope."
+    body_deg: float | None = typer.Option(
+        None,
+        help="Body angle beta_B to the horizontal [deg], between 0 and the slope. [default: 10]",
     ),
-    step: float = typer.Option(0.4, help="Step length S along the slope [m]."),
-    height: float = typer.Option(0.1, help="Swing height H normal to the slope [m]."),
-    cycles: int = typer.Option(6, help="Number of gait cycles."),
-    swing_period: float = typer.Option(0.5, help="Swing period T_w [s]."),
-    shift_period: float = typer.Option(1.5, help="Duration of each body shift [s]."),
-    strategy: str = typer.Option("osp", help="ZMP placement: osp, incentre or transverse."),
+    step: float | None = typer.Option(None, help="Step length S along the slope [m]. [0.4]"),
+    height: float | None = typer.Option(None, help="Swing height H normal to the slope [m]. [0.1]"),
+    cycles: int | None = typer.Option(None, help="Number of gait cycles. [6]"),
+    swing_period: float | None = typer.Option(None, help="Swing period T_w [s]. [0.5]"),
+    shift_period: float | None = typer.Option(None, help="Duration of each body shift [s]. [1.5]"),
+    strategy: str | None = typer.Option(
+        None, help="ZMP placement: osp, incentre or transverse. [osp]"
+    ),
+    scene: str | None = typer.Option(
+        None,
+        help="A quadruped scene: a built-in name (slope_15, downhill_20, side_slope, "
+        "varying_slope, stairs_10cm) or a YAML file (schema: terrain/SCHEMA.md). Its ground, "
+        "gait and friction replace the options above; --cycles may still shorten it.",
+    ),
     compare: bool = typer.Option(False, help="Also run the other strategies (body sway table)."),
     out: Path = typer.Option("out/quadruped", help="Output folder."),
     video: bool = typer.Option(True, "--video/--no-video", help="Render an MP4 (offscreen GL)."),
@@ -73,19 +85,101 @@ def quadruped_cmd(
         "torques from the whole-body QP that puts the centre of pressure on the planned ZMP.",
     ),
 ) -> None:
-    """Walk gait up a slope (document 001): plan with ZMP/OSP, simulate in MuJoCo, measure."""
-    import math
-
+    """Walk gait up a slope (document 001) or over a scene's ground: plan with ZMP/OSP, simulate
+    in MuJoCo, measure."""
     if video:
         # must be chosen before MuJoCo is imported; EGL works headless here
         os.environ.setdefault("MUJOCO_GL", "egl")
     from footfall.experiments.slope_walk import compare_strategies, plan_strategies
-    from footfall.quadruped import GaitParams, QuadrupedRobot, ZmpStrategy
+    from footfall.quadruped import QuadrupedRobot
+    from footfall.sim.quadruped.mjcf import SimSettings
     from footfall.sim.quadruped.sim import simulate
     from footfall.viz.quadruped_plots import save_walk_figures
 
     if controller not in ("servo", "wbc"):
         raise InputError("--controller", controller, "servo or wbc")
+    options = {
+        "--slope-deg": slope_deg,
+        "--body-deg": body_deg,
+        "--step": step,
+        "--height": height,
+        "--swing-period": swing_period,
+        "--shift-period": shift_period,
+        "--strategy": strategy,
+    }
+    settings = None
+    if scene is not None:
+        from footfall.quadruped.scene import resolve_quadruped_scene
+
+        given = [name for name, v in options.items() if v is not None]
+        if given:
+            raise InputError(given[0], options[given[0]], "no gait option with --scene")
+        sc = resolve_quadruped_scene(scene)
+        params = sc.params
+        if cycles is not None:
+            params = replace(params, cycles=cycles)
+        if sc.friction is not None:
+            settings = SimSettings(friction=sc.friction)
+        label = sc.name
+    else:
+        params = _slope_params(
+            15.0 if slope_deg is None else slope_deg,
+            10.0 if body_deg is None else body_deg,
+            (step, height, cycles, swing_period, shift_period),
+            "osp" if strategy is None else strategy,
+        )
+        label = f"{math.degrees(params.slope):g}°/{math.degrees(params.body_pitch):g}°"
+    output_folder(out)
+    plans, infeasible = plan_strategies(QuadrupedRobot(), params, compare)
+    plan = plans[params.strategy]
+    console.print(f"simulating {params.cycles} cycles on {label} ({plan.duration:.1f} s)...")
+    res = simulate(
+        plan,
+        settings,
+        video_path=out / "quadruped.mp4" if video else None,
+        controller=controller,
+    )
+    if video and res.video is None:
+        console.print(res.video_note)
+    payload = res.metrics.to_dict()
+    payload["controller"] = {"name": controller, "qp_failures": res.qp_failures}
+    if scene is not None:
+        payload["scene"] = scene
+    if compare:
+        payload["strategy_comparison"] = compare_strategies(plans, res)
+        payload["strategy_comparison_infeasible"] = infeasible
+    figs = save_walk_figures(plan, res, out, label)
+    payload["figures"] = [str(f) for f in figs]
+    write_json(out / "quadruped.json", payload)
+    m = res.metrics
+    margin = (
+        f"margin min {m.stability_margin_min_m:.3f} m mean {m.stability_margin_mean_m:.3f} m"
+        if m.stability_margin_min_m is not None and m.stability_margin_mean_m is not None
+        else "no stance sample with three loaded feet"
+    )
+    console.print(
+        f"distance {m.distance_up_slope_m:.2f} m, speed {m.mean_speed_m_s:.3f} m/s, "
+        f"fell {m.fell}, {margin}, {m.realtime_factor:.0f}x real time"
+    )
+    if m.zmp_error_mean_m is not None and m.zmp_error_max_m is not None:
+        console.print(
+            f"{controller}: centre of pressure vs planned ZMP: mean "
+            f"{100 * m.zmp_error_mean_m:.1f} cm, max {100 * m.zmp_error_max_m:.1f} cm"
+        )
+    console.print(f"wrote {out / 'quadruped.json'}")
+    if m.fell:
+        raise typer.Exit(1)
+
+
+def _slope_params(
+    slope_deg: float,
+    body_deg: float,
+    gait: tuple[float | None, float | None, int | None, float | None, float | None],
+    strategy: str,
+) -> Any:
+    """GaitParams of the document's slope from the CLI options (errors name the option)."""
+    from footfall.quadruped import GaitParams, ZmpStrategy
+
     if not math.isfinite(slope_deg) or not -60.0 <= slope_deg <= 60.0:
         raise InputError("--slope-deg", slope_deg, "a slope in [-60, 60] deg (negative: downhill)")
     lo, hi = min(0.0, slope_deg), max(0.0, slope_deg)
@@ -97,43 +191,18 @@ def quadruped_cmd(
         strat = ZmpStrategy(strategy)
     except ValueError:
         raise InputError("--strategy", strategy, "one of osp, incentre, transverse") from None
+    step, height, cycles, swing_period, shift_period = gait
     params = GaitParams(
-        slope=math.radians(slope_deg),
-        body_pitch=math.radians(body_deg),
-        step=step,
-        swing_height=height,
-        swing_period=swing_period,
-        shift_period=shift_period,
-        cycles=cycles,
-        strategy=strat,
+        slope=math.radians(slope_deg), body_pitch=math.radians(body_deg), strategy=strat
     )
-    output_folder(out)
-    plans, infeasible = plan_strategies(QuadrupedRobot(), params, compare)
-    plan = plans[strat]
-    console.print(f"simulating {cycles} cycles on {slope_deg:g} deg ({plan.duration:.1f} s)...")
-    res = simulate(plan, video_path=out / "quadruped.mp4" if video else None, controller=controller)
-    if video and res.video is None:
-        console.print(res.video_note)
-    payload = res.metrics.to_dict()
-    payload["controller"] = {"name": controller, "qp_failures": res.qp_failures}
-    if compare:
-        payload["strategy_comparison"] = compare_strategies(plans, res)
-        payload["strategy_comparison_infeasible"] = infeasible
-    figs = save_walk_figures(plan, res, out, f"{slope_deg:g}°/{body_deg:g}°")
-    payload["figures"] = [str(f) for f in figs]
-    write_json(out / "quadruped.json", payload)
-    m = res.metrics
-    console.print(
-        f"distance {m.distance_up_slope_m:.2f} m, speed {m.mean_speed_m_s:.3f} m/s, "
-        f"fell {m.fell}, margin min {m.stability_margin_min_m:.3f} m "
-        f"mean {m.stability_margin_mean_m:.3f} m, {m.realtime_factor:.0f}x real time"
-    )
-    if m.zmp_error_mean_m is not None and m.zmp_error_max_m is not None:
-        console.print(
-            f"{controller}: centre of pressure vs planned ZMP: mean "
-            f"{100 * m.zmp_error_mean_m:.1f} cm, max {100 * m.zmp_error_max_m:.1f} cm"
-        )
-    console.print(f"wrote {out / 'quadruped.json'}")
+    given: dict[str, Any] = {
+        "step": step,
+        "swing_height": height,
+        "cycles": cycles,
+        "swing_period": swing_period,
+        "shift_period": shift_period,
+    }
+    return replace(params, **{k: v for k, v in given.items() if v is not None})
 
 
 @app.command("simulate")

@@ -13,7 +13,7 @@ import stat
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, TypeVar
 
 import numpy as np
 import yaml
@@ -174,12 +174,17 @@ Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Vec4 = Annotated[list[float], Field(min_length=4, max_length=4)]
 
 
-class _Spec(BaseModel):
-    # strict: no "0.5" strings or booleans for numbers; no NaN/inf; unknown keys are typos.
+class StrictSpec(BaseModel):
+    """Base of YAML schemas: no "0.5" strings or booleans for numbers, no NaN/inf, and unknown
+    keys are refused (they are usually typos)."""
+
     model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
 
 
-class _RobotSpec(_Spec):
+ModelT = TypeVar("ModelT", bound=StrictSpec)
+
+
+class _RobotSpec(StrictSpec):
     mass: float | None = None
     com_height: float | None = None
     t_ss: float | None = None
@@ -196,7 +201,7 @@ class _RobotSpec(_Spec):
     g: float | None = None
 
 
-class _StartSpec(_Spec):
+class _StartSpec(StrictSpec):
     left: Vec3
     right: Vec3
     heading: float | None = None
@@ -205,13 +210,13 @@ class _StartSpec(_Spec):
     alip_state: Vec4 | None = None
 
 
-class _GoalSpec(_Spec):
+class _GoalSpec(StrictSpec):
     position: Vec3
     heading: float | None = None
     heading_deg: float | None = None
 
 
-class _RegionSpec(_Spec):
+class _RegionSpec(StrictSpec):
     name: str
     vertices: Annotated[list[list[float]], Field(min_length=3)]
     normal: Vec3 | None = None
@@ -219,7 +224,7 @@ class _RegionSpec(_Spec):
     height: float | None = None
 
 
-class _SceneSpec(_Spec):
+class _SceneSpec(StrictSpec):
     name: str
     description: str = ""
     robot: _RobotSpec = Field(default_factory=_RobotSpec)
@@ -237,7 +242,7 @@ class _Missing:
         return "nothing (the field is missing)"
 
 
-class _Locator:
+class YamlLocator:
     """Maps a path in the document (keys and list indices) to a 1-based line number."""
 
     def __init__(self, root: yaml.Node | None, source: str | None) -> None:
@@ -287,7 +292,7 @@ def _split_field(fld: str) -> Path_:
     return tuple(fld.split("."))
 
 
-def _angle(loc: _Locator, path: Path_, rad: float | None, deg: float | None, name: str) -> float:
+def _angle(loc: YamlLocator, path: Path_, rad: float | None, deg: float | None, name: str) -> float:
     if rad is not None and deg is not None:
         raise loc.error(
             (*path, f"{name}_deg"), deg, f"only one of {name} [rad] or {name}_deg [deg]"
@@ -297,7 +302,7 @@ def _angle(loc: _Locator, path: Path_, rad: float | None, deg: float | None, nam
     return float(rad) if rad is not None else math.radians(float(deg))  # type: ignore[arg-type]
 
 
-def _build_robot(spec: _RobotSpec, loc: _Locator) -> BipedParams:
+def _build_robot(spec: _RobotSpec, loc: YamlLocator) -> BipedParams:
     kw: dict[str, Any] = {}
     for name in spec.model_fields_set:
         value = getattr(spec, name)
@@ -322,7 +327,7 @@ def _build_robot(spec: _RobotSpec, loc: _Locator) -> BipedParams:
         raise loc.error(path, e.value, e.expected) from None
 
 
-def _build_region(i: int, spec: _RegionSpec, loc: _Locator) -> Region:
+def _build_region(i: int, spec: _RegionSpec, loc: YamlLocator) -> Region:
     here: Path_ = ("regions", i)
     dims = 2 if (spec.normal is not None or spec.height is not None) else 3
     form = {2: "[x, y] (with normal/offset or height)", 3: "[x, y, z] (no normal or height)"}[dims]
@@ -353,7 +358,7 @@ def _build_region(i: int, spec: _RegionSpec, loc: _Locator) -> Region:
         raise loc.error(path, e.value, f"{e.expected} [region {spec.name!r}]") from None
 
 
-def _build_scene(spec: _SceneSpec, loc: _Locator) -> Scene:
+def _build_scene(spec: _SceneSpec, loc: YamlLocator) -> Scene:
     robot = _build_robot(spec.robot, loc)
     names: dict[str, int] = {}
     for i, r in enumerate(spec.regions):
@@ -383,7 +388,7 @@ def _build_scene(spec: _SceneSpec, loc: _Locator) -> Scene:
         raise loc.error(_split_field(e.field), e.value, e.expected) from None
 
 
-def _pydantic_error(err: ValidationError, loc: _Locator) -> SceneError:
+def _pydantic_error(err: ValidationError, loc: YamlLocator) -> SceneError:
     errors = err.errors()
     first = errors[0]
     path: Path_ = tuple(k for k in first["loc"] if isinstance(k, str | int))
@@ -461,14 +466,15 @@ def _check_expanded_size(root: yaml.Node | None, source: str | None) -> None:
             )
 
 
-def load_scene(path_or_text: str | Path) -> Scene:
-    """Load and validate a scene from a YAML file path or YAML text.
+def read_yaml(path_or_text: str | Path) -> tuple[Any, YamlLocator]:
+    """Parse a YAML file path or YAML text safely (no Python objects, bounded size and alias
+    expansion): the data and a locator naming fields with their lines.
 
     A ``str`` is a path when it has no newline and names an existing file or ends in ``.yaml`` /
     ``.yml``; otherwise it is YAML text.
 
     Raises:
-        SceneError: naming the field path and the line, e.g. ``start.left (line 12 of a.yaml)``.
+        SceneError: for an unreadable or oversized file, or invalid YAML (with its line).
     """
     if not isinstance(path_or_text, str | Path):
         raise SceneError(
@@ -498,18 +504,34 @@ def load_scene(path_or_text: str | Path) -> Scene:
         lines = text.splitlines()
         shown = lines[mark.line] if mark and mark.line < len(lines) else None  # past the end: EOF
         raise SceneError(f"yaml{where}", shown, f"valid YAML ({problem})") from None
-    loc = _Locator(root, source)
+    return data, YamlLocator(root, source)
+
+
+def validate_yaml(spec: type[ModelT], data: Any, loc: YamlLocator) -> ModelT:
+    """``data`` validated against the strict schema ``spec`` (errors name the field and line)."""
+    try:
+        return spec.model_validate(data)
+    except ValidationError as e:
+        raise _pydantic_error(e, loc) from None
+
+
+def load_scene(path_or_text: str | Path) -> Scene:
+    """Load and validate a scene from a YAML file path or YAML text.
+
+    A ``str`` is a path when it has no newline and names an existing file or ends in ``.yaml`` /
+    ``.yml``; otherwise it is YAML text.
+
+    Raises:
+        SceneError: naming the field path and the line, e.g. ``start.left (line 12 of a.yaml)``.
+    """
+    data, loc = read_yaml(path_or_text)
     if not isinstance(data, dict):
         raise loc.error((), type(data).__name__, "a mapping with name, start, goal and regions")
     regions = data.get("regions")
     # refused before any work per region
     if isinstance(regions, list) and len(regions) > MAX_REGIONS:
         raise loc.error(("regions",), f"{len(regions)} regions", f"1..{MAX_REGIONS} regions")
-    try:
-        spec = _SceneSpec.model_validate(data)
-    except ValidationError as e:
-        raise _pydantic_error(e, loc) from None
-    return _build_scene(spec, loc)
+    return _build_scene(validate_yaml(_SceneSpec, data, loc), loc)
 
 
 # ============================================================================= YAML writing
