@@ -106,15 +106,20 @@ def _ground(spec: _GroundSpec, loc: YamlLocator) -> tuple[QuadrupedGround | None
             f"no such field for a {spec.kind} ground (it takes "
             f"{', '.join(sorted(_GROUND_KEYS[spec.kind]))})",
         )
+    if spec.kind == "varying" and spec.knots is None:
+        raise loc.error(("ground", "knots"), None, "[[x, slope_deg], ...] (>= 2 knots)")
     try:
         if spec.kind == "plane":
+            for key in ("slope_deg", "side_slope_deg"):
+                deg = getattr(spec, key)
+                if deg is not None and not -60.0 <= deg <= 60.0:
+                    raise loc.error(("ground", key), deg, "an inclination in [-60, 60] deg")
             slope = math.radians(spec.slope_deg or 0.0)
             side = math.radians(spec.side_slope_deg or 0.0)
             PlaneGround(slope, side)
             return None, slope, side
         if spec.kind == "varying":
-            if spec.knots is None:
-                raise loc.error(("ground", "knots"), None, "[[x, slope_deg], ...] (>= 2 knots)")
+            assert spec.knots is not None
             xs = tuple(k[0] for k in spec.knots)
             slopes = tuple(math.radians(k[1]) for k in spec.knots)
             return VaryingSlope(xs, slopes), 0.0, 0.0
@@ -126,9 +131,19 @@ def _ground(spec: _GroundSpec, loc: YamlLocator) -> tuple[QuadrupedGround | None
         if spec.start is not None:
             given["start_x"] = spec.start
         return Stairs(**given), 0.0, 0.0
+    except SceneError:
+        raise
     except InputError as e:
-        fld = "start" if e.field == "start_x" else e.field.split("[")[0]
-        raise loc.error(("ground", fld), e.value, e.expected) from None
+        raise loc.error(_ground_path(e.field), e.value, e.expected) from None
+
+
+def _ground_path(fld: str) -> tuple[str | int, ...]:
+    """The YAML path of a ground's field: ``knots_x[2]`` is ``ground.knots[2]``."""
+    if fld.startswith("knots"):
+        index = fld[fld.index("[") + 1 : -1] if "[" in fld else None
+        return ("ground", "knots") if index is None else ("ground", "knots", int(index))
+    yaml_name = {"start_x": "start", "slope": "slope_deg", "side_slope": "side_slope_deg"}
+    return ("ground", yaml_name.get(fld, fld))
 
 
 def _params(spec: _QuadrupedSceneSpec, loc: YamlLocator) -> GaitParams:
@@ -158,7 +173,11 @@ def _params(spec: _QuadrupedSceneSpec, loc: YamlLocator) -> GaitParams:
     except InputError as e:
         section = "ground" if e.field in ("slope", "side_slope") else "gait"
         fld = {"body_pitch": "body_deg", "slope": "slope_deg", "side_slope": "side_slope_deg"}
-        raise loc.error((section, fld.get(e.field, e.field)), e.value, e.expected) from None
+        value = g.body_deg if e.field == "body_pitch" else e.value
+        expected = e.expected
+        if e.field == "body_pitch":
+            expected = f"a body angle in degrees between 0 and the slope ({e.expected})"
+        raise loc.error((section, fld.get(e.field, e.field)), value, expected) from None
 
 
 def load_quadruped_scene(path_or_text: str | Path) -> QuadrupedScene:
