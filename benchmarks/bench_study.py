@@ -64,7 +64,9 @@ def main() -> None:
         same = [{k: v for k, v in r.items() if k not in RUN_DEPENDENT} for r in rows] == [
             {k: v for k, v in r.items() if k not in RUN_DEPENDENT} for r in base_rows
         ]
-        print(f"{key[0]} x{key[1]}: {rate / base_rate:.2f}x local x1; rows equal to local x1: {same}")
+        print(
+            f"{key[0]} x{key[1]}: {rate / base_rate:.2f}x local x1; rows equal to local x1: {same}"
+        )
 
 
 if __name__ == "__main__":
