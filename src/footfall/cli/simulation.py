@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import replace
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
@@ -84,6 +84,14 @@ def quadruped_cmd(
         help="servo: the document's joint position servos on the planned angles; wbc: joint "
         "torques from the whole-body QP that puts the centre of pressure on the planned ZMP.",
     ),
+    on_slip: str = typer.Option(
+        "off",
+        help="Slip guard: off, or stop (when a foot slides more than --slip-limit in one stance, "
+        "finish the current swing or shift, then hold the four-foot stance).",
+    ),
+    slip_limit: float = typer.Option(
+        0.03, help="Slip guard limit: a foot's sliding in one stance [m]."
+    ),
 ) -> None:
     """Walk gait up a slope (document 001) or over a scene's ground: plan with ZMP/OSP, simulate
     in MuJoCo, measure."""
@@ -94,10 +102,16 @@ def quadruped_cmd(
     from footfall.quadruped import QuadrupedRobot
     from footfall.sim.quadruped.mjcf import SimSettings
     from footfall.sim.quadruped.sim import simulate
+    from footfall.sim.quadruped.slip import SLIP_ACTIONS, SlipGuard
     from footfall.viz.quadruped_plots import save_walk_figures
 
     if controller not in ("servo", "wbc"):
         raise InputError("--controller", controller, "servo or wbc")
+    if on_slip not in ("off", *SLIP_ACTIONS):
+        raise InputError("--on-slip", on_slip, f"one of off, {', '.join(SLIP_ACTIONS)}")
+    if not math.isfinite(slip_limit) or slip_limit <= 0.0:
+        raise InputError("--slip-limit", slip_limit, "a finite distance > 0 [m]")
+    guard = SlipGuard(slip_limit, on_slip) if on_slip != "off" else None
     options = {
         "--slope-deg": slope_deg,
         "--body-deg": body_deg,
@@ -138,11 +152,17 @@ def quadruped_cmd(
         settings,
         video_path=out / "quadruped.mp4" if video else None,
         controller=controller,
+        slip_guard=guard,
     )
     if video and res.video is None:
         console.print(res.video_note)
     payload = res.metrics.to_dict()
     payload["controller"] = {"name": controller, "qp_failures": res.qp_failures}
+    payload["slip_guard"] = {
+        "on_slip": on_slip,
+        "limit_m": slip_limit,
+        "stop": asdict(res.slip_stop) if res.slip_stop is not None else None,
+    }
     if scene is not None:
         payload["scene"] = scene
     if compare:
@@ -165,6 +185,16 @@ def quadruped_cmd(
         console.print(
             f"{controller}: centre of pressure vs planned ZMP: mean "
             f"{100 * m.zmp_error_mean_m:.1f} cm, max {100 * m.zmp_error_max_m:.1f} cm"
+        )
+    console.print(
+        f"slip per stance: max {100 * m.foot_slip_max_m:.1f} cm, mean "
+        f"{100 * m.foot_slip_mean_m:.1f} cm over {len(m.stance_slips)} stances"
+    )
+    if res.slip_stop is not None:
+        st = res.slip_stop
+        console.print(
+            f"slip guard: {st.leg} slid {100 * st.slip_m:.1f} cm at {st.time_s:.2f} s; "
+            f"holding four feet from {st.hold_time_s:.2f} s"
         )
     console.print(f"wrote {out / 'quadruped.json'}")
     if m.fell:

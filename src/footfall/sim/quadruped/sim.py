@@ -9,7 +9,6 @@ trajectory. Planned quantities are only used to compute tracking errors.
 
 from __future__ import annotations
 
-import itertools
 import math
 import time
 from collections.abc import Callable
@@ -30,6 +29,15 @@ from footfall.quadruped.stability import centre_of_pressure, stability_margin, s
 from footfall.sim.pushes import Push
 from footfall.sim.quadruped import names as nm
 from footfall.sim.quadruped.mjcf import SimSettings, ground_scene
+from footfall.sim.quadruped.slip import (
+    SlipGuard,
+    SlipMonitor,
+    SlipStop,
+    StanceSlip,
+    check_guard,
+    downhill,
+    stance_slips,
+)
 
 #: a foot counts as in contact when it carries more than this fraction of the robot's weight
 CONTACT_FORCE_FRACTION = 0.01
@@ -104,7 +112,8 @@ class QuadrupedMetrics:
     planned_margin_min_m: float
     """Smallest planned stability margin [m]."""
     planned_margin_min_three_leg_m: float
-    """Smallest planned margin with exactly three planned contacts [m]."""
+    """Smallest planned margin with exactly three planned contacts [m] (NaN without such a
+    sample: the slip guard stopped the gait before the first swing)."""
     stance_samples: int
     """Number of samples where the plan has three or more feet down."""
     stance_samples_with_fewer_than_3_contacts: int
@@ -119,6 +128,8 @@ class QuadrupedMetrics:
     """Mean sliding displacement of a foot over one planned stance [m]."""
     foot_backward_slip_total_m: float
     """Total sliding of the feet down the slope, summed over stances [m]."""
+    stance_slips: tuple[StanceSlip, ...]
+    """Sliding of every foot over each of its planned stances, ordered by start time."""
     trunk_drift_from_plan_m: float
     """Distance of the final trunk position from the planned final body position [m]."""
     body_sway_measured: BodySway
@@ -183,7 +194,8 @@ class SimResult:
         slip_vel: tangential velocity of each foot's material point at its ground contact,
             shape (T, 4, 3) [m/s] (zero when the foot is off the ground). A rolling sphere has
             none, so this is true sliding, not the rolling of the spherical foot.
-        planned: the planned references at the same instants.
+        planned: the commanded references at the same instants: the plan, held on four feet
+            from the slip guard's stop on (:mod:`.slip`; the plan itself without a stop).
         metrics: summary numbers (see :func:`summarise`).
         wall_time: wall-clock time of the physics + control loop [s] (video excluded).
         sim_time: simulated time [s].
@@ -191,6 +203,7 @@ class SimResult:
         video_note: why there is no video, if there is none.
         controller: ``servo`` or ``wbc`` (see :func:`simulate`).
         qp_failures: physics steps whose whole-body QP failed (``wbc``; the last torques held).
+        slip_stop: when and why the slip guard stopped the gait, None when it did not.
     """
 
     t: FloatArray
@@ -209,6 +222,7 @@ class SimResult:
     video_note: str = ""
     controller: str = "servo"
     qp_failures: int = 0
+    slip_stop: SlipStop | None = None
 
 
 def _pitch_of(xmat: FloatArray) -> float:
@@ -447,14 +461,16 @@ def _track(
     control_dt: float,
     progress: Callable[[float], None] | None,
     pushes: tuple[Push, ...] = (),
+    guard: SlipMonitor | None = None,
 ) -> None:
-    """Track the planned joint angles sample by sample, measuring after each control period."""
+    """Track the planned joint angles sample by sample, measuring after each control period
+    (``guard``: the slip guard, which may hold the reference, ``rec.planned``, still)."""
     m, d, mj = sim.model, sim.data, sim.mujoco
-    joints = rec.planned.joints
     substeps = max(1, round(control_dt / m.opt.timestep))
     frame_every = max(1, round(1.0 / (VIDEO_FPS * control_dt)))
-    n = joints.shape[0]
+    n = rec.planned.joints.shape[0]
     for k in range(n):
+        joints = rec.planned.joints
         q0 = joints[k]
         q1 = joints[min(k + 1, n - 1)]
         # joint targets interpolated linearly between plan samples at every physics step
@@ -464,6 +480,8 @@ def _track(
                 _push_force(sim, pushes, float(rec.t[0]) + (k * substeps + s) * m.opt.timestep)
             mj.mj_step(m, d)
         rec.measure(k)
+        if guard is not None and guard.update(k, rec.slip_vel[k]):
+            rec.planned = guard.reference
         if k % frame_every == 0:
             video.frame(d)
         if progress is not None and k % 200 == 0:
@@ -479,6 +497,7 @@ def _track_wbc(
     gains: Any,
     settle_time: float,
     pushes: tuple[Push, ...] = (),
+    guard: SlipMonitor | None = None,
 ) -> None:
     """Drive every joint by torque from the whole-body QP (:mod:`.wbc`) at every physics step,
     measuring after each control period; it also holds the first reference while the robot
@@ -507,6 +526,9 @@ def _track_wbc(
                 _push_force(sim, pushes, t_start + i * m.opt.timestep)
             mj.mj_step2(m, d)
         rec.measure(k)
+        if guard is not None and guard.update(k, rec.slip_vel[k]):
+            rec.planned = guard.reference
+            wbc.retarget(rec.planned)
         if k % frame_every == 0:
             video.frame(d)
         if progress is not None and k % 200 == 0:
@@ -525,6 +547,7 @@ def simulate(
     controller: str = "servo",
     wbc_gains: Any = None,
     pushes: tuple[Push, ...] = (),
+    slip_guard: SlipGuard | None = None,
 ) -> SimResult:
     """Simulate ``plan`` in MuJoCo and measure it.
 
@@ -533,6 +556,8 @@ def simulate(
     ZMP, :mod:`footfall.sim.quadruped.wbc`); ``wbc_gains`` its
     :class:`~footfall.sim.quadruped.wbc.QuadrupedWbcGains` (None: the defaults). ``pushes``:
     forces on the trunk (:class:`~footfall.sim.pushes.Push`, times since the gait started).
+    ``slip_guard``: stop the gait when a foot slips (:class:`~footfall.sim.quadruped.slip.SlipGuard`;
+    None: off); the run keeps its planned length, holding still after a stop.
 
     Args:
         plan: the gait plan (its slope defines the scene).
@@ -554,6 +579,7 @@ def simulate(
             raise InputError(f"pushes[{i}]", p, "a footfall.sim.Push")
     if controller not in CONTROLLERS:
         raise InputError("controller", controller, f"one of {', '.join(CONTROLLERS)}")
+    slip_guard = check_guard(slip_guard)
     if controller == "wbc":
         from footfall.sim.quadruped.wbc import QuadrupedWbcGains, check_gains
 
@@ -564,15 +590,16 @@ def simulate(
     sim.set_pose(ref.body_pos[0], float(ref.body_pitch[0]), ref.joints[0])
     video = _Video(sim, video_path, video_size)
     rec = _Recorder(sim, plan, ref)
+    guard = SlipMonitor(slip_guard, plan, ref) if slip_guard is not None else None
 
     wall0 = time.perf_counter()
     if controller == "wbc":
-        _track_wbc(sim, rec, video, control_dt, progress, wbc_gains, settle_time, pushes)
+        _track_wbc(sim, rec, video, control_dt, progress, wbc_gains, settle_time, pushes, guard)
     else:
         # settle in the initial pose so the legs take the weight before the gait starts
         for _ in range(round(settle_time / sim.model.opt.timestep)):
             sim.mujoco.mj_step(sim.model, sim.data)
-        _track(sim, rec, video, control_dt, progress, pushes)
+        _track(sim, rec, video, control_dt, progress, pushes, guard)
     rec.wall_time = time.perf_counter() - wall0 - video.render_time
     rec.video = video.close()
     rec.video_note = video.note
@@ -586,7 +613,7 @@ def simulate(
         n_contacts=rec.n_contacts,
         feet=rec.feet,
         slip_vel=rec.slip_vel,
-        planned=ref,
+        planned=rec.planned,
         metrics=summarise(plan, rec, rec.fallen_at),
         wall_time=rec.wall_time,
         sim_time=rec.sim_time,
@@ -594,6 +621,7 @@ def simulate(
         video_note=rec.video_note,
         controller=controller,
         qp_failures=rec.qp_failures,
+        slip_stop=guard.stop if guard is not None else None,
     )
 
 
@@ -635,26 +663,19 @@ def _last_swing_end(plan: GaitPlan) -> float:
     return max(p.t1 for p in plan.phases if p.kind is PhaseKind.SWING)
 
 
-def _foot_slips(res: Measured, u: FloatArray) -> tuple[list[float], list[float]]:
-    """Sliding displacement of each foot over each planned stance, and its part down ``u`` [m].
+def _foot_slips(
+    plan: GaitPlan, res: Measured, u: FloatArray
+) -> tuple[list[StanceSlip], list[float], list[float]]:
+    """Each foot's sliding over each planned stance (:func:`.slip.stance_slips`), the lengths of
+    those displacements and their parts against ``u`` [m].
 
     The displacement is the integral of the contact point's sliding velocity over the stance.
     """
-    contact = res.planned.contact
-    dt = float(res.t[1] - res.t[0])
-    slips: list[float] = []
-    backward: list[float] = []
-    for i in range(4):
-        c = contact[:, i]
-        edges = np.flatnonzero(np.diff(c.astype(int)) != 0) + 1
-        bounds = np.concatenate([[0], edges, [c.size]])
-        for a, b in itertools.pairwise(bounds):
-            if not c[a]:
-                continue
-            disp = res.slip_vel[a:b, i].sum(axis=0) * dt
-            slips.append(float(np.linalg.norm(disp)))
-            backward.append(float(-min(0.0, disp @ u)))
-    return slips, backward
+    down = downhill(plan, res.planned.feet)
+    per_stance = stance_slips(res.t, res.planned.contact, res.slip_vel, down)
+    slips = [s.slip_m for s in per_stance]
+    backward = [-min(0.0, float(np.dot(s.displacement_m, u))) for s in per_stance]
+    return per_stance, slips, backward
 
 
 def _min_mean(x: FloatArray) -> tuple[float | None, float | None]:
@@ -679,7 +700,7 @@ def summarise(plan: GaitPlan, res: Measured, fallen_at: float = math.nan) -> Qua
     m_min, m_mean = _min_mean(res.margin[measured_ok])
     m3_min, m3_mean = _min_mean(res.margin[measured_ok & three])
     err_ok = np.linalg.norm(res.cop - ref.zmp, axis=1)[measured_ok]
-    slips, backward = _foot_slips(res, u)
+    per_stance, slips, backward = _foot_slips(plan, res, u)
     fell = not math.isnan(fallen_at)
     return QuadrupedMetrics(
         slope_deg=math.degrees(post.slope),
@@ -701,7 +722,9 @@ def summarise(plan: GaitPlan, res: Measured, fallen_at: float = math.nan) -> Qua
         stability_margin_min_three_leg_m=m3_min,
         stability_margin_mean_three_leg_m=m3_mean,
         planned_margin_min_m=float(np.nanmin(ref.margin)),
-        planned_margin_min_three_leg_m=float(np.nanmin(ref.margin[three])),
+        planned_margin_min_three_leg_m=float(np.nanmin(ref.margin[three]))
+        if three.any()
+        else math.nan,
         stance_samples=int(stance.sum()),
         stance_samples_with_fewer_than_3_contacts=int((stance & (res.n_contacts < 3)).sum()),
         zmp_error_mean_m=float(err_ok.mean()) if err_ok.size else None,
@@ -709,6 +732,7 @@ def summarise(plan: GaitPlan, res: Measured, fallen_at: float = math.nan) -> Qua
         foot_slip_max_m=max(slips) if slips else 0.0,
         foot_slip_mean_m=float(np.mean(slips)) if slips else 0.0,
         foot_backward_slip_total_m=float(np.sum(backward)) if backward else 0.0,
+        stance_slips=tuple(per_stance),
         trunk_drift_from_plan_m=float(np.linalg.norm(res.trunk_pos[-1] - ref.body_pos[-1])),
         body_sway_measured=body_sway(plan, res.t, res.trunk_pos),
         body_sway_planned=body_sway(plan, ref.t, ref.body_pos),

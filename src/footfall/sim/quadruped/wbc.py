@@ -180,6 +180,10 @@ class QuadrupedWbc:
         self.last_problem: WbcProblem | None = None
         self.last: WbcSolution | None = None
 
+    def retarget(self, ref: GaitTrajectory) -> None:
+        """Track ``ref`` from now on (same sample times; the slip guard's held reference)."""
+        self.ref = _Reference(ref)
+
     def _touching(self) -> list[bool]:
         """Which feet touch the ground now (from the contacts of the last collision check)."""
         con = self.sim.data.contact
