@@ -64,7 +64,7 @@ def assemble(
     eps_qacc: float,
     eps_force: float,
     eps_torque: float,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, np.ndarray, bool]:
     """The QP of one tick.
 
     Shapes: ``mass`` (nv, nv), ``bias`` (nv,), ``actuated`` (na,), ``unactuated`` (nu,);
@@ -76,8 +76,11 @@ def assemble(
     ``wrench_about`` (rw, 3), ``wrench_target`` (rw,), ``wrench_w`` (rw,), ``wrench_mask``
     (rw, nc) (1: contact c's forces count).
 
-    Returns ``(H, g, C, lower, upper, n_eq, T)`` where ``T`` (na, n + 1) maps ``(x, 1)`` to the
-    joint torques: ``tau = T[:, :n] x + T[:, n]``.
+    Returns ``(H, g, C, lower, upper, n_eq, T, zero_row_value)`` where ``T`` (na, n + 1) maps
+    ``(x, 1)`` to the joint torques: ``tau = T[:, :n] x + T[:, n]``. Equality rows that are zero
+    (a point contact's angular rows, 0 = 0) are left out of ``C`` and ``n_eq``: they would make
+    the active set's system singular; ``zero_row_value`` is True when such a row has a non-zero
+    value (an infeasible problem).
     """
     nv = mass.shape[0]
     nc = jac.shape[0]
@@ -190,4 +193,33 @@ def assemble(
             for j in range(1, 5):
                 lower[row + j], upper[row + j] = -INFINITY, 0.0
             row += 5
-    return h_mat, g_vec, c_mat, lower, upper, n_eq, t_map
+    # drop the zero equality rows, moving the rows after them up in place
+    kept = 0
+    kept_eq = n_eq
+    zero_row_value = False
+    for r in range(m_rows):
+        if r < n_eq:
+            zero = True
+            for j in range(n):
+                if c_mat[r, j] != 0.0:
+                    zero = False
+                    break
+            if zero:
+                zero_row_value = zero_row_value or lower[r] != 0.0
+                kept_eq -= 1
+                continue
+        if kept != r:
+            c_mat[kept] = c_mat[r]
+            lower[kept] = lower[r]
+            upper[kept] = upper[r]
+        kept += 1
+    return (
+        h_mat,
+        g_vec,
+        c_mat[:kept],
+        lower[:kept],
+        upper[:kept],
+        kept_eq,
+        t_map,
+        zero_row_value,
+    )

@@ -277,18 +277,11 @@ class WholeBodyController:
         if check:
             _check_problem(p)
         packed = _pack(p)
-        h_mat, g_vec, c_mat, lower, upper, n_eq, t_map = assemble(*packed, *self.eps)  # type: ignore[call-arg]
+        assembled = assemble(*packed, *self.eps)  # type: ignore[call-arg]
+        h_mat, g_vec, c_mat, lower, upper, n_eq, t_map, zero_row_value = assembled
         n = h_mat.shape[0]
-        # equalities 0 = 0 (a point contact's angular rows) make the active set's system
-        # singular: drop them (a zero row with a non-zero side would be an infeasible problem)
-        eq = c_mat[:n_eq]
-        zero = ~np.any(eq != 0.0, axis=1)
-        if zero.any():
-            if np.any(lower[:n_eq][zero] != 0.0):
-                raise SolverError("whole-body QP: an equality row is zero but its value is not")
-            keep = np.concatenate([~zero, np.ones(c_mat.shape[0] - n_eq, dtype=bool)])
-            c_mat, lower, upper = c_mat[keep], lower[keep], upper[keep]
-            n_eq -= int(zero.sum())
+        if zero_row_value:
+            raise SolverError("whole-body QP: an equality row is zero but its value is not")
         senses = np.zeros(lower.shape[0], dtype=np.int32)
         senses[:n_eq] = 5
         key = (n, lower.shape[0])
@@ -300,7 +293,7 @@ class WholeBodyController:
             self.failures += 1
             raise SolverError(f"whole-body QP has no solution (daqp exit flag {flag})")
         x = np.asarray(x)
-        if not np.all(np.isfinite(x)):
+        if not np.isfinite(x).all():
             # only non-finite data (an unchecked problem) gets here: no solution to return
             self._warm = None
             self.failures += 1

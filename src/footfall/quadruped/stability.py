@@ -6,6 +6,10 @@ support polygons are returned counter-clockwise.
 
 from __future__ import annotations
 
+import itertools
+import math
+from collections.abc import Sequence
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -17,7 +21,7 @@ from footfall.models.lip import GRAVITY
 _GEOM_EPS = 1e-12
 
 
-def _cross(o: FloatArray, a: FloatArray, b: FloatArray) -> float:
+def _cross(o: Sequence[float], a: Sequence[float], b: Sequence[float]) -> float:
     return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
 
 
@@ -34,20 +38,22 @@ def support_polygon(points: ArrayLike) -> FloatArray:
     pts = np.asarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[0] == 0 or pts.shape[1] < 2:
         raise InputError("points", pts.shape, "an array of shape (N, 2) or (N, 3), N >= 1")
-    xy = pts[:, :2]
-    p = xy[np.lexsort((xy[:, 1], xy[:, 0]))]  # sorted by x then y (monotone chain)
-    if p.shape[0] > 1:  # drop duplicates, which would stall the chain
-        keep = np.ones(p.shape[0], dtype=bool)
-        keep[1:] = np.any(np.abs(np.diff(p, axis=0)) > _GEOM_EPS, axis=1)
-        p = p[keep]
-    if p.shape[0] <= 2:
-        return p
-    lower: list[FloatArray] = []
+    # a handful of points: Python floats are faster here than numpy's per-call overhead
+    xy = sorted(map(tuple, pts[:, :2].tolist()))  # by x then y (monotone chain)
+    # drop duplicates, which would stall the chain
+    p = xy[:1] + [
+        b
+        for a, b in itertools.pairwise(xy)
+        if abs(b[0] - a[0]) > _GEOM_EPS or abs(b[1] - a[1]) > _GEOM_EPS
+    ]
+    if len(p) <= 2:
+        return np.array(p)
+    lower: list[tuple[float, ...]] = []
     for pt in p:
         while len(lower) >= 2 and _cross(lower[-2], lower[-1], pt) <= _GEOM_EPS:
             lower.pop()
         lower.append(pt)
-    upper: list[FloatArray] = []
+    upper: list[tuple[float, ...]] = []
     for pt in p[::-1]:
         while len(upper) >= 2 and _cross(upper[-2], upper[-1], pt) <= _GEOM_EPS:
             upper.pop()
@@ -84,13 +90,17 @@ def stability_margin(zmp: ArrayLike, polygon: ArrayLike) -> float:
         return -float(np.linalg.norm(p - poly[0]))
     if k == 2:
         return -_point_segment_distance(p, poly[0], poly[1])
-    edges = np.roll(poly, -1, axis=0) - poly
-    lengths = np.linalg.norm(edges, axis=1)
-    # CCW polygon: the inward normal of edge (a -> b) is the edge rotated by +90 degrees.
-    normals = np.stack([-edges[:, 1], edges[:, 0]], axis=1) / lengths[:, None]
-    signed = np.einsum("ij,ij->i", p[None, :] - poly, normals)
-    if np.all(signed >= 0.0):
-        return float(signed.min())
+    # a handful of vertices: Python floats are faster here than numpy's per-call overhead
+    px, py = float(p[0]), float(p[1])
+    vs = poly.tolist()
+    signed = []
+    for (ax, ay), (bx, by) in zip(vs, vs[1:] + vs[:1], strict=True):
+        ex, ey = bx - ax, by - ay
+        length = math.sqrt(ex * ex + ey * ey)
+        # CCW polygon: the inward normal of edge (a -> b) is the edge rotated by +90 degrees.
+        signed.append((px - ax) * (-ey / length) + (py - ay) * (ex / length))
+    if min(signed) >= 0.0:
+        return float(min(signed))
     return -min(_point_segment_distance(p, poly[i], poly[(i + 1) % k]) for i in range(k))
 
 

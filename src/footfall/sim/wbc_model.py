@@ -78,17 +78,22 @@ class MujocoWbcModel:
             self.mj.mj_fullM(self.m, self.d, self._mass)
         else:  # MuJoCo < 3.5: mj_fullM(m, dst, qM)
             self.mj.mj_fullM(self.m, self._mass, self.d.qM)
-        return self._mass.copy(), np.array(self.d.qfrc_bias) - np.array(self.d.qfrc_passive)
+        return self._mass.copy(), self.d.qfrc_bias - self.d.qfrc_passive
 
-    def frame(self, body: int, point: FloatArray) -> tuple[FloatArray, FloatArray]:
+    def frame(
+        self, body: int, point: FloatArray, angular: bool = True
+    ) -> tuple[FloatArray, FloatArray]:
         """Jacobian (6, nv) of ``point`` (3,) [m] moving with ``body`` (linear rows, then
-        angular) and its drift ``Jdot qd`` (6,)."""
+        angular) and its drift ``Jdot qd`` (6,); with ``angular`` False only the linear rows,
+        (3, nv) and (3,)."""
         mj, m, d = self.mj, self.m, self.d
-        pt = np.asarray(point, dtype=float).reshape(3, 1)
-        jac = np.empty((6, self.nv))
-        mj.mj_jac(m, d, jac[:3], jac[3:], pt, body)
-        mj.mj_jacDot(m, d, self._jdot[:3], self._jdot[3:], pt, body)
-        return jac, self._jdot @ d.qvel
+        pt = np.asarray(point, dtype=float)
+        rows = 6 if angular else 3
+        jac = np.empty((rows, self.nv))
+        jdot = self._jdot[:rows]
+        mj.mj_jac(m, d, jac[:3], jac[3:] if angular else None, pt, body)
+        mj.mj_jacDot(m, d, jdot[:3], jdot[3:] if angular else None, pt, body)
+        return jac, jdot @ d.qvel
 
     def contact(
         self,

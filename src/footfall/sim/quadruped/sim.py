@@ -19,6 +19,7 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from footfall._geometry import cross3
 from footfall._typing import FloatArray
 from footfall._validate import positive
 from footfall.errors import FootfallError, InputError
@@ -290,7 +291,7 @@ class QuadrupedSim:
             self.model, self.data, self.mujoco.mjtObj.mjOBJ_GEOM, g, self._vel6, 0
         )
         w, v = self._vel6[:3], self._vel6[3:]
-        vp = v + np.cross(w, point - self.data.geom_xpos[g])
+        vp = v + cross3(w, point - self.data.geom_xpos[g])
         return vp - (vp @ normal) * normal
 
     def set_pose(self, body_pos: FloatArray, pitch_up: float, joints: FloatArray) -> None:

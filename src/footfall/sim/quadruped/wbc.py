@@ -96,6 +96,33 @@ class QuadrupedWbcGains:
             raise InputError("wbc_gains.qp_every", q, "an integer >= 1")
 
 
+@dataclass(frozen=True)
+class _Sample:
+    """The plan at one instant (:meth:`_Reference.sample`).
+
+    Attributes:
+        k, w: sample index and weight of the instant (:meth:`_Reference.at`).
+        body, body_v, body_a: trunk position (3,) [m], velocity [m/s], acceleration [m/s^2].
+        feet, feet_v, feet_a: foot centres (4, 3) [m], velocities, accelerations.
+        joints, joints_v: joint angles (12,) [rad] and rates [rad/s].
+        zmp: planned ZMP (2,) [m].
+        rot: planned trunk orientation (3, 3) (its pitch follows the ground's local plane).
+    """
+
+    k: int
+    w: float
+    body: FloatArray
+    body_v: FloatArray
+    body_a: FloatArray
+    feet: FloatArray
+    feet_v: FloatArray
+    feet_a: FloatArray
+    joints: FloatArray
+    joints_v: FloatArray
+    zmp: FloatArray
+    rot: FloatArray
+
+
 class _Reference:
     """The sampled plan with velocities and accelerations, interpolated linearly in time."""
 
@@ -103,14 +130,27 @@ class _Reference:
         self.t = ref.t
         dt = float(ref.t[1] - ref.t[0]) if ref.t.size > 1 else 1.0
         self.dt = dt
-        self.body = ref.body_pos
-        self.body_v = np.gradient(ref.body_pos, dt, axis=0)
-        self.body_a = np.gradient(self.body_v, dt, axis=0)
-        self.feet = ref.feet
-        self.feet_v = np.gradient(ref.feet, dt, axis=0)
-        self.feet_a = np.gradient(self.feet_v, dt, axis=0)
-        self.joints = ref.joints
-        self.joints_v = np.gradient(ref.joints, dt, axis=0)
+        body_v = np.gradient(ref.body_pos, dt, axis=0)
+        feet_v = np.gradient(ref.feet, dt, axis=0)
+        n = ref.t.size
+        # the interpolated quantities side by side (in _Sample's order), so that one
+        # interpolation per tick gives them all
+        columns = [
+            ref.body_pos,
+            body_v,
+            np.gradient(body_v, dt, axis=0),
+            ref.feet.reshape(n, -1),
+            feet_v.reshape(n, -1),
+            np.gradient(feet_v, dt, axis=0).reshape(n, -1),
+            ref.joints,
+            np.gradient(ref.joints, dt, axis=0),
+            ref.zmp,
+            ref.body_pitch[:, None],
+        ]
+        #: (T, 72) the columns above
+        self.table = np.hstack(columns)
+        ends = np.cumsum([c.shape[1] for c in columns]).tolist()
+        self._slices = [slice(a, b) for a, b in zip([0, *ends[:-1]], ends, strict=True)]
         self.contact = ref.contact
         #: (T, 4) time from each sample to the next change of each leg's planned contact [s]
         self.to_switch = np.full(ref.contact.shape, np.inf)
@@ -119,15 +159,6 @@ class _Reference:
             changed = ref.contact[k + 1] != ref.contact[k]
             nxt = np.where(changed, ref.t[k + 1], nxt)
             self.to_switch[k] = nxt - ref.t[k]
-        self.zmp = ref.zmp
-        #: planned trunk pitch (T,) [rad]
-        self.pitch = ref.body_pitch
-
-    def rot(self, k: int, w: float) -> FloatArray:
-        """Planned trunk orientation at (k, w): nose-up pitch is a rotation about y by -pitch."""
-        p = (1.0 - w) * self.pitch[k] + w * self.pitch[k + 1]
-        c, s = math.cos(-p), math.sin(-p)
-        return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
     def at(self, t: float) -> tuple[int, float]:
         """Sample index k and weight w of time ``t``: value = (1 - w) x[k] + w x[k + 1]."""
@@ -135,9 +166,29 @@ class _Reference:
         k = int(min(max(math.floor(u), 0), self.t.size - 2))
         return k, float(min(max(u - k, 0.0), 1.0))
 
-
-def _lerp(x: FloatArray, k: int, w: float) -> FloatArray:
-    return np.asarray((1.0 - w) * x[k] + w * x[k + 1])
+    def sample(self, t: float) -> _Sample:
+        """The plan at time ``t`` [s]."""
+        k, w = self.at(t)
+        row = (1.0 - w) * self.table[k] + w * self.table[k + 1]
+        body, body_v, body_a, feet, feet_v, feet_a, joints, joints_v, zmp, pitch = (
+            row[s] for s in self._slices
+        )
+        c, s = math.cos(-pitch[0]), math.sin(-pitch[0])
+        return _Sample(
+            k,
+            w,
+            body,
+            body_v,
+            body_a,
+            feet.reshape(4, 3),
+            feet_v.reshape(4, 3),
+            feet_a.reshape(4, 3),
+            joints,
+            joints_v,
+            zmp,
+            # nose-up pitch is a rotation about y by -pitch
+            np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]),
+        )
 
 
 class QuadrupedWbc:
@@ -188,33 +239,37 @@ class QuadrupedWbc:
         """Which feet touch the ground now (from the contacts of the last collision check)."""
         con = self.sim.data.contact
         geoms = np.asarray(con.geom)[np.asarray(con.dist) <= 0.0]  # within the margin: not yet
-        return [bool(np.any(geoms == g)) for g in self.sim.foot_geoms]
+        hit = set(geoms.ravel().tolist())
+        return [g in hit for g in self.sim.foot_geoms]
 
     def torques(self, t: float) -> FloatArray:
         """Joint torques (12,) [N m] at gait time ``t`` from the current state (positions and
         velocities; ``mj_step1`` has run)."""
         sim, d, g, ref = self.sim, self.sim.data, self.gains, self.ref
-        k, w = ref.at(t)
+        plan = ref.sample(t)
+        k, w = plan.k, plan.w
+        qvel = d.qvel
         mass, bias = self.model.dynamics()
         stance = ref.contact[k] if w < 0.5 else ref.contact[k + 1]
         to_switch = ref.to_switch[k] - w * ref.dt
         touching = self._touching()
+        centres = d.site_xpos[sim.foot_sites]
         contacts, tasks, wrench = [], [], []
-        points = []
+        heights = []
         for leg in range(4):
-            centre = d.site_xpos[sim.foot_sites[leg]]
+            centre = centres[leg]
             early = touching[leg] and to_switch[leg] <= g.touchdown_window
             if stance[leg] or early:
                 normal, tangent, normal_force = self._plane or _surface(
                     self.ground.normal(float(centre[0]), float(centre[1]))
                 )
                 pt = centre - self.radius * normal
-                jac, drift = self.model.frame(self.foot_bodies[leg], pt)
+                jac, drift = self.model.frame(self.foot_bodies[leg], pt, angular=False)
                 name = f"foot{leg}"
                 contacts.append(
-                    Contact.point(name, jac[:3], drift[:3], pt, normal, self.friction, 0.0, tangent)
+                    Contact.point(name, jac, drift, pt, normal, self.friction, 0.0, tangent)
                 )
-                points.append(pt)
+                heights.append(pt[2])
                 if stance[leg] and g.unload_time > 0 and to_switch[leg] < g.unload_time:
                     share = 1.0 - max(to_switch[leg], 0.0) / g.unload_time
                     wrench.append(
@@ -228,37 +283,35 @@ class QuadrupedWbc:
                         )
                     )
             else:
-                jac, drift = self.model.frame(self.foot_bodies[leg], centre)
-                vel = jac[:3] @ d.qvel
+                jac, drift = self.model.frame(self.foot_bodies[leg], centre, angular=False)
+                vel = jac @ qvel
                 acc = (
-                    _lerp(ref.feet_a[:, leg], k, w)
-                    + g.swing_kp * (_lerp(ref.feet[:, leg], k, w) - centre)
-                    + g.swing_kd * (_lerp(ref.feet_v[:, leg], k, w) - vel)
+                    plan.feet_a[leg]
+                    + g.swing_kp * (plan.feet[leg] - centre)
+                    + g.swing_kd * (plan.feet_v[leg] - vel)
                 )
-                tasks.append(MotionTask(f"swing{leg}", jac[:3], drift[:3], acc, g.swing_weight))
+                tasks.append(MotionTask(f"swing{leg}", jac, drift, acc, g.swing_weight))
         # trunk position and orientation
         jac, drift = self.model.frame(sim.trunk, d.xpos[sim.trunk])
-        vel = jac @ d.qvel
+        vel = jac @ qvel
         acc_lin = (
-            _lerp(ref.body_a, k, w)
-            + g.trunk_kp * (_lerp(ref.body, k, w) - d.xpos[sim.trunk])
-            - g.trunk_kd * (vel[:3] - _lerp(ref.body_v, k, w))
+            plan.body_a
+            + g.trunk_kp * (plan.body - d.xpos[sim.trunk])
+            - g.trunk_kd * (vel[:3] - plan.body_v)
         )
         rot = d.xmat[sim.trunk].reshape(3, 3)
-        err = rotation_log(ref.rot(k, w) @ rot.T)
+        err = rotation_log(plan.rot @ rot.T)
         acc_ang = g.rot_kp * err - g.rot_kd * vel[3:]
         tasks.append(MotionTask("trunk", jac[:3], drift[:3], acc_lin, g.trunk_weight))
         tasks.append(MotionTask("trunk_rot", jac[3:], drift[3:], acc_ang, g.rot_weight))
         # joint posture
         q = d.qpos[sim.qpos_adr]
-        qd = d.qvel[self.joint_dofs]
-        acc_q = g.posture_kp * (_lerp(ref.joints, k, w) - q) + g.posture_kd * (
-            _lerp(ref.joints_v, k, w) - qd
-        )
+        qd = qvel[self.joint_dofs]
+        acc_q = g.posture_kp * (plan.joints - q) + g.posture_kd * (plan.joints_v - qd)
         tasks.append(MotionTask("posture", self._select, self._no_drift, acc_q, g.posture_weight))
-        if points and g.cop_weight > 0:
-            zp = float(np.mean([p[2] for p in points]))
-            z = _lerp(ref.zmp, k, w)
+        if heights and g.cop_weight > 0:
+            zp = sum(heights) / len(heights)  # the stance points' mean height
+            z = plan.zmp
             wrench.append(
                 WrenchTask(
                     "cop", np.array([z[0], z[1], zp]), _HORIZONTAL_MOMENT, np.zeros(2), g.cop_weight
