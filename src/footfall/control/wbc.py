@@ -297,7 +297,12 @@ class WholeBodyController:
         Raises:
             SolverError: as :meth:`solve`.
         """
-        assembled = assemble(*packed, *self.eps)
+        return self.solve_assembled(assemble(*packed, *self.eps))
+
+    def solve_assembled(self, assembled: Assembled) -> tuple[FloatArray, FloatArray, int]:
+        """:meth:`solve_packed` of the QP as :func:`footfall.control._wbc_kernel.assemble`
+        returns it (for compiled code that packs and assembles in one call, with this
+        controller's ``eps``)."""
         h_mat, g_vec, c_mat, lower, upper, n_eq, t_map, zero_row_value = assembled
         n = h_mat.shape[0]
         if zero_row_value:
@@ -321,6 +326,11 @@ class WholeBodyController:
         self._warm = (key, np.asarray(info["lam"]) != 0.0)
         torque = t_map[:, :n] @ x + t_map[:, n]
         return x, torque, int(info.get("iterations", 0))
+
+
+#: :func:`footfall.control._wbc_kernel.assemble`'s QP: ``(H, g, C, lower, upper, n_eq, T,
+#: zero_row_value)``
+Assembled = tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, int, FloatArray, bool]
 
 
 class PackedProblem(NamedTuple):
@@ -492,6 +502,7 @@ def _shape(name: str, a: FloatArray, shape: tuple[int, ...], allow_inf: bool = F
 
 __all__ = [
     "PYRAMID_SHARE",
+    "Assembled",
     "Contact",
     "MotionTask",
     "PackedProblem",

@@ -14,6 +14,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from footfall.control._wbc_kernel import assemble
+
 #: columns of ``_Reference.table`` (see :class:`footfall.sim.quadruped.wbc._Sample`)
 BODY, BODY_V, BODY_A, FEET, FEET_V, FEET_A, JOINTS, JOINTS_V, ZMP = 0, 3, 6, 9, 21, 33, 45, 57, 69
 #: entries of the gains vector of :func:`pack_tick`
@@ -62,9 +64,26 @@ def pack_tick(
     w_about: np.ndarray,
     w_weight: np.ndarray,
     w_mask: np.ndarray,
-) -> tuple[int, int, int]:
-    """Fill one tick's packed problem; returns its numbers of contacts, motion rows and wrench
-    rows (the arrays' leading parts that count).
+    mass: np.ndarray,
+    bias: np.ndarray,
+    actuated: np.ndarray,
+    unactuated: np.ndarray,
+    torque_min: np.ndarray,
+    torque_max: np.ndarray,
+    n_points: np.ndarray,
+    friction: np.ndarray,
+    min_normal: np.ndarray,
+    w_target: np.ndarray,
+    eps: tuple[float, float, float],
+) -> tuple[
+    int,
+    int,
+    int,
+    tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, np.ndarray, bool],
+]:
+    """Fill one tick's packed problem and assemble its QP: returns the numbers of contacts,
+    motion rows and wrench rows (the arrays' leading parts that count) and
+    :func:`~footfall.control._wbc_kernel.assemble`'s QP.
 
     Inputs: ``row`` (72,) the plan at this instant (``_Reference.table``'s columns); ``err`` (3,)
     the trunk's orientation error [rad]; per leg (4): ``contact`` (bool) a contact this tick,
@@ -80,6 +99,11 @@ def pack_tick(
     (4, 6, nv), ``c_drift`` (4, 6), ``c_origin`` (4, 3), ``c_points`` (4, 1, 3), ``c_normal``,
     ``c_tangent`` (4, 3); the motion rows ``m_jac`` (rm, nv), ``m_rhs``, ``m_w`` (rm,); the wrench
     rows ``w_rows`` (rw, 6), ``w_about`` (rw, 3), ``w_weight`` (rw,), ``w_mask`` (rw, 4).
+
+    Then the rest of :class:`~footfall.control.wbc.PackedProblem`: ``mass`` (nv, nv), ``bias``
+    (nv,), ``actuated``, ``unactuated``, ``torque_min``, ``torque_max``; per contact (4,)
+    ``n_points`` (ones), ``friction``, ``min_normal``; ``w_target`` (6,) (zeros); and the
+    controller's regularisation weights ``eps``.
     """
     nv = qvel.shape[0]
     vel = np.empty(6)
@@ -158,4 +182,32 @@ def pack_tick(
             w_weight[rw + i] = gains[COP_W]
             w_mask[rw + i, :nc] = 1.0
         rw += 2
-    return nc, rm, rw
+    qp = assemble(
+        mass,
+        bias,
+        actuated,
+        unactuated,
+        torque_min,
+        torque_max,
+        c_jac[:nc],
+        c_drift[:nc],
+        c_origin[:nc],
+        c_points[:nc],
+        n_points[:nc],
+        c_normal[:nc],
+        c_tangent[:nc],
+        friction[:nc],
+        min_normal[:nc],
+        m_jac[:rm],
+        m_rhs[:rm],
+        m_w[:rm],
+        w_rows[:rw],
+        w_about[:rw],
+        w_target[:rw],
+        w_weight[:rw],
+        w_mask[:rw, :nc],
+        eps[0],
+        eps[1],
+        eps[2],
+    )
+    return nc, rm, rw, qp

@@ -199,9 +199,9 @@ class _Buffers:
         #: the solution: x = (qdd, forces), joint torques [N m], solver iterations
         self.x, self.torque, self.iterations = np.zeros(0), np.zeros(0), 0
 
-    def packed(self, nc: int, rm: int, rw: int) -> PackedProblem:
-        """The packed problem of ``nc`` contacts, ``rm`` motion and ``rw`` wrench rows."""
-        self.sizes = (nc, rm, rw)
+    def packed(self) -> PackedProblem:
+        """The last packed problem (``sizes``)."""
+        nc, rm, rw = self.sizes
         c_jac, c_drift, c_origin, c_points, c_normal, c_tangent, *motion_wrench = self.outputs
         m_jac, m_rhs, m_w, w_rows, w_about, w_weight, w_mask = motion_wrench
         act, unact, lo, hi = self.constant
@@ -237,7 +237,7 @@ class _Buffers:
     def problem(self) -> WbcProblem:
         """The packed problem as dataclasses (copies). A motion task's drift is folded into its
         acceleration (zero drift, acceleration ``a* - Jdot qd``): the same rows of the QP."""
-        p = self.packed(*self.sizes)
+        p = self.packed()
         contacts = tuple(
             Contact.point(
                 name,
@@ -409,7 +409,7 @@ class QuadrupedWbc:
         err = rotation_log(plan_rot @ d.xmat[sim.trunk].reshape(3, 3).T)
         self.model.mass_matrix(buf.mass)
         np.subtract(d.qfrc_bias, d.qfrc_passive, out=buf.bias)
-        sizes = pack_tick(
+        nc, rm, rw, qp = pack_tick(
             row,
             err,
             buf.contact,
@@ -427,9 +427,18 @@ class QuadrupedWbc:
             self.joint_dofs,
             self._gains,
             *buf.outputs,
+            buf.mass,
+            buf.bias,
+            *buf.constant,
+            buf.n_points,
+            buf.friction,
+            buf.min_normal,
+            buf.w_target,
+            self.ctrl.eps,
         )
+        buf.sizes = (nc, rm, rw)
         try:
-            buf.x, buf.torque, buf.iterations = self.ctrl.solve_packed(buf.packed(*sizes))
+            buf.x, buf.torque, buf.iterations = self.ctrl.solve_assembled(qp)
         except SolverError:  # counted in the metrics; the last torques are held for one step
             self.failures += 1
             return self.last_tau
