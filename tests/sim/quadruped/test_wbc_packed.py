@@ -46,7 +46,8 @@ def _reference_problem(wbc: QuadrupedWbc, t: float) -> WbcProblem:
     for leg in range(4):
         centre = d.site_xpos[sim.foot_sites[leg]]
         if stance[leg] or (touching[leg] and to_switch[leg] <= g.touchdown_window):
-            normal, tangent, normal_force = _surface(wbc.ground.normal(centre[0], centre[1]))
+            normal, tangent = _surface(wbc.ground.normal(centre[0], centre[1]))
+            normal_force = np.concatenate([normal, np.zeros(3)]).reshape(1, 6)
             pt = centre - wbc.radius * normal
             jac, drift = wbc.model.frame(wbc.foot_bodies[leg], pt, angular=False)
             name = f"foot{leg}"
