@@ -46,9 +46,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import NDArray
 
 from footfall._typing import FloatArray
 from footfall.control._wbc_kernel import PYRAMID_SHARE, _tangents, assemble
@@ -276,8 +277,32 @@ class WholeBodyController:
         nv = p.nv
         if check:
             _check_problem(p)
-        packed = _pack(p)
-        assembled = assemble(*packed, *self.eps)  # type: ignore[call-arg]
+        x, torque, iterations = self.solve_packed(_pack(p))
+        forces = {}
+        o = nv
+        for c in p.contacts:
+            forces[c.name] = x[o : o + 3 * c.n_points].reshape(-1, 3)
+            o += 3 * c.n_points
+        return WbcSolution(x[:nv].copy(), torque, forces, iterations)
+
+    def solve_packed(self, packed: PackedProblem) -> tuple[FloatArray, FloatArray, int]:
+        """Solve one tick's QP given as arrays (what :meth:`solve` does after packing its
+        problem; a controller that fills the arrays itself skips the dataclasses). The arrays are
+        not checked.
+
+        Returns:
+            ``x`` (n,) = (qdd (nv,), the contacts' point forces (3 per point) [N], in order),
+            the joint torques (na,) [N m] and daqp's iterations.
+
+        Raises:
+            SolverError: as :meth:`solve`.
+        """
+        return self.solve_assembled(assemble(*packed, *self.eps))
+
+    def solve_assembled(self, assembled: Assembled) -> tuple[FloatArray, FloatArray, int]:
+        """:meth:`solve_packed` of the QP as :func:`footfall.control._wbc_kernel.assemble`
+        returns it (for compiled code that packs and assembles in one call, with this
+        controller's ``eps``)."""
         h_mat, g_vec, c_mat, lower, upper, n_eq, t_map, zero_row_value = assembled
         n = h_mat.shape[0]
         if zero_row_value:
@@ -299,16 +324,46 @@ class WholeBodyController:
             self.failures += 1
             raise SolverError("whole-body QP returned non-finite values (non-finite input?)")
         self._warm = (key, np.asarray(info["lam"]) != 0.0)
-        forces = {}
-        o = nv
-        for c in p.contacts:
-            forces[c.name] = x[o : o + 3 * c.n_points].reshape(-1, 3)
-            o += 3 * c.n_points
         torque = t_map[:, :n] @ x + t_map[:, n]
-        return WbcSolution(x[:nv].copy(), torque, forces, int(info.get("iterations", 0)))
+        return x, torque, int(info.get("iterations", 0))
 
 
-def _pack(p: WbcProblem) -> tuple[Any, ...]:
+#: :func:`footfall.control._wbc_kernel.assemble`'s QP: ``(H, g, C, lower, upper, n_eq, T,
+#: zero_row_value)``
+Assembled = tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, int, FloatArray, bool]
+
+
+class PackedProblem(NamedTuple):
+    """A :class:`WbcProblem` as the arrays of :func:`footfall.control._wbc_kernel.assemble`
+    (whose docstring gives the shapes), in its argument order: contacts, then motion rows, then
+    wrench rows, each in the problem's order."""
+
+    mass: FloatArray
+    bias: FloatArray
+    actuated: NDArray[np.int64]
+    unactuated: NDArray[np.int64]
+    torque_min: FloatArray
+    torque_max: FloatArray
+    jac: FloatArray
+    drift: FloatArray
+    origin: FloatArray
+    points: FloatArray
+    n_points: NDArray[np.int64]
+    normal: FloatArray
+    tangent: FloatArray
+    friction: FloatArray
+    min_normal: FloatArray
+    motion_jac: FloatArray
+    motion_rhs: FloatArray
+    motion_w: FloatArray
+    wrench_rows: FloatArray
+    wrench_about: FloatArray
+    wrench_target: FloatArray
+    wrench_w: FloatArray
+    wrench_mask: FloatArray
+
+
+def _pack(p: WbcProblem) -> PackedProblem:
     """The problem as the arrays of :func:`footfall.control._wbc_kernel.assemble`."""
     nv = p.nv
     actuated = np.asarray(p.actuated, dtype=np.int64)
@@ -354,7 +409,7 @@ def _pack(p: WbcProblem) -> tuple[Any, ...]:
             if wt.contacts is None or nm in wt.contacts:
                 w_mask[r0:r1, i] = 1.0
         r0 = r1
-    return (
+    return PackedProblem(
         np.ascontiguousarray(p.mass_matrix, dtype=float),
         np.asarray(p.bias, dtype=float),
         actuated,
@@ -447,8 +502,10 @@ def _shape(name: str, a: FloatArray, shape: tuple[int, ...], allow_inf: bool = F
 
 __all__ = [
     "PYRAMID_SHARE",
+    "Assembled",
     "Contact",
     "MotionTask",
+    "PackedProblem",
     "WbcProblem",
     "WbcSolution",
     "WholeBodyController",

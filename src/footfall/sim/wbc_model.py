@@ -74,11 +74,17 @@ class MujocoWbcModel:
 
     def dynamics(self) -> tuple[FloatArray, FloatArray]:
         """``M`` (nv, nv) and ``h`` (nv,) at the current state."""
+        return self.mass_matrix().copy(), self.d.qfrc_bias - self.d.qfrc_passive
+
+    def mass_matrix(self, out: FloatArray | None = None) -> FloatArray:
+        """``M`` (nv, nv) at the current state, written into ``out`` (C-contiguous) or else into
+        a buffer of this object that the next call overwrites (copy it to keep it)."""
+        mass = self._mass if out is None else out
         if self._new_full_m:
-            self.mj.mj_fullM(self.m, self.d, self._mass)
+            self.mj.mj_fullM(self.m, self.d, mass)
         else:  # MuJoCo < 3.5: mj_fullM(m, dst, qM)
-            self.mj.mj_fullM(self.m, self._mass, self.d.qM)
-        return self._mass.copy(), self.d.qfrc_bias - self.d.qfrc_passive
+            self.mj.mj_fullM(self.m, mass, self.d.qM)
+        return mass
 
     def frame(
         self, body: int, point: FloatArray, angular: bool = True
@@ -94,6 +100,18 @@ class MujocoWbcModel:
         mj.mj_jac(m, d, jac[:3], jac[3:] if angular else None, pt, body)
         mj.mj_jacDot(m, d, jdot[:3], jdot[3:] if angular else None, pt, body)
         return jac, jdot @ d.qvel
+
+    def jacobians(self, body: int, point: FloatArray, jac: FloatArray, jdot: FloatArray) -> None:
+        """:meth:`frame` in place, without its drift product: the Jacobian of ``point`` (3,) [m]
+        moving with ``body`` into ``jac`` and its time derivative into ``jdot``, both C-contiguous
+        (3, nv) (linear rows) or (6, nv) (linear, then angular)."""
+        mj, m, d = self.mj, self.m, self.d
+        if jac.shape[0] == 3:
+            mj.mj_jac(m, d, jac, None, point, body)
+            mj.mj_jacDot(m, d, jdot, None, point, body)
+        else:
+            mj.mj_jac(m, d, jac[:3], jac[3:], point, body)
+            mj.mj_jacDot(m, d, jdot[:3], jdot[3:], point, body)
 
     def contact(
         self,

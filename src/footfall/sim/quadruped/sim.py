@@ -396,6 +396,8 @@ class _Recorder:
     def __init__(self, sim: QuadrupedSim, plan: GaitPlan, ref: GaitTrajectory) -> None:
         self.sim = sim
         self.plan = plan
+        #: the plan's ground, read once (GaitPlan.ground builds a checked PlaneGround per call)
+        self.ground = plan.ground
         self.planned = ref
         self.t = ref.t
         n = ref.t.shape[0]
@@ -430,9 +432,8 @@ class _Recorder:
             self.cop[k], _ = centre_of_pressure(pts[loaded], frc[loaded], z_p)
             # each foot touches at one point (sphere on plane), so the feet's points span it
             self.margin[k] = stability_margin(self.cop[k], support_polygon(pts[loaded]))
-        ground = self.plan.ground
         for j in range(idx.size):
-            normal = ground.normal(float(pts[j, 0]), float(pts[j, 1]))
+            normal = self.ground.normal(float(pts[j, 0]), float(pts[j, 1]))
             self.slip_vel[k, idx[j]] = sim.contact_slip_velocity(idx[j], pts[j], normal)
         if math.isnan(self.fallen_at) and (trunk_hit or self._fallen(k)):
             self.fallen_at = float(self.t[k])
@@ -442,7 +443,7 @@ class _Recorder:
         post = self.plan.posture
         tilt = abs(self.trunk_pitch[k] - self.planned.body_pitch[k])
         x, y = float(self.trunk_pos[k, 0]), float(self.trunk_pos[k, 1])
-        low = self.trunk_pos[k, 2] - self.plan.ground.centre_height(x, y)
+        low = self.trunk_pos[k, 2] - self.ground.centre_height(x, y)
         return bool(tilt > FALL_TILT or low < FALL_HEIGHT_FRACTION * post.height)
 
 
@@ -506,7 +507,7 @@ def _track_wbc(
     from footfall.sim.quadruped.wbc import QuadrupedWbc
 
     m, d, mj = sim.model, sim.data, sim.mujoco
-    wbc = QuadrupedWbc(sim, rec.planned, rec.plan.ground, gains)
+    wbc = QuadrupedWbc(sim, rec.planned, rec.ground, gains)
     substeps = max(1, round(control_dt / m.opt.timestep))
     frame_every = max(1, round(1.0 / (VIDEO_FPS * control_dt)))
     t_start = float(rec.t[0])

@@ -14,7 +14,9 @@ then strays far from the plan. Here every joint is torque-driven by the whole-bo
   acceleration as feedforward; the swing feet: the zero-impact trajectories (eq. 10-13) the same
   way; the joints: a weak posture task toward the planned angles.
 
-The QP runs at every physics step from the state of that step (``mj_step1`` / ``mj_step2``).
+The QP runs at every physics step (or every ``qp_every``-th) from the state of that step
+(``mj_step1`` / ``mj_step2``); the tick packs it straight into arrays (:mod:`._wbc_tick`), the
+dataclasses are rebuilt only when asked (``last_problem``).
 """
 
 from __future__ import annotations
@@ -25,12 +27,13 @@ from typing import Any
 
 import numpy as np
 
-from footfall._geometry import rotation_log
+from footfall._geometry import cross3, rotation_log
 from footfall._typing import FloatArray
 from footfall._validate import check_fields, non_negative
 from footfall.control.wbc import (
     Contact,
     MotionTask,
+    PackedProblem,
     WbcProblem,
     WbcSolution,
     WholeBodyController,
@@ -39,10 +42,8 @@ from footfall.control.wbc import (
 from footfall.errors import InputError, SolverError
 from footfall.quadruped.gait import GaitTrajectory
 from footfall.quadruped.ground import PlaneGround, QuadrupedGround
+from footfall.sim.quadruped._wbc_tick import FIXED_MOTION_ROWS, pack_tick
 from footfall.sim.wbc_model import MujocoWbcModel
-
-#: moment rows (mx, my) of the contact wrench: the horizontal moment about the ZMP
-_HORIZONTAL_MOMENT = np.array([[0, 0, 0, 1.0, 0, 0], [0, 0, 0, 0, 1.0, 0]])
 
 
 @dataclass(frozen=True)
@@ -96,33 +97,6 @@ class QuadrupedWbcGains:
             raise InputError("wbc_gains.qp_every", q, "an integer >= 1")
 
 
-@dataclass(frozen=True)
-class _Sample:
-    """The plan at one instant (:meth:`_Reference.sample`).
-
-    Attributes:
-        k, w: sample index and weight of the instant (:meth:`_Reference.at`).
-        body, body_v, body_a: trunk position (3,) [m], velocity [m/s], acceleration [m/s^2].
-        feet, feet_v, feet_a: foot centres (4, 3) [m], velocities, accelerations.
-        joints, joints_v: joint angles (12,) [rad] and rates [rad/s].
-        zmp: planned ZMP (2,) [m].
-        rot: planned trunk orientation (3, 3) (its pitch follows the ground's local plane).
-    """
-
-    k: int
-    w: float
-    body: FloatArray
-    body_v: FloatArray
-    body_a: FloatArray
-    feet: FloatArray
-    feet_v: FloatArray
-    feet_a: FloatArray
-    joints: FloatArray
-    joints_v: FloatArray
-    zmp: FloatArray
-    rot: FloatArray
-
-
 class _Reference:
     """The sampled plan with velocities and accelerations, interpolated linearly in time."""
 
@@ -133,8 +107,8 @@ class _Reference:
         body_v = np.gradient(ref.body_pos, dt, axis=0)
         feet_v = np.gradient(ref.feet, dt, axis=0)
         n = ref.t.size
-        # the interpolated quantities side by side (in _Sample's order), so that one
-        # interpolation per tick gives them all
+        # the interpolated quantities side by side (the columns of _wbc_tick.BODY...), so that
+        # one interpolation per tick gives them all
         columns = [
             ref.body_pos,
             body_v,
@@ -147,10 +121,9 @@ class _Reference:
             ref.zmp,
             ref.body_pitch[:, None],
         ]
-        #: (T, 72) the columns above
+        #: (T, 72) the columns above: body position (3) [m], velocity, acceleration, feet
+        #: (4 x 3) [m], velocities, accelerations, joints (12) [rad], rates, ZMP (2) [m], pitch
         self.table = np.hstack(columns)
-        ends = np.cumsum([c.shape[1] for c in columns]).tolist()
-        self._slices = [slice(a, b) for a, b in zip([0, *ends[:-1]], ends, strict=True)]
         self.contact = ref.contact
         #: (T, 4) time from each sample to the next change of each leg's planned contact [s]
         self.to_switch = np.full(ref.contact.shape, np.inf)
@@ -166,29 +139,164 @@ class _Reference:
         k = int(min(max(math.floor(u), 0), self.t.size - 2))
         return k, float(min(max(u - k, 0.0), 1.0))
 
-    def sample(self, t: float) -> _Sample:
-        """The plan at time ``t`` [s]."""
-        k, w = self.at(t)
-        row = (1.0 - w) * self.table[k] + w * self.table[k + 1]
-        body, body_v, body_a, feet, feet_v, feet_a, joints, joints_v, zmp, pitch = (
-            row[s] for s in self._slices
+
+class _Buffers:
+    """One tick's arrays: the inputs of :func:`pack_tick` that the tick fills, its outputs (the
+    arrays of a :class:`PackedProblem` with room for 4 contacts, 12 + 18 motion rows and 4 + 2
+    wrench rows) and the solution; the problem and the solution as dataclasses are rebuilt from
+    them when asked (:meth:`problem`, :meth:`solution`).
+
+    Args:
+        model: the robot's model terms.
+        friction: the feet's friction coefficient.
+        plane: ``_surface`` of a plane ground (its normal and pyramid orientation are set once),
+            None on other grounds (set per contact by the tick).
+    """
+
+    def __init__(
+        self,
+        model: MujocoWbcModel,
+        friction: float,
+        plane: tuple[FloatArray, FloatArray | None] | None,
+    ) -> None:
+        nv = model.nv
+        self.nv = nv
+        #: inputs: M (nv, nv), h (nv,), per leg a contact flag, unload weight (< 0: none), point
+        #: [m], normal, pyramid orientation (zero: any), Jacobian of the point and derivative
+        self.mass, self.bias = np.zeros((nv, nv)), np.zeros(nv)
+        self.contact = np.zeros(4, dtype=bool)
+        self.unload_w = np.full(4, -1.0)
+        self.pts, self.normal, self.tangent = np.zeros((4, 3)), np.zeros((4, 3)), np.zeros((4, 3))
+        if plane is not None:
+            self.normal[:] = plane[0]
+            if plane[1] is not None:
+                self.tangent[:] = plane[1]
+        self.foot_jac, self.foot_jdot = np.zeros((4, 3, nv)), np.zeros((4, 3, nv))
+        self.trunk_jac, self.trunk_jdot = np.zeros((6, nv)), np.zeros((6, nv))
+        rm, rw = 12 + FIXED_MOTION_ROWS, 6
+        #: pack_tick's outputs, in its argument order (the contacts' angular rows stay zero)
+        self.outputs = (
+            *(np.zeros((4, 6, nv)), np.zeros((4, 6)), np.zeros((4, 3)), np.zeros((4, 1, 3))),
+            *(np.zeros((4, 3)), np.zeros((4, 3))),
+            *(np.zeros((rm, nv)), np.zeros(rm), np.zeros(rm)),
+            *(np.zeros((rw, 6)), np.zeros((rw, 3)), np.zeros(rw), np.zeros((rw, 4))),
         )
-        c, s = math.cos(-pitch[0]), math.sin(-pitch[0])
-        return _Sample(
-            k,
-            w,
-            body,
-            body_v,
-            body_a,
-            feet.reshape(4, 3),
-            feet_v.reshape(4, 3),
-            feet_a.reshape(4, 3),
-            joints,
-            joints_v,
-            zmp,
-            # nose-up pitch is a rotation about y by -pitch
-            np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]),
+        act = np.asarray(model.actuated, dtype=np.int64)
+        free = np.ones(nv, dtype=bool)
+        free[act] = False
+        #: the constant arrays: actuated and other dofs, torque limits [N m], per contact one
+        #: point, the friction, no minimum normal force; the wrench targets (zero)
+        self.constant = (
+            act,
+            np.flatnonzero(free).astype(np.int64),
+            np.asarray(model.torque_min, dtype=float),
+            np.asarray(model.torque_max, dtype=float),
         )
+        self.n_points, self.friction = np.ones(4, dtype=np.int64), np.full(4, friction)
+        self.min_normal, self.w_target = np.zeros(4), np.zeros(rw)
+        #: the sizes (contacts, motion rows, wrench rows) of the last packed problem
+        self.sizes = (0, 0, 0)
+        #: the solution: x = (qdd, forces), joint torques [N m], solver iterations
+        self.x, self.torque, self.iterations = np.zeros(0), np.zeros(0), 0
+
+    def packed(self) -> PackedProblem:
+        """The last packed problem (``sizes``)."""
+        nc, rm, rw = self.sizes
+        c_jac, c_drift, c_origin, c_points, c_normal, c_tangent, *motion_wrench = self.outputs
+        m_jac, m_rhs, m_w, w_rows, w_about, w_weight, w_mask = motion_wrench
+        act, unact, lo, hi = self.constant
+        return PackedProblem(
+            self.mass,
+            self.bias,
+            act,
+            unact,
+            lo,
+            hi,
+            c_jac[:nc],
+            c_drift[:nc],
+            c_origin[:nc],
+            c_points[:nc],
+            self.n_points[:nc],
+            c_normal[:nc],
+            c_tangent[:nc],
+            self.friction[:nc],
+            self.min_normal[:nc],
+            m_jac[:rm],
+            m_rhs[:rm],
+            m_w[:rm],
+            w_rows[:rw],
+            w_about[:rw],
+            self.w_target[:rw],
+            w_weight[:rw],
+            w_mask[:rw, :nc],
+        )
+
+    def _names(self) -> list[str]:
+        return [f"foot{leg}" for leg in range(4) if self.contact[leg]]
+
+    def problem(self) -> WbcProblem:
+        """The packed problem as dataclasses (copies). A motion task's drift is folded into its
+        acceleration (zero drift, acceleration ``a* - Jdot qd``): the same rows of the QP."""
+        p = self.packed()
+        contacts = tuple(
+            Contact.point(
+                name,
+                p.jac[i, :3].copy(),
+                p.drift[i, :3].copy(),
+                p.origin[i].copy(),
+                p.normal[i].copy(),
+                float(p.friction[i]),
+                float(p.min_normal[i]),
+                p.tangent[i].copy() if p.tangent[i].any() else None,
+            )
+            for i, name in enumerate(self._names())
+        )
+        groups = [(f"swing{leg}", 3) for leg in range(4) if not self.contact[leg]]
+        tasks, r = [], 0
+        for name, n in [*groups, ("trunk", 3), ("trunk_rot", 3), ("posture", 12)]:
+            sel = slice(r, r + n)
+            tasks.append(
+                MotionTask(
+                    name,
+                    p.motion_jac[sel].copy(),
+                    np.zeros(n),
+                    p.motion_rhs[sel].copy(),
+                    p.motion_w[sel].copy(),
+                )
+            )
+            r += n
+        # the unload rows (one per unloading contact, in leg order), then the CoP's two rows
+        wrench, r = [], 0
+        for c in contacts:
+            if self.unload_w[int(c.name[-1])] >= 0.0:
+                about, rows = p.wrench_about[r].copy(), p.wrench_rows[r : r + 1].copy()
+                weight = float(p.wrench_w[r])
+                wrench.append(
+                    WrenchTask(f"unload{c.name[-1]}", about, rows, np.zeros(1), weight, (c.name,))
+                )
+                r += 1
+        if r < p.wrench_w.shape[0]:
+            about, rows = p.wrench_about[r].copy(), p.wrench_rows[r : r + 2].copy()
+            wrench.append(WrenchTask("cop", about, rows, np.zeros(2), float(p.wrench_w[r])))
+        return WbcProblem(
+            mass_matrix=p.mass.copy(),
+            bias=p.bias.copy(),
+            actuated=p.actuated.astype(float),
+            torque_min=p.torque_min.copy(),
+            torque_max=p.torque_max.copy(),
+            contacts=contacts,
+            motion_tasks=tuple(tasks),
+            wrench_tasks=tuple(wrench),
+        )
+
+    def solution(self) -> WbcSolution:
+        """The solution of :meth:`problem`."""
+        nv, x = self.nv, self.x
+        forces = {
+            name: x[nv + 3 * i : nv + 3 * i + 3].reshape(1, 3).copy()
+            for i, name in enumerate(self._names())
+        }
+        return WbcSolution(x[:nv].copy(), self.torque, forces, self.iterations)
 
 
 class QuadrupedWbc:
@@ -221,15 +329,23 @@ class QuadrupedWbc:
         self.joint_dofs = np.array(
             [int(m.jnt_dofadr[int(m.actuator_trnid[a, 0])]) for a in sim.actuators]
         )
-        #: constant task arrays: the joints' rows of qdd, their zero drift, a normal-force row
-        self._select = np.zeros((self.joint_dofs.size, self.model.nv))
-        self._select[np.arange(self.joint_dofs.size), self.joint_dofs] = 1.0
-        self._no_drift = np.zeros(self.joint_dofs.size)
+        g = gains
+        #: the gains in the order of pack_tick's vector
+        self._gains = np.array(
+            [
+                *(g.trunk_kp, g.trunk_kd, g.rot_kp, g.rot_kd, g.swing_kp, g.swing_kd),
+                *(g.posture_kp, g.posture_kd, g.trunk_weight, g.rot_weight, g.swing_weight),
+                *(g.posture_weight, g.cop_weight),
+            ]
+        )
+        # two sets of arrays: a tick fills the one that does not hold the last solved problem
+        self._buffers = (
+            _Buffers(self.model, self.friction, self._plane),
+            _Buffers(self.model, self.friction, self._plane),
+        )
+        self._last: _Buffers | None = None
         self.failures = 0
         self.last_tau = np.zeros(len(sim.actuators))
-        #: the last solved problem and its solution (None before the first solve)
-        self.last_problem: WbcProblem | None = None
-        self.last: WbcSolution | None = None
 
     def retarget(self, ref: GaitTrajectory) -> None:
         """Track ``ref`` from now on (same sample times; the slip guard's held reference)."""
@@ -242,103 +358,103 @@ class QuadrupedWbc:
         hit = set(geoms.ravel().tolist())
         return [g in hit for g in self.sim.foot_geoms]
 
-    def torques(self, t: float) -> FloatArray:
-        """Joint torques (12,) [N m] at gait time ``t`` from the current state (positions and
-        velocities; ``mj_step1`` has run)."""
+    @property
+    def last_problem(self) -> WbcProblem | None:
+        """The last solved problem as dataclasses (rebuilt from its packed arrays when asked;
+        None before the first solve)."""
+        return None if self._last is None else self._last.problem()
+
+    @property
+    def last(self) -> WbcSolution | None:
+        """The last solution (None before the first solve)."""
+        return None if self._last is None else self._last.solution()
+
+    def _feet(self, buf: _Buffers, k: int, w: float) -> None:
+        """Each foot's part of the tick at plan sample ``k``, weight ``w``, into ``buf``: a
+        contact or not, its contact normal, unload weight, point and that point's Jacobians."""
         sim, d, g, ref = self.sim, self.sim.data, self.gains, self.ref
-        plan = ref.sample(t)
-        k, w = plan.k, plan.w
-        qvel = d.qvel
-        mass, bias = self.model.dynamics()
         stance = ref.contact[k] if w < 0.5 else ref.contact[k + 1]
         to_switch = ref.to_switch[k] - w * ref.dt
         touching = self._touching()
         centres = d.site_xpos[sim.foot_sites]
-        contacts, tasks, wrench = [], [], []
-        heights = []
         for leg in range(4):
-            centre = centres[leg]
             early = touching[leg] and to_switch[leg] <= g.touchdown_window
-            if stance[leg] or early:
-                normal, tangent, normal_force = self._plane or _surface(
-                    self.ground.normal(float(centre[0]), float(centre[1]))
-                )
-                pt = centre - self.radius * normal
-                jac, drift = self.model.frame(self.foot_bodies[leg], pt, angular=False)
-                name = f"foot{leg}"
-                contacts.append(
-                    Contact.point(name, jac, drift, pt, normal, self.friction, 0.0, tangent)
-                )
-                heights.append(pt[2])
+            buf.contact[leg] = is_contact = bool(stance[leg] or early)
+            buf.unload_w[leg] = -1.0
+            if is_contact:
+                if self._plane is None:
+                    normal, tangent = _surface(
+                        self.ground.normal(float(centres[leg, 0]), float(centres[leg, 1]))
+                    )
+                    buf.normal[leg] = normal
+                    buf.tangent[leg] = 0.0 if tangent is None else tangent
+                buf.pts[leg] = centres[leg] - self.radius * buf.normal[leg]
                 if stance[leg] and g.unload_time > 0 and to_switch[leg] < g.unload_time:
                     share = 1.0 - max(to_switch[leg], 0.0) / g.unload_time
-                    wrench.append(
-                        WrenchTask(
-                            f"unload{leg}",
-                            pt,
-                            normal_force,
-                            np.zeros(1),
-                            g.unload_weight * share,
-                            (name,),
-                        )
-                    )
+                    buf.unload_w[leg] = g.unload_weight * share
             else:
-                jac, drift = self.model.frame(self.foot_bodies[leg], centre, angular=False)
-                vel = jac @ qvel
-                acc = (
-                    plan.feet_a[leg]
-                    + g.swing_kp * (plan.feet[leg] - centre)
-                    + g.swing_kd * (plan.feet_v[leg] - vel)
-                )
-                tasks.append(MotionTask(f"swing{leg}", jac, drift, acc, g.swing_weight))
-        # trunk position and orientation
-        jac, drift = self.model.frame(sim.trunk, d.xpos[sim.trunk])
-        vel = jac @ qvel
-        acc_lin = (
-            plan.body_a
-            + g.trunk_kp * (plan.body - d.xpos[sim.trunk])
-            - g.trunk_kd * (vel[:3] - plan.body_v)
-        )
-        rot = d.xmat[sim.trunk].reshape(3, 3)
-        err = rotation_log(plan.rot @ rot.T)
-        acc_ang = g.rot_kp * err - g.rot_kd * vel[3:]
-        tasks.append(MotionTask("trunk", jac[:3], drift[:3], acc_lin, g.trunk_weight))
-        tasks.append(MotionTask("trunk_rot", jac[3:], drift[3:], acc_ang, g.rot_weight))
-        # joint posture
-        q = d.qpos[sim.qpos_adr]
-        qd = qvel[self.joint_dofs]
-        acc_q = g.posture_kp * (plan.joints - q) + g.posture_kd * (plan.joints_v - qd)
-        tasks.append(MotionTask("posture", self._select, self._no_drift, acc_q, g.posture_weight))
-        if heights and g.cop_weight > 0:
-            zp = sum(heights) / len(heights)  # the stance points' mean height
-            z = plan.zmp
-            wrench.append(
-                WrenchTask(
-                    "cop", np.array([z[0], z[1], zp]), _HORIZONTAL_MOMENT, np.zeros(2), g.cop_weight
-                )
+                buf.pts[leg] = centres[leg]
+            self.model.jacobians(
+                self.foot_bodies[leg], buf.pts[leg], buf.foot_jac[leg], buf.foot_jdot[leg]
             )
-        problem = WbcProblem(
-            mass_matrix=mass,
-            bias=bias,
-            actuated=self.model.actuated,
-            torque_min=self.model.torque_min,
-            torque_max=self.model.torque_max,
-            contacts=tuple(contacts),
-            motion_tasks=tuple(tasks),
-            wrench_tasks=tuple(wrench),
+
+    def torques(self, t: float) -> FloatArray:
+        """Joint torques (12,) [N m] at gait time ``t`` from the current state (positions and
+        velocities; ``mj_step1`` has run)."""
+        sim, d, ref = self.sim, self.sim.data, self.ref
+        k, w = ref.at(t)
+        row = (1.0 - w) * ref.table[k] + w * ref.table[k + 1]
+        # fill the buffers that do not hold the last solved problem
+        buf = self._buffers[1] if self._last is self._buffers[0] else self._buffers[0]
+        self._feet(buf, k, w)
+        trunk_pos = d.xpos[sim.trunk]
+        self.model.jacobians(sim.trunk, trunk_pos, buf.trunk_jac, buf.trunk_jdot)
+        # the planned orientation: nose-up pitch is a rotation about y by -pitch
+        c, s = math.cos(-row[-1]), math.sin(-row[-1])
+        plan_rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+        err = rotation_log(plan_rot @ d.xmat[sim.trunk].reshape(3, 3).T)
+        self.model.mass_matrix(buf.mass)
+        np.subtract(d.qfrc_bias, d.qfrc_passive, out=buf.bias)
+        nc, rm, rw, qp = pack_tick(
+            row,
+            err,
+            buf.contact,
+            buf.unload_w,
+            buf.pts,
+            buf.normal,
+            buf.tangent,
+            buf.foot_jac,
+            buf.foot_jdot,
+            buf.trunk_jac,
+            buf.trunk_jdot,
+            trunk_pos,
+            d.qvel,
+            d.qpos[sim.qpos_adr],
+            self.joint_dofs,
+            self._gains,
+            *buf.outputs,
+            buf.mass,
+            buf.bias,
+            *buf.constant,
+            buf.n_points,
+            buf.friction,
+            buf.min_normal,
+            buf.w_target,
+            self.ctrl.eps,
         )
+        buf.sizes = (nc, rm, rw)
         try:
-            sol = self.ctrl.solve(problem, check=False)
+            buf.x, buf.torque, buf.iterations = self.ctrl.solve_assembled(qp)
         except SolverError:  # counted in the metrics; the last torques are held for one step
             self.failures += 1
             return self.last_tau
-        self.last_tau = sol.torque
-        self.last_problem, self.last = problem, sol
-        return np.asarray(sol.torque)
+        self._last = buf
+        self.last_tau = buf.torque
+        return buf.torque
 
 
-def _surface(normal: FloatArray) -> tuple[FloatArray, FloatArray | None, FloatArray]:
-    """Contact normal (3,), friction pyramid orientation and the normal-force wrench row (1, 6).
+def _surface(normal: FloatArray) -> tuple[FloatArray, FloatArray | None]:
+    """Contact normal (3,) and friction pyramid orientation (3,) (or None).
 
     Gravity's pull along a slope points at an edge of the friction pyramid (where it reaches
     Coulomb's cone, mu) rather than at a face (mu / sqrt(2)): the first face direction is the
@@ -348,10 +464,12 @@ def _surface(normal: FloatArray) -> tuple[FloatArray, FloatArray | None, FloatAr
     n = np.asarray(normal, dtype=float)
     down = np.array([0.0, 0.0, -1.0]) - n * (-n[2])
     tangent = None
-    if np.linalg.norm(down) > 1e-9:
-        down /= np.linalg.norm(down)
-        tangent = (down + np.cross(n, down)) / math.sqrt(2.0)
-    return n, tangent, np.concatenate([n, np.zeros(3)]).reshape(1, 6)
+    length = np.linalg.norm(down)
+    if length > 1e-9:
+        down /= length
+        # cross3: np.cross's ~15 us would be paid per contact and tick on a curved ground
+        tangent = (down + cross3(n, down)) / math.sqrt(2.0)
+    return n, tangent
 
 
 def check_gains(gains: object) -> QuadrupedWbcGains:

@@ -1,0 +1,213 @@
+"""Compiled packing of the quadruped's whole-body QP (numba, beyond the documents).
+
+:func:`pack_tick` writes one tick's contacts and tasks (:mod:`footfall.sim.quadruped.wbc`'s
+module docstring) straight into the arrays of :class:`footfall.control.wbc.PackedProblem`, the
+same numbers as building :class:`~footfall.control.wbc.Contact`, ``MotionTask`` and ``WrenchTask``
+and packing them, without the ~40 small numpy operations and dataclasses per tick that cost more
+than the QP itself at 250 Hz.
+
+Everything compiled lives in this module (numba's on-disk cache, ``cache=True``, keys on it).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from footfall.control._wbc_kernel import assemble
+
+#: columns of ``_Reference.table`` (see :class:`footfall.sim.quadruped.wbc._Sample`)
+BODY, BODY_V, BODY_A, FEET, FEET_V, FEET_A, JOINTS, JOINTS_V, ZMP = 0, 3, 6, 9, 21, 33, 45, 57, 69
+#: entries of the gains vector of :func:`pack_tick`
+(TRUNK_KP, TRUNK_KD, ROT_KP, ROT_KD, SWING_KP, SWING_KD, POSTURE_KP, POSTURE_KD) = range(8)
+(TRUNK_W, ROT_W, SWING_W, POSTURE_W, COP_W) = range(8, 13)
+#: rows of the tick's motion tasks that are not swing feet: trunk (3), orientation (3), joints (12)
+FIXED_MOTION_ROWS = 18
+
+
+@njit(cache=True)
+def _matvec(a: np.ndarray, x: np.ndarray, out: np.ndarray) -> None:
+    """``out = a @ x`` for ``a`` (r, n), ``x`` (n,), ``out`` (r,): BLAS's product, as numpy's
+    ``@`` (a loop sums in another order; a walk then drifts from the dataclass path's by more
+    than rounding, through the contact decisions)."""
+    out[:] = np.dot(a, x)
+
+
+@njit(cache=True)
+def pack_tick(
+    row: np.ndarray,
+    err: np.ndarray,
+    contact: np.ndarray,
+    unload_w: np.ndarray,
+    pts: np.ndarray,
+    normal: np.ndarray,
+    tangent: np.ndarray,
+    foot_jac: np.ndarray,
+    foot_jdot: np.ndarray,
+    trunk_jac: np.ndarray,
+    trunk_jdot: np.ndarray,
+    trunk_pos: np.ndarray,
+    qvel: np.ndarray,
+    q_joints: np.ndarray,
+    joint_dofs: np.ndarray,
+    gains: np.ndarray,
+    c_jac: np.ndarray,
+    c_drift: np.ndarray,
+    c_origin: np.ndarray,
+    c_points: np.ndarray,
+    c_normal: np.ndarray,
+    c_tangent: np.ndarray,
+    m_jac: np.ndarray,
+    m_rhs: np.ndarray,
+    m_w: np.ndarray,
+    w_rows: np.ndarray,
+    w_about: np.ndarray,
+    w_weight: np.ndarray,
+    w_mask: np.ndarray,
+    mass: np.ndarray,
+    bias: np.ndarray,
+    actuated: np.ndarray,
+    unactuated: np.ndarray,
+    torque_min: np.ndarray,
+    torque_max: np.ndarray,
+    n_points: np.ndarray,
+    friction: np.ndarray,
+    min_normal: np.ndarray,
+    w_target: np.ndarray,
+    eps: tuple[float, float, float],
+) -> tuple[
+    int,
+    int,
+    int,
+    tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, np.ndarray, bool],
+]:
+    """Fill one tick's packed problem and assemble its QP: returns the numbers of contacts,
+    motion rows and wrench rows (the arrays' leading parts that count) and
+    :func:`~footfall.control._wbc_kernel.assemble`'s QP.
+
+    Inputs: ``row`` (72,) the plan at this instant (``_Reference.table``'s columns); ``err`` (3,)
+    the trunk's orientation error [rad]; per leg (4): ``contact`` (bool) a contact this tick,
+    ``unload_w`` the weight of its unload task (< 0: none), ``pts`` (4, 3) its contact point or
+    (swing) its foot centre [m], ``normal`` and ``tangent`` (4, 3) its contact normal and friction
+    pyramid orientation (zero: any), ``foot_jac`` and ``foot_jdot`` (4, 3, nv) the Jacobian of
+    ``pts`` and its derivative; the trunk's ``trunk_jac``, ``trunk_jdot`` (6, nv) at its origin
+    ``trunk_pos`` (3,) [m]; ``qvel`` (nv,); the joint angles ``q_joints`` (12,) [rad], their dofs
+    ``joint_dofs`` (12,); ``gains`` (13,) (the indices above).
+
+    Outputs (written in place, the constant parts set once by the caller: rows 3-5 of ``c_jac``
+    and ``c_drift`` zero, one point per contact, the wrench targets zero): the contacts' ``c_jac``
+    (4, 6, nv), ``c_drift`` (4, 6), ``c_origin`` (4, 3), ``c_points`` (4, 1, 3), ``c_normal``,
+    ``c_tangent`` (4, 3); the motion rows ``m_jac`` (rm, nv), ``m_rhs``, ``m_w`` (rm,); the wrench
+    rows ``w_rows`` (rw, 6), ``w_about`` (rw, 3), ``w_weight`` (rw,), ``w_mask`` (rw, 4).
+
+    Then the rest of :class:`~footfall.control.wbc.PackedProblem`: ``mass`` (nv, nv), ``bias``
+    (nv,), ``actuated``, ``unactuated``, ``torque_min``, ``torque_max``; per contact (4,)
+    ``n_points`` (ones), ``friction``, ``min_normal``; ``w_target`` (6,) (zeros); and the
+    controller's regularisation weights ``eps``.
+    """
+    nv = qvel.shape[0]
+    vel = np.empty(6)
+    drift = np.empty(6)
+    nc = 0
+    rm = 0
+    rw = 0
+    height_sum = 0.0
+    w_mask[:] = 0.0
+    for leg in range(4):
+        if contact[leg]:
+            c_jac[nc, :3] = foot_jac[leg]
+            _matvec(foot_jdot[leg], qvel, c_drift[nc, :3])
+            c_origin[nc] = pts[leg]
+            c_points[nc, 0] = pts[leg]
+            c_normal[nc] = normal[leg]
+            c_tangent[nc] = tangent[leg]
+            height_sum += pts[leg, 2]
+            if unload_w[leg] >= 0.0:
+                w_rows[rw, :3] = normal[leg]
+                w_rows[rw, 3:] = 0.0
+                w_about[rw] = pts[leg]
+                w_weight[rw] = unload_w[leg]
+                w_mask[rw, nc] = 1.0
+                rw += 1
+            nc += 1
+        else:
+            _matvec(foot_jac[leg], qvel, vel[:3])
+            _matvec(foot_jdot[leg], qvel, drift[:3])
+            for i in range(3):
+                acc = (
+                    row[FEET_A + 3 * leg + i]
+                    + gains[SWING_KP] * (row[FEET + 3 * leg + i] - pts[leg, i])
+                    + gains[SWING_KD] * (row[FEET_V + 3 * leg + i] - vel[i])
+                )
+                m_jac[rm] = foot_jac[leg, i]
+                m_rhs[rm] = acc - drift[i]
+                m_w[rm] = gains[SWING_W]
+                rm += 1
+    _matvec(trunk_jac, qvel, vel)
+    _matvec(trunk_jdot, qvel, drift)
+    for i in range(3):
+        acc = (
+            row[BODY_A + i]
+            + gains[TRUNK_KP] * (row[BODY + i] - trunk_pos[i])
+            - gains[TRUNK_KD] * (vel[i] - row[BODY_V + i])
+        )
+        m_jac[rm + i] = trunk_jac[i]
+        m_rhs[rm + i] = acc - drift[i]
+        m_w[rm + i] = gains[TRUNK_W]
+        acc = gains[ROT_KP] * err[i] - gains[ROT_KD] * vel[3 + i]
+        m_jac[rm + 3 + i] = trunk_jac[3 + i]
+        m_rhs[rm + 3 + i] = acc - drift[3 + i]
+        m_w[rm + 3 + i] = gains[ROT_W]
+    rm += 6
+    for j in range(joint_dofs.shape[0]):
+        dof = joint_dofs[j]
+        acc = gains[POSTURE_KP] * (row[JOINTS + j] - q_joints[j]) + gains[POSTURE_KD] * (
+            row[JOINTS_V + j] - qvel[dof]
+        )
+        for a in range(nv):
+            m_jac[rm, a] = 0.0
+        m_jac[rm, dof] = 1.0
+        m_rhs[rm] = acc - 0.0  # the posture task's zero drift
+        m_w[rm] = gains[POSTURE_W]
+        rm += 1
+    if nc > 0 and gains[COP_W] > 0:
+        # the horizontal moment (mx, my) about the planned ZMP at the stance points' mean height
+        zp = height_sum / nc
+        for i in range(2):
+            w_rows[rw + i] = 0.0
+            w_rows[rw + i, 3 + i] = 1.0
+            w_about[rw + i, 0] = row[ZMP]
+            w_about[rw + i, 1] = row[ZMP + 1]
+            w_about[rw + i, 2] = zp
+            w_weight[rw + i] = gains[COP_W]
+            w_mask[rw + i, :nc] = 1.0
+        rw += 2
+    qp = assemble(
+        mass,
+        bias,
+        actuated,
+        unactuated,
+        torque_min,
+        torque_max,
+        c_jac[:nc],
+        c_drift[:nc],
+        c_origin[:nc],
+        c_points[:nc],
+        n_points[:nc],
+        c_normal[:nc],
+        c_tangent[:nc],
+        friction[:nc],
+        min_normal[:nc],
+        m_jac[:rm],
+        m_rhs[:rm],
+        m_w[:rm],
+        w_rows[:rw],
+        w_about[:rw],
+        w_target[:rw],
+        w_weight[:rw],
+        w_mask[:rw, :nc],
+        eps[0],
+        eps[1],
+        eps[2],
+    )
+    return nc, rm, rw, qp

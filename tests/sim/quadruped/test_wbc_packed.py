@@ -1,0 +1,136 @@
+"""The quadruped's whole-body tick packs its QP straight into arrays (sim/quadruped/_wbc_tick.py):
+tick by tick on a walk it gives the torques of the problem built the plain way, from the
+Contact / MotionTask / WrenchTask dataclasses of control/wbc.py (the reference below, the
+controller's tick before the packing was compiled), and its rebuilt ``last_problem`` solves to
+its own solution."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+mujoco = pytest.importorskip("mujoco")
+
+from footfall._geometry import rotation_log  # noqa: E402
+from footfall.control.wbc import (  # noqa: E402
+    Contact,
+    MotionTask,
+    WbcProblem,
+    WholeBodyController,
+    WrenchTask,
+)
+from footfall.quadruped import GaitParams, QuadrupedRobot, plan_gait  # noqa: E402
+from footfall.quadruped.ground import VaryingSlope  # noqa: E402
+from footfall.sim.quadruped.sim import QuadrupedSim  # noqa: E402
+from footfall.sim.quadruped.wbc import QuadrupedWbc, QuadrupedWbcGains, _surface  # noqa: E402
+
+#: fast vs reference torques [N m]: the same algebra, summed in other orders
+TORQUE_TOL = 1e-9
+
+
+def _reference_problem(wbc: QuadrupedWbc, t: float) -> WbcProblem:
+    """The tick's problem from the dataclasses, at the state in ``wbc.sim.data``."""
+    sim, d, g, ref = wbc.sim, wbc.sim.data, wbc.gains, wbc.ref
+    k, w = ref.at(t)
+    row = (1.0 - w) * ref.table[k] + w * ref.table[k + 1]
+    body, body_v, body_a = row[0:3], row[3:6], row[6:9]
+    feet, feet_v, feet_a = (row[a : a + 12].reshape(4, 3) for a in (9, 21, 33))
+    joints, joints_v, zmp, pitch = row[45:57], row[57:69], row[69:71], row[71]
+    qvel = d.qvel
+    stance = ref.contact[k] if w < 0.5 else ref.contact[k + 1]
+    to_switch = ref.to_switch[k] - w * ref.dt
+    touching = wbc._touching()
+    contacts, tasks, wrench, heights = [], [], [], []
+    for leg in range(4):
+        centre = d.site_xpos[sim.foot_sites[leg]]
+        if stance[leg] or (touching[leg] and to_switch[leg] <= g.touchdown_window):
+            normal, tangent = _surface(wbc.ground.normal(centre[0], centre[1]))
+            normal_force = np.concatenate([normal, np.zeros(3)]).reshape(1, 6)
+            pt = centre - wbc.radius * normal
+            jac, drift = wbc.model.frame(wbc.foot_bodies[leg], pt, angular=False)
+            name = f"foot{leg}"
+            contacts.append(Contact.point(name, jac, drift, pt, normal, wbc.friction, 0.0, tangent))
+            heights.append(pt[2])
+            if stance[leg] and g.unload_time > 0 and to_switch[leg] < g.unload_time:
+                share = 1.0 - max(to_switch[leg], 0.0) / g.unload_time
+                weight = g.unload_weight * share
+                wrench.append(
+                    WrenchTask(f"unload{leg}", pt, normal_force, np.zeros(1), weight, (name,))
+                )
+        else:
+            jac, drift = wbc.model.frame(wbc.foot_bodies[leg], centre, angular=False)
+            acc = feet_a[leg] + g.swing_kp * (feet[leg] - centre)
+            acc = acc + g.swing_kd * (feet_v[leg] - jac @ qvel)
+            tasks.append(MotionTask(f"swing{leg}", jac, drift, acc, g.swing_weight))
+    pos = d.xpos[sim.trunk]
+    jac, drift = wbc.model.frame(sim.trunk, pos)
+    vel = jac @ qvel
+    acc_lin = body_a + g.trunk_kp * (body - pos) - g.trunk_kd * (vel[:3] - body_v)
+    c, s = math.cos(-pitch), math.sin(-pitch)
+    plan_rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+    err = rotation_log(plan_rot @ d.xmat[sim.trunk].reshape(3, 3).T)
+    acc_ang = g.rot_kp * err - g.rot_kd * vel[3:]
+    tasks.append(MotionTask("trunk", jac[:3], drift[:3], acc_lin, g.trunk_weight))
+    tasks.append(MotionTask("trunk_rot", jac[3:], drift[3:], acc_ang, g.rot_weight))
+    dofs = wbc.joint_dofs
+    select = np.zeros((dofs.size, wbc.model.nv))
+    select[np.arange(dofs.size), dofs] = 1.0
+    acc_q = g.posture_kp * (joints - d.qpos[sim.qpos_adr])
+    acc_q = acc_q + g.posture_kd * (joints_v - qvel[dofs])
+    tasks.append(MotionTask("posture", select, np.zeros(dofs.size), acc_q, g.posture_weight))
+    if heights and g.cop_weight > 0:
+        about = np.array([zmp[0], zmp[1], sum(heights) / len(heights)])
+        rows = np.array([[0, 0, 0, 1.0, 0, 0], [0, 0, 0, 0, 1.0, 0]])
+        wrench.append(WrenchTask("cop", about, rows, np.zeros(2), g.cop_weight))
+    mass, bias = wbc.model.dynamics()
+    return WbcProblem(
+        mass_matrix=mass,
+        bias=bias,
+        actuated=wbc.model.actuated,
+        torque_min=wbc.model.torque_min,
+        torque_max=wbc.model.torque_max,
+        contacts=tuple(contacts),
+        motion_tasks=tuple(tasks),
+        wrench_tasks=tuple(wrench),
+    )
+
+
+@pytest.mark.parametrize(
+    "params",
+    [
+        GaitParams(slope=math.radians(15), body_pitch=math.radians(10), cycles=1),
+        GaitParams(slope=0.0, body_pitch=0.0, ground=VaryingSlope((0.3, 1.3), (0.0, 0.26))),
+    ],
+    ids=["plane", "varying_slope"],
+)
+def test_packed_tick_equals_the_dataclass_problem_tick_by_tick(params: GaitParams) -> None:
+    plan = plan_gait(QuadrupedRobot(), params)
+    ref = plan.sample(0.01)
+    sim = QuadrupedSim(plan.robot, plan.ground)
+    sim.set_pose(ref.body_pos[0], float(ref.body_pitch[0]), ref.joints[0])
+    wbc = QuadrupedWbc(sim, ref, plan.ground, QuadrupedWbcGains())
+    plain, rebuilt = WholeBodyController(), WholeBodyController()
+    m, d = sim.model, sim.data
+    n_contacts = set()
+    steps = round(float(ref.t[-1]) / m.opt.timestep)
+    for i in range(0, steps, 2):  # the QP every 2nd step, as simulate()
+        mujoco.mj_step1(m, d)
+        t = i * m.opt.timestep
+        expected = plain.solve(_reference_problem(wbc, t))
+        tau = wbc.torques(t)
+        np.testing.assert_allclose(tau, expected.torque, rtol=0, atol=TORQUE_TOL)
+        problem, sol = wbc.last_problem, wbc.last
+        assert problem is not None and sol is not None
+        assert [c.name for c in problem.contacts] == list(expected.forces)
+        for name, f in expected.forces.items():
+            np.testing.assert_allclose(sol.forces[name], f, rtol=0, atol=TORQUE_TOL)
+        np.testing.assert_allclose(rebuilt.solve(problem).torque, tau, rtol=0, atol=1e-12)
+        n_contacts.add(len(problem.contacts))
+        d.ctrl[sim.actuators] = tau
+        mujoco.mj_step2(m, d)
+        mujoco.mj_step1(m, d)
+        mujoco.mj_step2(m, d)
+    assert wbc.failures == 0 and plain.failures == 0
+    assert {3, 4} <= n_contacts  # swings and four-foot stances were both compared
