@@ -3,6 +3,7 @@ walk gait on the document's 15 degree slope; success (no fall, >= 90 % of the se
 distance without a push) per impulse and controller, Wilson 95 % intervals, paired McNemar.
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_quadruped_pushes.py --seeds 10 --impulses 20,40,60
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_quadruped_pushes.py --scene stairs_10cm --cycles 8
 
 Trial ``s`` pushes sideways (+y or -y from the seed) for 0.1 s at a seeded time within a seeded
 body shift or swing of cycles 2-4; both controllers get the same push (paired).
@@ -12,11 +13,13 @@ from __future__ import annotations
 
 import argparse
 import math
+from dataclasses import replace
 
 import numpy as np
 from scipy import stats
 
 from footfall.quadruped import GaitParams, QuadrupedRobot, plan_gait
+from footfall.quadruped.scene import resolve_quadruped_scene
 from footfall.sim.pushes import Push
 from footfall.sim.quadruped.sim import simulate
 
@@ -37,19 +40,26 @@ def main() -> None:
     ap.add_argument("--slope-deg", type=float, default=15.0)
     ap.add_argument("--body-deg", type=float, default=10.0)
     ap.add_argument("--cycles", type=int, default=4)
+    ap.add_argument(
+        "--scene", default=None, help="a quadruped scene (name or YAML) instead of the slope"
+    )
     args = ap.parse_args()
-    plan = plan_gait(
-        QuadrupedRobot(),
-        GaitParams(
+    if args.scene is not None:
+        sc = resolve_quadruped_scene(args.scene)
+        params = replace(sc.params, cycles=args.cycles)
+        what = sc.name
+    else:
+        params = GaitParams(
             slope=math.radians(args.slope_deg),
             body_pitch=math.radians(args.body_deg),
             cycles=args.cycles,
-        ),
-    )
+        )
+        what = f"{args.slope_deg:g} deg"
+    plan = plan_gait(QuadrupedRobot(), params)
     base = simulate(plan).metrics.distance_up_slope_m
     cycle = plan.duration / args.cycles
     print(
-        f"{args.slope_deg:g} deg, {args.cycles} cycles ({plan.duration:.1f} s), "
+        f"{what}, {args.cycles} cycles ({plan.duration:.1f} s), "
         f"servo distance without push {base:.2f} m"
     )
     for imp in (float(x) for x in args.impulses.split(",")):

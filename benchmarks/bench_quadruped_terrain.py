@@ -85,7 +85,9 @@ def main() -> None:
     for name in builtin_quadruped_scene_names():
         sc = builtin_quadruped_scene(name)
         params = sc.params
-        scene_settings = settings if sc.friction is None else replace(settings, friction=sc.friction)
+        scene_settings = (
+            settings if sc.friction is None else replace(settings, friction=sc.friction)
+        )
         cells = _cells(plan_gait(robot, params), scene_settings)
         print(f"| {name} ({params.cycles}) | " + " | ".join(cells) + " |", flush=True)
 
