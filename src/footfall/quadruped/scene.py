@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from importlib import resources
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -19,7 +18,14 @@ from footfall.errors import InputError, SceneError
 from footfall.quadruped.gait import GaitParams
 from footfall.quadruped.ground import PlaneGround, QuadrupedGround, Stairs, VaryingSlope
 from footfall.quadruped.zmp_planning import ZmpStrategy
-from footfall.terrain.scene import StrictSpec, YamlLocator, read_yaml, validate_yaml
+from footfall.terrain.scene import (
+    StrictSpec,
+    YamlLocator,
+    packaged_scene_names,
+    packaged_scene_text,
+    read_yaml,
+    validate_yaml,
+)
 
 #: most knots of a varying slope
 MAX_KNOTS = 1000
@@ -197,17 +203,12 @@ def load_quadruped_scene(path_or_text: str | Path) -> QuadrupedScene:
 
 def builtin_quadruped_scene_names() -> list[str]:
     """Names of the scenes shipped in ``footfall/quadruped/scenes/*.yaml``, sorted."""
-    folder = resources.files("footfall.quadruped").joinpath("scenes")
-    return sorted(p.name[: -len(".yaml")] for p in folder.iterdir() if p.name.endswith(".yaml"))
+    return packaged_scene_names("footfall.quadruped")
 
 
 def builtin_quadruped_scene(name: str) -> QuadrupedScene:
     """Load the built-in quadruped scene ``name`` (see :func:`builtin_quadruped_scene_names`)."""
-    names = builtin_quadruped_scene_names()
-    if name not in names:
-        raise SceneError("scene", name, f"one of {', '.join(names)}")
-    text = resources.files("footfall.quadruped").joinpath("scenes", f"{name}.yaml").read_text()
-    return load_quadruped_scene(text)
+    return load_quadruped_scene(packaged_scene_text("footfall.quadruped", name))
 
 
 def resolve_quadruped_scene(name_or_path: str) -> QuadrupedScene:

@@ -593,18 +593,28 @@ def scene_to_yaml(scene: Scene) -> str:
 
 
 # ============================================================================= built-in scenes
+def packaged_scene_names(package: str) -> list[str]:
+    """Names of the YAML files shipped in ``<package>/scenes/``, sorted."""
+    folder = resources.files(package).joinpath("scenes")
+    return sorted(p.name[: -len(".yaml")] for p in folder.iterdir() if p.name.endswith(".yaml"))
+
+
+def packaged_scene_text(package: str, name: str) -> str:
+    """The text of ``<package>/scenes/<name>.yaml`` (an error listing the names otherwise)."""
+    names = packaged_scene_names(package)
+    if name not in names:
+        raise SceneError("scene", name, f"one of {', '.join(names)}")
+    return resources.files(package).joinpath("scenes", f"{name}.yaml").read_text()
+
+
 def builtin_scene_names() -> list[str]:
     """Names of the scenes shipped in ``footfall/terrain/scenes/*.yaml``, sorted."""
-    folder = resources.files("footfall.terrain").joinpath("scenes")
-    return sorted(p.name[: -len(".yaml")] for p in folder.iterdir() if p.name.endswith(".yaml"))
+    return packaged_scene_names("footfall.terrain")
 
 
 def builtin_scene(name: str) -> Scene:
     """Load the built-in scene ``name`` (see :func:`builtin_scene_names`)."""
-    names = builtin_scene_names()
-    if name not in names:
-        raise SceneError("scene", name, f"one of {', '.join(names)}")
-    text = resources.files("footfall.terrain").joinpath("scenes", f"{name}.yaml").read_text()
+    text = packaged_scene_text("footfall.terrain", name)
     try:
         return load_scene(text)
     except SceneError as e:  # pragma: no cover - the shipped files are tested
