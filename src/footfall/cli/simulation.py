@@ -87,7 +87,7 @@ def quadruped_cmd(
     on_slip: str = typer.Option(
         "off",
         help="Slip guard: off, or stop (when a foot slides more than --slip-limit in one stance, "
-        "finish the current swing or shift, then hold the four-foot stance).",
+        "land the swinging foot, if any, then hold the four-foot stance).",
     ),
     slip_limit: float = typer.Option(
         0.03, help="Slip guard limit: a foot's sliding in one stance [m]."

@@ -44,6 +44,9 @@ def _one_tick(t: float) -> tuple[QuadrupedSim, QuadrupedWbc]:
     ref = plan.sample(0.01)
     sim = QuadrupedSim(plan.robot, plan.posture.slope)
     sim.set_pose(ref.body_pos[0], float(ref.body_pitch[0]), ref.joints[0])
+    # 1 mm lower, so that every foot touches (the pose puts them exactly on the ground, and a
+    # planned stance foot counts as a contact only while it touches)
+    sim.data.qpos[sim.root_adr + 2] -= 1e-3
     sim.data.qvel[:] = np.random.default_rng(0).normal(0.0, 0.05, sim.model.nv)
     mujoco.mj_forward(sim.model, sim.data)
     wbc = QuadrupedWbc(sim, ref, plan.ground, QuadrupedWbcGains())

@@ -45,7 +45,8 @@ def _reference_problem(wbc: QuadrupedWbc, t: float) -> WbcProblem:
     contacts, tasks, wrench, heights = [], [], [], []
     for leg in range(4):
         centre = d.site_xpos[sim.foot_sites[leg]]
-        if stance[leg] or (touching[leg] and to_switch[leg] <= g.touchdown_window):
+        early = touching[leg] and to_switch[leg] <= g.touchdown_window
+        if (stance[leg] and touching[leg]) or early:
             normal, tangent = _surface(wbc.ground.normal(centre[0], centre[1]))
             normal_force = np.concatenate([normal, np.zeros(3)]).reshape(1, 6)
             pt = centre - wbc.radius * normal
@@ -60,9 +61,14 @@ def _reference_problem(wbc: QuadrupedWbc, t: float) -> WbcProblem:
                     WrenchTask(f"unload{leg}", pt, normal_force, np.zeros(1), weight, (name,))
                 )
         else:
+            target, target_v, target_a = feet[leg], feet_v[leg], feet_a[leg]
+            if stance[leg]:  # planned down but off the ground: reach below the foothold
+                n = wbc.ground.normal(centre[0], centre[1])
+                target = target - g.reach_depth * n
+                target_v, target_a = -g.reach_speed * n, np.zeros(3)
             jac, drift = wbc.model.frame(wbc.foot_bodies[leg], centre, angular=False)
-            acc = feet_a[leg] + g.swing_kp * (feet[leg] - centre)
-            acc = acc + g.swing_kd * (feet_v[leg] - jac @ qvel)
+            acc = target_a + g.swing_kp * (target - centre)
+            acc = acc + g.swing_kd * (target_v - jac @ qvel)
             tasks.append(MotionTask(f"swing{leg}", jac, drift, acc, g.swing_weight))
     pos = d.xpos[sim.trunk]
     jac, drift = wbc.model.frame(sim.trunk, pos)
@@ -114,11 +120,15 @@ def test_packed_tick_equals_the_dataclass_problem_tick_by_tick(params: GaitParam
     plain, rebuilt = WholeBodyController(), WholeBodyController()
     m, d = sim.model, sim.data
     n_contacts = set()
+    late = 0  # ticks with a planned stance foot off the ground (reaching down)
     steps = round(float(ref.t[-1]) / m.opt.timestep)
     for i in range(0, steps, 2):  # the QP every 2nd step, as simulate()
         mujoco.mj_step1(m, d)
         t = i * m.opt.timestep
         expected = plain.solve(_reference_problem(wbc, t))
+        k, w = wbc.ref.at(t)
+        stance = wbc.ref.contact[k] if w < 0.5 else wbc.ref.contact[k + 1]
+        late += int(any(s and not on for s, on in zip(stance, wbc._touching(), strict=True)))
         tau = wbc.torques(t)
         np.testing.assert_allclose(tau, expected.torque, rtol=0, atol=TORQUE_TOL)
         problem, sol = wbc.last_problem, wbc.last
@@ -134,3 +144,4 @@ def test_packed_tick_equals_the_dataclass_problem_tick_by_tick(params: GaitParam
         mujoco.mj_step2(m, d)
     assert wbc.failures == 0 and plain.failures == 0
     assert {3, 4} <= n_contacts  # swings and four-foot stances were both compared
+    assert late > 0  # and feet reaching down for the ground

@@ -193,8 +193,10 @@ class SimResult:
         n_contacts: number of feet in contact, shape (T,).
         feet: measured foot centres, shape (T, 4, 3) [m].
         slip_vel: tangential velocity of each foot's material point at its ground contact,
-            shape (T, 4, 3) [m/s] (zero when the foot is off the ground). A rolling sphere has
-            none, so this is true sliding, not the rolling of the spherical foot.
+            shape (T, 4, 3) [m/s]. A rolling sphere has none, so this is true sliding, not the
+            rolling of the spherical foot. A foot planned in stance but off the ground (it
+            bounced, or the ground is lower than planned) slides with its centre: the centre's
+            velocity along the ground; a swing foot off the ground has none.
         planned: the commanded references at the same instants: the plan, held on four feet
             from the slip guard's stop on (:mod:`.slip`; the plan itself without a stop).
         metrics: summary numbers (see :func:`summarise`).
@@ -435,6 +437,14 @@ class _Recorder:
         for j in range(idx.size):
             normal = self.ground.normal(float(pts[j, 0]), float(pts[j, 1]))
             self.slip_vel[k, idx[j]] = sim.contact_slip_velocity(idx[j], pts[j], normal)
+        # a planned stance foot off the ground (bouncing, or the ground lower than planned)
+        # moves with its whole centre: that motion along the ground is slip too
+        stance = self.planned.contact[k]
+        for leg in range(4):
+            if stance[leg] and not np.any(idx == leg):
+                c = self.feet[k, leg]
+                normal = self.ground.normal(float(c[0]), float(c[1]))
+                self.slip_vel[k, leg] = sim.contact_slip_velocity(leg, c, normal)
         if math.isnan(self.fallen_at) and (trunk_hit or self._fallen(k)):
             self.fallen_at = float(self.t[k])
 

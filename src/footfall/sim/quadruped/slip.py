@@ -7,9 +7,9 @@ integrated over one planned stance of that foot. The same sum serves two purpose
 - :func:`stance_slips`, after the walk: one :class:`StanceSlip` per planned stance of every foot;
 - :class:`SlipMonitor`, during the walk: the sum so far of each stance foot, one control sample
   at a time from the sample just measured (causal: no later sample is read). When a foot's slip
-  in its current stance exceeds :attr:`SlipGuard.limit`, the guard acts. ``stop``: the gait
-  finishes the phase it is in (a swing lands its foot, a body shift reaches its end at rest) and
-  then holds that four-foot stance for the rest of the run: the commanded reference stops
+  in its current stance exceeds :attr:`SlipGuard.limit`, the guard acts. ``stop``: a swing
+  first lands its foot; in a body shift or the final hold (all four feet down) the gait holds at
+  once. The four-foot stance is then held for the rest of the run: the commanded reference stops
   advancing (:func:`held_reference`) while the physics goes on, so the run shows whether the
   robot stays put.
 
@@ -48,7 +48,7 @@ class SlipGuard:
     Attributes:
         limit: a foot's sliding displacement in its current planned stance above which the guard
             acts [m] (> 0).
-        action: ``stop``: finish the current phase, then hold the four-foot stance.
+        action: ``stop``: land the swinging foot (if any), then hold the four-foot stance.
     """
 
     limit: float = DEFAULT_SLIP_LIMIT
@@ -152,11 +152,12 @@ def stance_slips(
 
 
 def hold_index(ref: GaitTrajectory, plan: GaitPlan, k: int) -> int:
-    """The first sample at or after ``k`` where the walk can hold still on four feet: the first
-    sample of the next phase (``k`` itself in the final hold, the last sample when no phase
+    """The first sample at or after ``k`` where the walk can hold still on four feet: ``k``
+    itself in a body shift or the final hold (every foot is down; a shift that went on to its end
+    let a sliding robot run away), the first sample after a swing (the last sample when no phase
     follows)."""
     phase = int(ref.phase[k])
-    if plan.phases[phase].kind is PhaseKind.HOLD:
+    if plan.phases[phase].kind is not PhaseKind.SWING:
         return k
     later = np.flatnonzero(ref.phase[k:] != phase)
     return k + int(later[0]) if later.size else ref.t.shape[0] - 1

@@ -42,7 +42,7 @@ from footfall.control.wbc import (
 from footfall.errors import InputError, SolverError
 from footfall.quadruped.gait import GaitTrajectory
 from footfall.quadruped.ground import PlaneGround, QuadrupedGround
-from footfall.sim.quadruped._wbc_tick import FIXED_MOTION_ROWS, pack_tick
+from footfall.sim.quadruped._wbc_tick import FEET, FEET_A, FEET_V, FIXED_MOTION_ROWS, pack_tick
 from footfall.sim.wbc_model import MujocoWbcModel
 
 
@@ -64,6 +64,10 @@ class QuadrupedWbcGains:
         unload_weight: weight of that task at lift-off [1/N^2] (ramping up from 0).
         touchdown_window: a swing foot that touches the ground this close [s] before its planned
             touchdown becomes a contact at once (the QP then chooses its force).
+        reach_depth, reach_speed: a planned stance foot that does not touch the ground (the
+            ground lower than planned, or a foot that bounced off) is not a contact: its target
+            moves this far [m] below the foothold along the normal, at this speed [m/s], until
+            it touches.
         qp_every: physics steps per QP solve (the torques are held in between).
     """
 
@@ -83,6 +87,8 @@ class QuadrupedWbcGains:
     unload_time: float = 0.05
     unload_weight: float = 1e-5
     touchdown_window: float = 0.05
+    reach_depth: float = 0.01
+    reach_speed: float = 0.1
     qp_every: int = 2
 
     def __post_init__(self) -> None:
@@ -369,9 +375,21 @@ class QuadrupedWbc:
         """The last solution (None before the first solve)."""
         return None if self._last is None else self._last.solution()
 
-    def _feet(self, buf: _Buffers, k: int, w: float) -> None:
+    def _reach_down(self, row: FloatArray, leg: int, centre: FloatArray) -> None:
+        """Point the plan row's swing target of ``leg`` (a stance foot still in the air) below
+        the ground: at the planned foothold minus ``reach_depth`` along the normal, moving into
+        the ground at ``reach_speed``, without acceleration."""
+        g = self.gains
+        normal = self.ground.normal(float(centre[0]), float(centre[1]))
+        f = FEET + 3 * leg
+        row[f : f + 3] -= g.reach_depth * normal
+        row[FEET_V + 3 * leg : FEET_V + 3 * leg + 3] = -g.reach_speed * normal
+        row[FEET_A + 3 * leg : FEET_A + 3 * leg + 3] = 0.0
+
+    def _feet(self, buf: _Buffers, k: int, w: float, row: FloatArray) -> None:
         """Each foot's part of the tick at plan sample ``k``, weight ``w``, into ``buf``: a
-        contact or not, its contact normal, unload weight, point and that point's Jacobians."""
+        contact or not, its contact normal, unload weight, point and that point's Jacobians
+        (``row``: the interpolated plan, whose swing target of a late foot is moved down)."""
         sim, d, g, ref = self.sim, self.sim.data, self.gains, self.ref
         stance = ref.contact[k] if w < 0.5 else ref.contact[k + 1]
         to_switch = ref.to_switch[k] - w * ref.dt
@@ -379,7 +397,12 @@ class QuadrupedWbc:
         centres = d.site_xpos[sim.foot_sites]
         for leg in range(4):
             early = touching[leg] and to_switch[leg] <= g.touchdown_window
-            buf.contact[leg] = is_contact = bool(stance[leg] or early)
+            # a planned stance foot is a contact while it touches the ground; off it (the ground
+            # lower than planned, or a foot that bounced) it reaches down instead of the QP
+            # counting on a force that the ground cannot give
+            buf.contact[leg] = is_contact = bool((stance[leg] and touching[leg]) or early)
+            if stance[leg] and not is_contact:
+                self._reach_down(row, leg, centres[leg])
             buf.unload_w[leg] = -1.0
             if is_contact:
                 if self._plane is None:
@@ -406,7 +429,7 @@ class QuadrupedWbc:
         row = (1.0 - w) * ref.table[k] + w * ref.table[k + 1]
         # fill the buffers that do not hold the last solved problem
         buf = self._buffers[1] if self._last is self._buffers[0] else self._buffers[0]
-        self._feet(buf, k, w)
+        self._feet(buf, k, w, row)
         trunk_pos = d.xpos[sim.trunk]
         self.model.jacobians(sim.trunk, trunk_pos, buf.trunk_jac, buf.trunk_jdot)
         # the planned orientation: nose-up pitch is a rotation about y by -pitch
