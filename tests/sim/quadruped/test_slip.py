@@ -250,26 +250,23 @@ def test_the_guard_does_not_trigger_on_the_nominal_15_deg_walk() -> None:
 
 
 def test_the_guard_stops_the_whole_body_controller_on_a_slippery_climb() -> None:
-    """30 deg up at friction 0.6 (the cone's edge is 31 deg): the wbc slides a few cm per
-    stance; the guard holds it mid-shift and the trunk then stays within 2 cm, against 13 cm of
-    motion of the unguarded walk over the same window."""
+    """30 deg up at friction 0.6 (the cone's edge is 31 deg), two cycles: a foot of the wbc walk
+    slides past the limit in the second cycle; the gait lands the swinging foot and holds, and
+    the robot stays put (the trunk within 3 cm over the five seconds held)."""
     pytest.importorskip("mujoco")
     from footfall.sim._mjcf import SimSettings
     from footfall.sim.quadruped.sim import simulate
 
-    plan = _plan(30.0)
+    plan = _plan(30.0, cycles=2)
     res = simulate(plan, SimSettings(friction=SLIPPERY), controller="wbc", slip_guard=SlipGuard())
     ev = res.slip_stop
     assert ev is not None
     hold = res.t >= ev.hold_time_s - 1e-9
-    assert hold.sum() > 100  # at least a second held
+    assert hold.sum() > 400  # more than four seconds held
     assert res.planned.contact[hold].all()
     assert not res.metrics.fell
     assert res.qp_failures == 0
-    held = np.linalg.norm(res.trunk_pos[hold][-1] - res.trunk_pos[hold][0])
-    free = simulate(plan, SimSettings(friction=SLIPPERY), controller="wbc")
-    moved = np.linalg.norm(free.trunk_pos[hold][-1] - free.trunk_pos[hold][0])
-    assert held < 0.02 < 0.1 < moved
+    assert np.linalg.norm(res.trunk_pos[hold][-1] - res.trunk_pos[hold][0]) < 0.03
 
 
 def test_simulate_refuses_a_guard_of_the_wrong_type() -> None:

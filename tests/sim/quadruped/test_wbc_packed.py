@@ -62,7 +62,7 @@ def _reference_problem(wbc: QuadrupedWbc, t: float) -> WbcProblem:
                 )
         else:
             target, target_v, target_a = feet[leg], feet_v[leg], feet_a[leg]
-            if stance[leg]:  # planned down but off the ground: reach below the foothold
+            if stance[leg] and to_switch[leg] >= g.unload_time:  # off the ground, not lifting
                 n = wbc.ground.normal(centre[0], centre[1])
                 target = target - g.reach_depth * n
                 target_v, target_a = -g.reach_speed * n, np.zeros(3)

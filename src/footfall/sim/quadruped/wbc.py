@@ -67,7 +67,7 @@ class QuadrupedWbcGains:
         reach_depth, reach_speed: a planned stance foot that does not touch the ground (the
             ground lower than planned, or a foot that bounced off) is not a contact: its target
             moves this far [m] below the foothold along the normal, at this speed [m/s], until
-            it touches.
+            it touches (in its unload window before lift-off it is let go instead).
         qp_every: physics steps per QP solve (the torques are held in between).
     """
 
@@ -401,7 +401,8 @@ class QuadrupedWbc:
             # lower than planned, or a foot that bounced) it reaches down instead of the QP
             # counting on a force that the ground cannot give
             buf.contact[leg] = is_contact = bool((stance[leg] and touching[leg]) or early)
-            if stance[leg] and not is_contact:
+            # (a foot leaving in its unload window is let go: it lifts off a little early)
+            if stance[leg] and not is_contact and to_switch[leg] >= g.unload_time:
                 self._reach_down(row, leg, centres[leg])
             buf.unload_w[leg] = -1.0
             if is_contact:
