@@ -117,6 +117,7 @@ def test_stairs_clearance_sees_the_edge() -> None:
         (lambda: Stairs(rise=-0.1), "rise"),
         (lambda: Stairs(steps=0), "steps"),
         (lambda: Stairs(steps=True), "steps"),  # type: ignore[arg-type]
+        (lambda: Stairs(steps=100_000_000), "steps"),
         (lambda: Stairs(rise=1.0, run=0.4), "rise"),
     ],
 )

@@ -29,6 +29,8 @@ from footfall.errors import InputError
 
 #: steepest inclination a ground may have anywhere (as for the document's slope)
 MAX_INCLINATION = math.radians(60.0)
+#: most steps of a flight of stairs (each is a MuJoCo box)
+MAX_STEPS = 1000
 #: Newton iterations for a step of a given chord length on a varying slope
 _CHORD_ITERATIONS = 30
 
@@ -212,8 +214,9 @@ class Stairs:
     def __post_init__(self) -> None:
         for name in ("rise", "run", "start_x", "landing", "edge_margin"):
             object.__setattr__(self, name, positive(name, getattr(self, name)))
-        if isinstance(self.steps, bool) or not isinstance(self.steps, int) or self.steps < 1:
-            raise InputError("steps", self.steps, "an integer >= 1")
+        steps = self.steps
+        if isinstance(steps, bool) or not isinstance(steps, int) or not 1 <= steps <= MAX_STEPS:
+            raise InputError("steps", steps, f"an integer in 1..{MAX_STEPS}")
         if math.atan2(self.rise, self.run) > MAX_INCLINATION:
             raise InputError("rise", self.rise, f"at most run * tan(60 deg) = {self.run:.3f} m")
 
