@@ -97,3 +97,38 @@ def test_a_planner_revision_makes_its_old_entries_miss(monkeypatch) -> None:  # 
     unrevised = plan_key(sc, "reactive", None, opts)
     monkeypatch.setitem(cache_mod.PLANNER_REVISION, "reactive", 2)
     assert plan_key(sc, "reactive", None, opts) != unrevised
+
+
+def test_the_shipped_study_plans_are_still_cache_hits(tmp_path: Path) -> None:
+    """The section 5.5 study's plans ship in the repository (minutes of planning each); a new
+    planner option or search setting must not silently turn them into misses."""
+    import shutil
+
+    from footfall.experiments.study import builtin_study
+    from footfall.sim.biped.plans import plan_for_walk
+    from footfall.terrain import builtin_scene
+
+    design = builtin_study("section55")
+    shipped = Path(__file__).parents[2] / "benchmarks" / "study" / "section55" / "plans"
+    shutil.copytree(shipped, tmp_path / "plans")
+    for name in design.scenes:
+        for planner in design.planners:
+            plan = plan_for_walk(
+                builtin_scene(name), planner, None, design.time_limit, tmp_path / "plans"
+            )
+            assert "loaded from cache" in plan.message, (name, planner, plan.message)
+
+
+def test_search_switches_leave_the_key_alone_other_settings_change_it() -> None:
+    import dataclasses
+
+    from footfall.planning import cache as cache_mod
+    from footfall.solvers.settings import BnbSettings
+
+    sc, opts = scene(SHORT_FLAT), PlannerOptions()
+    key = plan_key(sc, "miqcqp", None, opts)
+    for name in cache_mod.KEY_NEUTRAL_BNB:
+        flipped = BnbSettings(**{name: not getattr(BnbSettings(), name)})
+        assert plan_key(sc, "miqcqp", None, dataclasses.replace(opts, bnb=flipped)) == key
+    other = dataclasses.replace(opts, bnb=BnbSettings(probe_rounds=0))
+    assert plan_key(sc, "miqcqp", None, other) != key

@@ -747,3 +747,67 @@ def test_bnb_settings_travel_with_the_options_and_serialise() -> None:
 def test_pinned_optimum_is_scips() -> None:
     """The pinned SCIP optima still belong to the model (the cheapest one, 6 s, re-solved)."""
     assert _scip_optimum(8, 0, 7) == pytest.approx(SCIP_OPTIMA_8[0, 7], rel=GAP)
+
+
+#: a robot whose ankle-torque bound U_max (eq. 5.12d), not the reach, decides what is feasible:
+#: on 5-region stones seed 0, N = 6 has kinematic plans but none within 5 N m; N = 7 has plans
+#: whose torque reaches the bound
+WEAK_ANKLE = BipedParams(n_nodes=3, u_max=5.0)
+
+
+def _weak_ankle_problem(n: int):  # type: ignore[no-untyped-def]
+    return build_footstep_problem(random_stepping_stones(0, 5, robot=WEAK_ANKLE), WEAK_ANKLE, n)
+
+
+def test_a_condensed_point_past_the_torque_bound_is_resolved_in_full() -> None:
+    """The condensed relaxation drops the torque cone (its torques are the cost-optimal ones);
+    a point that breaks it is solved again with the full model, whose bound is tighter there.
+    The violation is checked here from the planner's own torque indices, not the relaxation's."""
+    fp = _weak_ankle_problem(7)
+    structure = bnb.analyse(fp.problem)
+    root = branching._root_allowed(structure)
+    plain = bnb.HullRelaxation(structure, settings=BnbSettings(escalate=False)).solve(root)
+    assert plain.status == "solved" and plain.x is not None and not plain.full
+    torque = np.linalg.norm(plain.x[fp.u], axis=-1)  # (N, K-1)
+    assert torque.max() > WEAK_ANKLE.u_max + 1e-3, "the bound does not bind: nothing to test"
+    relax = bnb.HullRelaxation(structure)
+    assert relax.dropped_violation(plain.x) == pytest.approx(
+        torque.max() - WEAK_ANKLE.u_max, rel=1e-9
+    )
+    res = relax.solve(root)
+    assert res.full and relax.escalations == 1
+    assert res.status == "solved" and res.x is not None
+    assert res.bound == pytest.approx(relax.solve(root, full=True).bound, rel=1e-9)
+    assert res.bound > plain.bound
+    assert np.linalg.norm(res.x[fp.u], axis=-1).max() <= WEAK_ANKLE.u_max + 1e-6
+
+
+def test_torque_limited_infeasibility_is_proven_in_few_nodes() -> None:
+    """SCIP, the search without re-solving in full, and the default search all find no plan;
+    without the full model the search must enumerate nearly every assignment to see it."""
+    fp = _weak_ankle_problem(6)
+    assert not fp.problem.bounds_conflict()
+    direct = solve(fp.problem, "scip", SolverOptions(time_limit=120.0))
+    assert direct.status is SolveStatus.INFEASIBLE
+    options = SolverOptions(time_limit=60.0)
+    blind = solve(fp.problem, "bnb", dataclasses.replace(options, bnb=BnbSettings(escalate=False)))
+    res = solve(fp.problem, "bnb", options)
+    assert blind.status is res.status is SolveStatus.INFEASIBLE
+    assert res.stats["nodes"] * 10 < blind.stats["nodes"]
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_torque_limited_optimum_is_scips(threads: int) -> None:
+    fp = _weak_ankle_problem(7)
+    res = solve(fp.problem, "bnb", SolverOptions(gap=GAP, threads=threads))
+    _assert_optimum(res, _weak_ankle_optimum())
+    assert res.x is not None and fp.problem.violation(res.x) <= DEFAULTS.feas_tol
+    # the optimum uses the whole torque bound: the cone the condensed model drops binds
+    assert np.linalg.norm(res.x[fp.u], axis=-1).max() == pytest.approx(WEAK_ANKLE.u_max, abs=1e-6)
+
+
+@functools.cache
+def _weak_ankle_optimum() -> float:
+    res = solve(_weak_ankle_problem(7).problem, "scip", SolverOptions(gap=GAP, time_limit=300.0))
+    assert res.status is SolveStatus.OPTIMAL
+    return res.objective

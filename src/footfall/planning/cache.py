@@ -38,6 +38,10 @@ CACHE_VERSION = 2
 #: (reactive 2: it brakes before the goal). A planner not listed is at revision 1, which is left
 #: out of the key so that its entries stay valid.
 PLANNER_REVISION: dict[str, int] = {"reactive": 2}
+#: ``bnb`` settings left out of the key: they change how the search proves its plan optimal (to
+#: the same problem and gap), not which plan that is, and were added after plans were cached
+#: (the section 5.5 study's plans ship in the repository)
+KEY_NEUTRAL_BNB = ("escalate",)
 #: a cache file larger than this [bytes] is refused (a plan of 100 steps is ~200 kB)
 MAX_CACHE_FILE = 20_000_000
 
@@ -71,10 +75,13 @@ def plan_key(
 ) -> str:
     """The cache key (64 hex digits) of the plan these arguments make (see the module docstring).
 
-    ``options.verbose`` is left out (it changes the log, not the plan).
+    ``options.verbose`` is left out (it changes the log, not the plan), and so are the search
+    switches of ``KEY_NEUTRAL_BNB``.
     """
     opts = _plain(options)
     opts.pop("verbose", None)
+    for name in KEY_NEUTRAL_BNB:
+        opts["bnb"].pop(name, None)
     doc = {
         "version": CACHE_VERSION,
         "scene": _plain(scene_to_dict(scene)),

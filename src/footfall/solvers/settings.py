@@ -59,6 +59,9 @@ class BnbSettings:
             (default True).
         local_solves: with threads >= 2, the search process solves nodes too, beside
             ``threads - 1`` workers, each kept two tasks deep (default False).
+        escalate: a condensed node point that breaks a dropped bound or cone of the eliminated
+            variables (the ALIP states and torques: the torque limit, eq. 5.12d) is solved again
+            with the full model, and so is the node's subtree (default True).
         clarabel: Clarabel settings of the node solves, ``(name, value)`` pairs over Clarabel's
             defaults (default: iterative refinement and equilibration off).
         clarabel_retry: Clarabel settings of the one retry of a node whose solve ended in a status
@@ -95,6 +98,7 @@ class BnbSettings:
     link_min_drop: float = 0.25
     staircase: bool = True
     local_solves: bool = False
+    escalate: bool = True
     clarabel: tuple[tuple[str, bool | int | float], ...] = (
         ("iterative_refinement_enable", False),
         ("equilibrate_enable", False),
@@ -123,7 +127,7 @@ class BnbSettings:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 0:
                 raise InputError(f"bnb.{name}", value, "an integer >= 0")
-        for name in ("compact", "links", "staircase", "local_solves"):
+        for name in ("compact", "links", "staircase", "local_solves", "escalate"):
             if not isinstance(getattr(self, name), bool):
                 raise InputError(f"bnb.{name}", getattr(self, name), "True or False")
         if self.map_depth < 1:

@@ -30,7 +30,12 @@ Relaxation of a node (each group ``G`` may use the members ``Z`` still allowed):
 * Condensed dynamics. Variables that appear only in equality rows, the objective, their bounds and
   cones (the ALIP states and torques) are eliminated: their optimal cost is a convex quadratic of
   the rest, from one KKT solve. Dropping their bounds and cones keeps a lower bound; when a node's
-  recovered point violates one, the node is re-solved with the full model.
+  recovered point violates one (``BnbSettings.escalate``: e.g. the torque limit, eq. 5.12d), the
+  node is re-solved with the full model, and so are its descendants. A condensed point that breaks
+  nothing is feasible for the full relaxation with the same cost, so the bound is the full one
+  either way; where it breaks something, the full model's bound is higher and can prove the node
+  infeasible (the condensed model alone cannot see an instance that only the torque limit makes
+  infeasible, and has to enumerate it).
 
 * Compact node problems (``BnbSettings.compact``). The same relaxation with a smaller KKT system (a
   node solve costs about linearly in its size): excluded binaries are left out instead of fixed to

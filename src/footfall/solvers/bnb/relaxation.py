@@ -53,6 +53,8 @@ class _Relaxation:
     iterations: int = 0
     #: Clarabel's status when ``status`` is "failed"
     raw: str = ""
+    #: solved with the full model (asked for, or the condensed point broke a dropped bound/cone)
+    full: bool = False
 
 
 class _CscLists:
@@ -179,6 +181,35 @@ class HullRelaxation:
         self._cones: dict[int, Any] = {}
         self.solves = 0
         self.solve_time = 0.0
+        #: condensed solves whose point broke a dropped bound or cone, re-solved in full
+        self.escalations = 0
+        self._dropped = self._dropped_checks()
+
+    def _dropped_checks(
+        self,
+    ) -> tuple[IntArray, FloatArray, FloatArray, list[tuple[IntArray, float]]]:
+        """What the condensed base drops: the eliminated variables, their bounds, and the cones
+        over them (``||x[idx]|| <= radius``)."""
+        pr = self.s.problem
+        if self.condensed is None:
+            empty = np.zeros(0, dtype=np.int64)
+            return empty, np.zeros(0), np.zeros(0), []
+        y = self.condensed.y_idx
+        is_y = np.zeros(pr.n, dtype=bool)
+        is_y[y] = True
+        cones = [(np.asarray(idx), float(r)) for idx, r in pr.cones if np.all(is_y[idx])]
+        return y, pr.lb[y], pr.ub[y], cones
+
+    def dropped_violation(self, x: FloatArray) -> float:
+        """Largest violation at ``x`` of the bounds and cones that the condensed base drops."""
+        y, lo, hi, cones = self._dropped
+        if len(y) == 0:
+            return 0.0
+        xy = x[y]
+        worst = max(0.0, float(np.max(lo - xy, initial=0.0)), float(np.max(xy - hi, initial=0.0)))
+        for idx, radius in cones:
+            worst = max(worst, float(np.linalg.norm(x[idx])) - radius)
+        return worst
 
     def recover(self, x: FloatArray) -> FloatArray:
         """Fill the condensed-out variables of ``x`` (a full-length vector) in place; returns x."""
@@ -199,8 +230,21 @@ class HullRelaxation:
         if self.settings.compact:
             keep_col = self._compact(t, a, problem)
             if keep_col is None:
-                return _Relaxation("infeasible")
-        return self._run(base, t, a, problem, keep_col)
+                return _Relaxation("infeasible", full=base is self.full)
+        res = self._run(base, t, a, problem, keep_col)
+        res.full = base is self.full
+        if (
+            self.settings.escalate
+            and not res.full
+            and res.status == "solved"
+            and res.x is not None
+            and self.dropped_violation(res.x) > self.settings.feas_tol
+        ):
+            # The condensed optimum breaks a dropped bound or cone (e.g. the torque limit):
+            # the full model's bound is tighter there, and it can prove the node infeasible.
+            self.escalations += 1
+            return self.solve(allowed, full=True)
+        return res
 
     def _layout(
         self, base: _Base, t: _Templates, allowed: tuple[tuple[int, ...], ...]

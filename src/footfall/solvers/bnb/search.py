@@ -166,7 +166,7 @@ class _Search:
         self.nodes += 1
         if res.status == "failed" and not full:
             res = self.relax.solve(allowed, full=True)  # numerical trouble: try the plain model
-            full = True
+        full = full or res.full
         if res.status == "failed":
             # unsolved node: its parent's bound stays in the reported bound (an honest gap)
             self.failed = True
@@ -463,6 +463,7 @@ class _Search:
                 "failed_nodes": dict(self.failures),
                 "relaxations": self.relax.solves,
                 "relaxation_time_s": self.relax.solve_time,
+                "escalations": self.relax.escalations,
                 "variables": self.problem.n,
                 "integer_variables": self.problem.n_integer,
                 "groups": len(self.s.groups),
