@@ -476,11 +476,11 @@ class _Recording:
 
 def _off_the_disc(res: _Relaxation) -> _Relaxation:
     """``res`` with x0 = 3: the member rows of the optimal branch (x0 >= 1, x1 <= 0.5) still hold,
-    the disc ||x|| <= 3 does not (as when a condensed model drops a cone)."""
+    the disc ||x|| <= 3 does not (as when a condensed model drops a cone): a condensed result."""
     assert res.x is not None
     x = res.x.copy()
     x[0] = 3.0
-    return dataclasses.replace(res, x=x)
+    return dataclasses.replace(res, x=x, full=False)
 
 
 def test_evaluate_solves_an_integral_node_again_on_the_full_model() -> None:
@@ -531,7 +531,8 @@ def test_evaluate_keeps_a_node_solved_again_at_its_depth() -> None:
     search = _search(hand_problem(), SolverOptions(bnb=NO_PROBING))
     allowed, res = _root(search)
     full = search.relax.solve(allowed, full=True)
-    fake = dataclasses.replace(res, bound=res.bound - 1.0, x=HAND_X.copy())
+    # a condensed result (this problem has no condensed model: ``res`` comes from the full one)
+    fake = dataclasses.replace(res, bound=res.bound - 1.0, x=HAND_X.copy(), full=False)
     assert fake.x is not None
     fake.x[0] = 3.0  # x0 >= 1 and x1 <= 0.5 hold, ||x|| <= 3 does not
     kept = search.evaluate(allowed, -math.inf, 4, False, fake)
