@@ -22,8 +22,10 @@ from footfall.errors import InputError
 from footfall.planning import PlannerOptions, make_plan, plan_min_steps
 from footfall.planning.bounds import (
     SLACK,
+    ForwardSets,
     bucket_bounds,
     footstep_sets,
+    live_members,
     reachable_steps_bound,
 )
 from footfall.planning.diagnose import min_steps_lower_bound
@@ -269,10 +271,14 @@ def test_bound_never_exceeds_a_feasible_n_on_random_stones(
     plan = make_plan(sc, "kinematic", bound.n_steps + 1, options)
     if plan.has_solution:
         _check_plan_in_sets(sc, options, plan)
+        _check_plan_uses_live_members(sc, options, plan)
 
 
-def test_kinematic_relaxation_proves_n_infeasible_before_the_miqcqp() -> None:
-    # both reach frames on SHORT_FLAT: the bound allows N = 3, the rows without dynamics do not
+def test_n_the_bound_allows_is_proven_infeasible_before_the_miqcqp() -> None:
+    # both reach frames on SHORT_FLAT: the bound allows N = 3; the live members (forward and
+    # backward reachable sets) leave a footstep no position, and so do the rows without dynamics
+    from footfall.planning.run import _kinematic_proof
+
     sc = load_scene(SHORT_FLAT)
     options = PlannerOptions(reach_both_frames=True, time_limit=60.0)
     assert reachable_steps_bound(sc, sc.robot, options, 10).n_steps == 3
@@ -280,8 +286,101 @@ def test_kinematic_relaxation_proves_n_infeasible_before_the_miqcqp() -> None:
     assert plan.has_solution and plan.n_steps == 4
     (tried,) = plan.stats["tried"]
     assert tried["n_steps"] == 3 and tried["status"] == "infeasible"
-    assert tried["proof"] == "kinematic relaxation" and tried["seconds"] >= 0.0
-    assert "proven infeasible: N = 3 (kinematic relaxation)" in plan.message
-    # the full model agrees: N = 3 has no plan
+    assert tried["proof"] == "reachable sets" and tried["seconds"] >= 0.0
+    assert "proven infeasible: N = 3 (reachable sets)" in plan.message
+    # the kinematic relaxation alone proves it too, and so does the full model
+    kin = _kinematic_proof(sc, sc.robot, 3, options)
+    assert kin is not None and kin.status is SolveStatus.INFEASIBLE
+    assert "rows without the ALIP dynamics" in kin.message
     full = make_plan(sc, "miqcqp", 3, options)
     assert full.status is SolveStatus.INFEASIBLE
+
+
+# --- live members: what each footstep of an N-step plan can use ---------------------------
+
+
+def _check_plan_uses_live_members(sc, options: PlannerOptions, plan) -> None:  # type: ignore[no-untyped-def]
+    """Every free footstep of ``plan`` (made without the live members) lies in a live region and
+    in a live heading segment (either segment when its heading sits on a breakpoint)."""
+    n = plan.n_steps
+    live = live_members(sc, plan.robot, options, n)
+    names = list(sc.terrain.names)
+    n_seg = options.heading_segments
+    width = 2.0 * math.pi / n_seg
+    start = float(sc.start.heading) - math.pi
+    for i in range(1, n - 1):
+        assert live.regions[i, names.index(plan.regions[i])], f"footstep {i}: region not live"
+        pos = (plan.headings[i] - start) / width
+        candidates = {min(max(math.floor(pos + d), 0), n_seg - 1) for d in (-1e-6, 1e-6)}
+        assert any(live.segments[i, seg] for seg in candidates), f"footstep {i}: segment not live"
+
+
+@pytest.mark.parametrize(
+    ("name", "n", "options"),
+    [
+        ("turn", 11, PlannerOptions(reach_both_frames=True)),
+        ("discrete_steps", 13, PlannerOptions(heading_segments=16, region_margin=0.05)),
+    ],
+)
+def test_fixing_out_dead_members_keeps_the_optimum(
+    name: str, n: int, options: PlannerOptions
+) -> None:
+    from footfall.planning.miqcqp import plan_footsteps
+
+    sc = builtin_scene(name)
+    options = replace(options, time_limit=120.0)
+    live = live_members(sc, sc.robot, options, n)
+    plain = plan_footsteps(sc, None, n, options)
+    pruned = plan_footsteps(sc, None, n, options, members=live)
+    assert plain.status is pruned.status is SolveStatus.OPTIMAL
+    assert pruned.stats["members_fixed_out"] > 0, "nothing fixed out: the test checks nothing"
+    assert pruned.objective == pytest.approx(plain.objective, rel=1e-6)
+    _check_plan_uses_live_members(sc, options, plain)
+
+
+def test_dead_members_have_no_plan_by_scip() -> None:
+    """An independent solver on the rows the live members come from (the model without the
+    ALIP dynamics, where the turn has plans with 11 steps): with any sampled dead member forced
+    in, SCIP proves that there is no plan."""
+    from footfall.planning.miqcqp import build_footstep_problem
+    from footfall.solvers import SolverOptions, solve
+    from footfall.solvers.problem import fix_variables
+
+    sc = builtin_scene("turn")
+    options = PlannerOptions(heading_segments=16, reach_both_frames=True, time_limit=60.0)
+    n = 11
+    assert make_plan(sc, "kinematic", n, options).has_solution
+    kin = build_footstep_problem(sc, sc.robot, n, options, dynamics=False)
+    live = live_members(sc, sc.robot, options, n)
+    dead_s = kin.segments[(kin.segments >= 0) & ~live.segments]
+    dead_r = kin.regions[(kin.regions >= 0) & ~live.regions]
+    assert len(dead_s) > 10 and len(dead_r) > 3
+    rng = np.random.default_rng(0)
+    for z in [*rng.choice(dead_s, 5, replace=False), *rng.choice(dead_r, 3, replace=False)]:
+        forced = fix_variables(kin.problem, np.array([z]), np.array([1.0]))
+        res = solve(forced, "scip", SolverOptions(gap=1.0, time_limit=120.0))
+        assert res.status is SolveStatus.INFEASIBLE, kin.problem.names[z]
+
+
+def test_shared_reachable_sets_give_the_same_bound_and_members() -> None:
+    sc = builtin_scene("discrete_steps")
+    options = PlannerOptions(heading_segments=16, reach_both_frames=True)
+    shared = ForwardSets(sc, sc.robot, options, 30)
+    bound = reachable_steps_bound(sc, sc.robot, options, 20, shared)
+    assert bound == reachable_steps_bound(sc, sc.robot, options, 20)
+    for n in (bound.n_steps, bound.n_steps + 2):
+        a = live_members(sc, sc.robot, options, n, shared)
+        b = live_members(sc, sc.robot, options, n)
+        np.testing.assert_array_equal(a.segments, b.segments)
+        np.testing.assert_array_equal(a.regions, b.regions)
+        assert not a.segments[1 : n - 1].all() and not a.regions[1 : n - 1].all()
+
+
+def test_members_of_another_problem_are_bad_input() -> None:
+    from footfall.planning.miqcqp import build_footstep_problem, restrict_members
+
+    sc = load_scene(SHORT_FLAT)
+    fp = build_footstep_problem(sc, sc.robot, 4)
+    other = live_members(sc, sc.robot, PlannerOptions(), 5)
+    with pytest.raises(InputError, match="members"):
+        restrict_members(fp, other)

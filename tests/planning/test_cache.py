@@ -101,21 +101,20 @@ def test_a_planner_revision_makes_its_old_entries_miss(monkeypatch) -> None:  # 
 
 def test_the_shipped_study_plans_are_still_cache_hits(tmp_path: Path) -> None:
     """The section 5.5 study's plans ship in the repository (minutes of planning each); a new
-    planner option or search setting must not silently turn them into misses."""
+    planner option or search setting must not silently turn them into misses for the study."""
     import shutil
 
     from footfall.experiments.study import builtin_study
-    from footfall.sim.biped.plans import plan_for_walk
+    from footfall.experiments.study.runner import _planner
     from footfall.terrain import builtin_scene
 
     design = builtin_study("section55")
     shipped = Path(__file__).parents[2] / "benchmarks" / "study" / "section55" / "plans"
     shutil.copytree(shipped, tmp_path / "plans")
+    plan_for = _planner(design, tmp_path / "plans")
     for name in design.scenes:
         for planner in design.planners:
-            plan = plan_for_walk(
-                builtin_scene(name), planner, None, design.time_limit, tmp_path / "plans"
-            )
+            plan = plan_for(builtin_scene(name), planner, None, None)
             assert "loaded from cache" in plan.message, (name, planner, plan.message)
 
 

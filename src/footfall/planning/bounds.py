@@ -41,6 +41,14 @@ step, its region and its swing pass the same rows). The smallest N that is not r
 therefore a valid lower bound on every N the planner's model can solve: the search may start
 there without skipping any feasible N. It is a bound for the *planner's model* (its conservative
 linear reach), exactly what the search proves infeasible.
+
+Live members (:func:`live_members`). For a given N the same rows run backward from the goal feet
+give sets ``B_i[b, r]`` holding every position of footstep ``i`` from which the goal can still be
+reached in the remaining steps (Minkowski sums with the reversed step sets, cut by the regions).
+A heading bucket or region that footstep ``i`` can use must have ``S_i[b, r]`` meet ``B_i[b, r]``;
+the segments and regions of no such pair are used by no plan of the model, and the smallest-N
+search fixes their binaries to 0 before it solves (the same feasible set; the walk plans' node
+problems shrink by about a third and their searches by 3-20x, ``benchmarks/RESULTS.md``).
 """
 
 from __future__ import annotations
@@ -51,6 +59,7 @@ from dataclasses import dataclass, field
 from functools import partial
 
 import numpy as np
+from numpy.typing import NDArray
 
 from footfall._geometry import (
     EDGE_TOL,
@@ -402,8 +411,41 @@ def _bucket_segments(n_seg: int) -> tuple[list[int], list[int]]:
     return firsts, [min(f + per, n_seg) for f in firsts]
 
 
+class ForwardSets:
+    """The reachable sets of :func:`footstep_sets`, computed as far as asked and kept: the
+    smallest-N search shares them between its bound and the live members of every N it tries."""
+
+    def __init__(
+        self, scene: Scene, robot: BipedParams, options: PlannerOptions, horizon: int
+    ) -> None:
+        self.horizon = horizon
+        self._gen = footstep_sets(scene, robot, options, horizon)
+        self._done: list[tuple[int, _Sets, Callable[[int], bool]]] = []
+        self._ended = False
+
+    def upto(self, last: int) -> Iterator[tuple[int, _Sets, Callable[[int], bool]]]:
+        """``(i, sets, goal)`` of :func:`footstep_sets` for i = 1..``last`` (fewer when the
+        sets run out or ``last`` passes the horizon)."""
+        k = 0
+        while k < last:
+            if k == len(self._done):
+                if self._ended:
+                    return
+                nxt = next(self._gen, None)
+                if nxt is None:
+                    self._ended = True
+                    return
+                self._done.append(nxt)
+            yield self._done[k]
+            k += 1
+
+
 def reachable_steps_bound(
-    scene: Scene, robot: BipedParams, options: PlannerOptions, horizon: int
+    scene: Scene,
+    robot: BipedParams,
+    options: PlannerOptions,
+    horizon: int,
+    forward: ForwardSets | None = None,
 ) -> StepsBound:
     """The smallest N in 2..``horizon`` that the reachable sets do not rule out (module
     docstring), or ``horizon + 1`` if they rule out all of them.
@@ -414,6 +456,8 @@ def reachable_steps_bound(
         options: the planner options whose rows are used: ``heading_segments`` (L),
             ``region_margin``, ``reach_both_frames``, ``swing_max``.
         horizon: the largest N to examine (the work grows linearly with it).
+        forward: the reachable sets of these arguments to use (and extend), e.g. shared with
+            :func:`live_members`; its horizon must be at least ``horizon``.
 
     Returns:
         A :class:`StepsBound`; every N below ``n_steps`` has no plan in the planner's model.
@@ -424,7 +468,9 @@ def reachable_steps_bound(
         + (f" {options.region_margin:g} m inside" if options.region_margin > 0 else "")
         + (f", swings of at most {options.swing_max:g} m" if options.swing_max is not None else "")
     )
-    for i, sets, goal in footstep_sets(scene, robot, options, horizon):
+    if forward is None:
+        forward = ForwardSets(scene, robot, options, horizon)
+    for i, sets, goal in forward.upto(horizon - 1):
         n = i + 1  # footstep N - 1 = i must be the goal foot
         if not sets:
             return StepsBound(horizon + 1, horizon, f"no footstep {i} can be placed: {what}")
@@ -433,3 +479,105 @@ def reachable_steps_bound(
     return StepsBound(
         horizon + 1, horizon, f"no footstep N - 1 <= {horizon - 1} can be the goal foot: {what}"
     )
+
+
+def _meet(p: FloatArray, q: FloatArray) -> bool:
+    """Whether the convex polygons (or points, or segments) ``p`` and ``q`` come within
+    ``SLACK`` of each other; True when neither has an area to cut by (a superset answer)."""
+    if p.shape[0] == 0 or q.shape[0] == 0:
+        return False
+    if q.shape[0] >= 3:
+        a, b = _rows_of(q)
+        return clip_rows(p, a, b + SLACK).shape[0] > 0
+    if p.shape[0] >= 3:
+        a, b = _rows_of(p)
+        return clip_rows(q, a, b + SLACK).shape[0] > 0
+    return True
+
+
+def _backward_sets(s: _Setup, robot: BipedParams, both: bool, n_steps: int) -> list[_Sets]:
+    """``B_i`` for i = 1..N - 2 (index i - 1): for each heading bucket and region, a convex
+    polygon holding every position of footstep ``i`` from which the goal feet can still be
+    reached by the reach, heading-rate, step-height and region rows (swings dropped: a
+    superset). ``B_{N-1}`` is the goal foot, at the goal heading."""
+    side_a = s.sides[n_steps - 1]
+    g_a = s.feet[side_a]
+    cur: _Sets = {}
+    for b in range(len(s.lo)):
+        if not s.lo[b] - ANGLE_SLACK <= s.theta_goal <= s.hi[b] + ANGLE_SLACK:
+            continue
+        for r, poly in enumerate(s.region_poly):
+            if poly.shape[0] and _near(poly, g_a):
+                cur[(b, r)] = g_a[None, :]
+    out: list[_Sets] = []
+    for i in range(n_steps - 2, 0, -1):
+        side = s.sides[i]
+        gathered: dict[tuple[int, int], list[FloatArray]] = {}
+        for (b2, r2), piece in cur.items():
+            for b in range(len(s.lo)):
+                if _gap(s.lo[b], s.hi[b], s.lo[b2], s.hi[b2]) > robot.theta_max + ANGLE_SLACK:
+                    continue
+                step = _both_frames_step(s, side, b, b2) if both else s.step[side][b]
+                if step is None:
+                    continue
+                for r, cut in _cuts(s, robot, r2, minkowski_sum(piece, -step)):
+                    gathered.setdefault((b, r), []).append(cut)
+        cur = {key: convex_hull(np.vstack(parts)) for key, parts in gathered.items()}
+        out.append(cur)
+    out.reverse()
+    return out
+
+
+@dataclass(frozen=True)
+class LiveMembers:
+    """Which heading segments and regions each footstep of an N-step plan can use at all
+    (:func:`live_members`).
+
+    Attributes:
+        segments: (N + 1, L) bool; True where footstep i may lie in heading segment l.
+        regions: (N + 1, R) bool; True where footstep i may lie in region r.
+    """
+
+    segments: NDArray[np.bool_]
+    regions: NDArray[np.bool_]
+
+
+def live_members(
+    scene: Scene,
+    robot: BipedParams,
+    options: PlannerOptions,
+    n_steps: int,
+    forward: ForwardSets | None = None,
+) -> LiveMembers:
+    """The heading segments (eq. 5.12g-h) and regions (5.12i-j) each free footstep ``1..N-2`` of
+    an ``n_steps`` plan can use: a pair (segment bucket, region) is live at footstep ``i`` when
+    the forward reachable set ``S_i`` (module docstring) meets the backward set ``B_i`` of the
+    positions from which the goal feet can still be reached in ``N - 1 - i`` steps by the same
+    rows. Both are supersets of what the model allows, so a member that is not live is used by
+    no plan of the model: fixing its binary to 0 leaves the feasible set (and the optimum) as it
+    is. The goal feet (footsteps N - 1 and N) and footstep 0 are left live. ``forward``: the
+    reachable sets of these arguments to reuse (:class:`ForwardSets`).
+    """
+    s = _setup(scene, robot, options, n_steps)
+    both = options.reach_both_frames
+    n_seg = options.heading_segments
+    n_reg = len(scene.terrain)
+    segments = np.ones((n_steps + 1, n_seg), dtype=bool)
+    regions = np.ones((n_steps + 1, n_reg), dtype=bool)
+    if n_steps < 3:
+        return LiveMembers(segments, regions)
+    backward = _backward_sets(s, robot, both, n_steps)
+    firsts, lasts = _bucket_segments(n_seg)
+    if forward is None:
+        forward = ForwardSets(scene, robot, options, n_steps)
+    fwd_sets = {i: sets for i, sets, _ in forward.upto(n_steps - 2)}
+    for i in range(1, n_steps - 1):
+        fwd, bwd = fwd_sets.get(i, {}), backward[i - 1]
+        live = [key for key, piece in fwd.items() if key in bwd and _meet(piece, bwd[key])]
+        seg = np.zeros(n_seg, dtype=bool)
+        for b, _ in live:
+            seg[firsts[b] : lasts[b]] = True
+        reg = np.zeros(n_reg, dtype=bool)
+        reg[[r for _, r in live]] = True
+        segments[i], regions[i] = seg, reg
+    return LiveMembers(segments, regions)

@@ -50,7 +50,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -71,6 +71,9 @@ from footfall.solvers import ProblemBuilder, SolveStatus, solve
 from footfall.solvers.base import SolveProgress
 from footfall.solvers.problem import MIQCQP
 from footfall.terrain.scene import Scene
+
+if TYPE_CHECKING:
+    from footfall.planning.bounds import LiveMembers
 
 #: sides M of the regular polygon inscribed in the swing disc ``||d|| <= L_swing`` (option
 #: ``swing_max``): 16 facets lose at most 1 - cos(pi / 16) = 1.9 % of L_swing (about 1 cm)
@@ -494,6 +497,29 @@ def _combine(d: tuple[dict[int, float], dict[int, float]], a: FloatArray) -> dic
     return row
 
 
+def restrict_members(fp: FootstepProblem, members: LiveMembers) -> tuple[FootstepProblem, int]:
+    """``fp`` with the segment and region binaries that ``members`` rules out fixed to 0 (through
+    their upper bounds), and how many were fixed. ``members`` must come from
+    :func:`footfall.planning.bounds.live_members` for the same scene, robot, options and N: it
+    only rules out members no plan of the model uses, so the feasible set stays the same."""
+    shapes = (fp.segments.shape, fp.regions.shape)
+    if (members.segments.shape, members.regions.shape) != shapes:
+        raise InputError(
+            "members", (members.segments.shape, members.regions.shape), f"shapes {shapes}"
+        )
+    dead = np.concatenate(
+        [
+            fp.segments[(fp.segments >= 0) & ~members.segments],
+            fp.regions[(fp.regions >= 0) & ~members.regions],
+        ]
+    )
+    if len(dead) == 0:
+        return fp, 0
+    ub = fp.problem.ub.copy()
+    ub[dead] = 0.0
+    return replace(fp, problem=replace(fp.problem, ub=ub)), len(dead)
+
+
 def extract_plan(fp: FootstepProblem, x: FloatArray, **meta: Any) -> FootstepPlan:
     """Read a :class:`FootstepPlan` out of a solution vector of ``fp.problem``."""
     names = fp.scene.terrain.names
@@ -540,11 +566,15 @@ def plan_footsteps(
     n_steps: int = 8,
     options: PlannerOptions | None = None,
     solve_progress: Callable[[SolveProgress], None] | None = None,
+    members: LiveMembers | None = None,
 ) -> FootstepPlan:
     """Plan ``n_steps`` footsteps with the full-horizon MIQCQP (document 000, section 5.3).
 
     ``solve_progress`` is called about once a second while the ``bnb`` backend searches
-    (``SolverOptions.progress``).
+    (``SolverOptions.progress``). ``members``: the heading segments and regions each footstep
+    can use at all (:func:`footfall.planning.bounds.live_members` for these arguments); the
+    others are fixed out before the solve (:func:`restrict_members`: same feasible set, smaller
+    search; ``stats["members_fixed_out"]`` counts them).
 
     Returns:
         A :class:`FootstepPlan`; its status says whether it is optimal (within the gap), a
@@ -572,8 +602,13 @@ def plan_footsteps(
             _model_infeasible(scene, fp.robot, n_steps, options),
             solver=options.solver,
         )
+    fixed_out = 0
+    if members is not None:
+        fp, fixed_out = restrict_members(fp, members)
     solver_options = replace(options.solver_options(), progress=solve_progress)
     result = solve(fp.problem, options.solver, solver_options)
+    if members is not None:
+        result.stats["members_fixed_out"] = fixed_out
     meta = result_meta(result)
     if result.x is None:
         if result.status is SolveStatus.INFEASIBLE:

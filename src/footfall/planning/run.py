@@ -10,7 +10,13 @@ from typing import Protocol
 
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
-from footfall.planning.bounds import StepsBound, reachable_steps_bound
+from footfall.planning.bounds import (
+    ForwardSets,
+    LiveMembers,
+    StepsBound,
+    live_members,
+    reachable_steps_bound,
+)
 from footfall.planning.diagnose import min_steps_lower_bound
 from footfall.planning.plan import (
     FootstepPlan,
@@ -40,6 +46,7 @@ def make_plan(
     robot: BipedParams | None = None,
     solve_progress: Callable[[SolveProgress], None] | None = None,
     monitor: SearchMonitor | None = None,
+    members: LiveMembers | None = None,
 ) -> FootstepPlan:
     """Plan with the named planner (``miqcqp``, ``kinematic`` or ``reactive``).
 
@@ -56,6 +63,8 @@ def make_plan(
             :func:`plan_min_steps`'s ``monitor`` instead.
         monitor: the smallest-N search's reporter (``n_steps`` None), see
             :func:`plan_min_steps`.
+        members: for ``miqcqp`` with a given N, the members each footstep can use
+            (:func:`~footfall.planning.bounds.live_members`); the others are fixed out.
     """
     check_planning_arguments(scene, robot, options)
     check_planner_name(planner)
@@ -85,7 +94,7 @@ def make_plan(
         return plan_kinematic(scene, robot, n_steps, options, solve_progress)
     from footfall.planning.miqcqp import plan_footsteps
 
-    return plan_footsteps(scene, robot, n_steps, options, solve_progress)
+    return plan_footsteps(scene, robot, n_steps, options, solve_progress, members)
 
 
 class SearchMonitor(Protocol):
@@ -169,7 +178,9 @@ def plan_min_steps(
     if n_max is not None and n_max < distance:
         raise InputError("n_max", n_max, f"at least the lower bound {distance}")
     horizon = n_max if n_max is not None else distance + BOUND_HORIZON
-    bound = reachable_steps_bound(scene, robot, options, horizon)
+    # the reachable sets serve the bound and every N's live members (computed as far as needed)
+    forward = ForwardSets(scene, robot, options, horizon + MIN_STEPS_SPAN + 1)
+    bound = reachable_steps_bound(scene, robot, options, horizon, forward)
     start = max(distance, bound.n_steps)
     skipped = _skipped(distance, start, bound)
     n_max = n_max if n_max is not None else start + MIN_STEPS_SPAN
@@ -186,14 +197,21 @@ def plan_min_steps(
         t0 = time.perf_counter()
         proof = "solver"
         plan = None
-        if precheck:
+        members = None
+        if planner == "miqcqp":
+            members = live_members(scene, robot, options, n, forward)
+            plan = _members_proof(planner, robot, options, n, members)
+            if plan is not None:
+                proof = "reachable sets"
+        if plan is None and precheck:
             hook = _hook(monitor, n, "kinematic relaxation")
-            plan = _kinematic_proof(scene, robot, n, options, hook)
+            plan = _kinematic_proof(scene, robot, n, options, hook, members)
             precheck = plan is not None
-        if plan is not None:
-            proof = "kinematic relaxation"
-        else:
-            plan = make_plan(scene, planner, n, options, robot, _hook(monitor, n, planner))
+            if plan is not None:
+                proof = "kinematic relaxation"
+        if plan is None:
+            hook = _hook(monitor, n, planner)
+            plan = make_plan(scene, planner, n, options, robot, hook, members=members)
         if progress is not None:
             progress(n, plan)
         if monitor is not None:
@@ -229,6 +247,7 @@ def _kinematic_proof(
     n_steps: int,
     options: PlannerOptions,
     solve_progress: Callable[[SolveProgress], None] | None = None,
+    members: LiveMembers | None = None,
 ) -> FootstepPlan | None:
     """An infeasible plan if the MIQCQP's rows *without* the ALIP dynamics, torque bound and
     their objective terms (the kinematic planner's model, ``dynamics=False``) are proven to have
@@ -237,12 +256,15 @@ def _kinematic_proof(
     Every row of that model is a row of the full model (eq. 5.12e-k, 5.14-5.18, the goal and the
     options beyond the document), so a proof that it is infeasible proves the full model
     infeasible. A mixed-integer *linear* feasibility question, it is decided in a fraction of
-    the time the branch and bound needs with the dynamics.
+    the time the branch and bound needs with the dynamics. ``members``: the live members of
+    this N (:func:`~footfall.planning.bounds.live_members`), the others fixed out.
     """
-    from footfall.planning.miqcqp import _model_infeasible, build_footstep_problem
+    from footfall.planning.miqcqp import _model_infeasible, build_footstep_problem, restrict_members
     from footfall.solvers import SolveStatus, solve
 
     kin = build_footstep_problem(scene, robot, n_steps, options, dynamics=False)
+    if members is not None:
+        kin, _ = restrict_members(kin, members)
     if kin.problem.bounds_conflict():
         result_status, meta = SolveStatus.INFEASIBLE, {"solver": options.solver}
     else:
@@ -264,6 +286,28 @@ def _kinematic_proof(
         + " (proven on its rows without the ALIP dynamics: the kinematic planner's model)"
     )
     return FootstepPlan.empty("miqcqp", SolveStatus.INFEASIBLE, kin.robot, message, **meta)
+
+
+def _members_proof(
+    planner: str, robot: BipedParams, options: PlannerOptions, n_steps: int, members: LiveMembers
+) -> FootstepPlan | None:
+    """An infeasible plan when some free footstep has no live heading segment or region (no
+    position of it is both reachable from the start and able to reach the goal); else None."""
+    from footfall.solvers import SolveStatus
+
+    free = range(1, n_steps - 1)
+    stuck = [i for i in free if not members.segments[i].any() or not members.regions[i].any()]
+    if not stuck:
+        return None
+    message = (
+        f"infeasible in the planner's model for N = {n_steps}: footstep {stuck[0]} has no "
+        "position both reachable from the start and able to reach the goal feet in the "
+        f"remaining {n_steps - 1 - stuck[0]} steps (reachable sets of the reach, heading-rate, "
+        "step-height and region rows)"
+    )
+    return FootstepPlan.empty(
+        planner, SolveStatus.INFEASIBLE, robot, message, solver=options.solver
+    )
 
 
 def _skipped(distance: int, start: int, bound: StepsBound) -> dict[str, object] | None:

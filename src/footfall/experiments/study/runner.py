@@ -82,7 +82,11 @@ def _planner(design: StudyDesign, folder: Path) -> Planner:
         def plan_mujoco(
             scene: Scene, planner: str, n: int | None, monitor: SearchMonitor | None
         ) -> FootstepPlan:
-            return plan_for_walk(scene, planner, n, design.time_limit, folder, monitor=monitor)
+            # one worker: the plans shipped with the section 5.5 study were made so, and the
+            # worker count is part of the plan cache key
+            return plan_for_walk(
+                scene, planner, n, design.time_limit, folder, monitor=monitor, threads=1
+            )
 
         return plan_mujoco
     from footfall.planning.cache import PlanCache, cached_plan

@@ -18,7 +18,12 @@ import numpy as np
 from footfall._validate import non_negative
 from footfall.errors import InputError
 from footfall.planning.cache import PlanCache, cached_plan
-from footfall.planning.plan import FootstepPlan, PlannerOptions, check_planner_name
+from footfall.planning.plan import (
+    FootstepPlan,
+    PlannerOptions,
+    available_cores,
+    check_planner_name,
+)
 from footfall.planning.run import SearchMonitor
 from footfall.sim.biped.model import (
     SWING_MAX,
@@ -75,6 +80,7 @@ def plan_for_walk(
     robot_aware: bool = True,
     heading_segments: int | None = None,
     monitor: SearchMonitor | None = None,
+    threads: int | None = None,
 ) -> FootstepPlan:
     """The plan of ``scene`` for the MuJoCo biped or another walker model (robot parameters from
     :func:`planner_params`).
@@ -98,6 +104,9 @@ def plan_for_walk(
     there (0.329 m forward at 0.16 m); the plans take longer (stairs_slope_gap N = 16: 38 s
     instead of 4 s).
 
+    ``threads``: worker processes of the ``bnb`` backend (default: 2, or the cores if fewer; not
+    part of the plan cache key).
+
     ``monitor`` hears of a smallest-N search (``n_steps`` None) while it runs
     (:func:`footfall.planning.run.plan_min_steps`; ``footfall walk`` prints its lines).
 
@@ -119,8 +128,14 @@ def plan_for_walk(
     aware = walk_planner_options(planner) if robot_aware else {}
     if heading_segments is None:
         heading_segments = WALK_HEADING_SEGMENTS if robot_aware else PlannerOptions.heading_segments
+    if threads is None:
+        threads = min(2, available_cores())
     opts = PlannerOptions(
-        time_limit=time_limit, region_margin=margin, heading_segments=heading_segments, **aware
+        time_limit=time_limit,
+        region_margin=margin,
+        heading_segments=heading_segments,
+        threads=threads,
+        **aware,
     )
     return cached_plan(
         scene,
