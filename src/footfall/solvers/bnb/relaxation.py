@@ -187,9 +187,10 @@ class HullRelaxation:
 
     def _dropped_checks(
         self,
-    ) -> tuple[IntArray, FloatArray, FloatArray, list[tuple[IntArray, float]]]:
+    ) -> tuple[IntArray, FloatArray, FloatArray, list[tuple[IntArray, FloatArray]]]:
         """What the condensed base drops: the eliminated variables, their bounds, and the cones
-        over them (``||x[idx]|| <= radius``)."""
+        over them (``||x[idx]|| <= radius``), stacked per cone dimension as ``(idx (m, d),
+        radius (m,))``."""
         pr = self.s.problem
         if self.condensed is None:
             empty = np.zeros(0, dtype=np.int64)
@@ -197,7 +198,14 @@ class HullRelaxation:
         y = self.condensed.y_idx
         is_y = np.zeros(pr.n, dtype=bool)
         is_y[y] = True
-        cones = [(np.asarray(idx), float(r)) for idx, r in pr.cones if np.all(is_y[idx])]
+        by_dim: dict[int, tuple[list[IntArray], list[float]]] = {}
+        for idx, r in pr.cones:
+            idx = np.asarray(idx, dtype=np.int64)
+            if np.all(is_y[idx]):
+                rows, radii = by_dim.setdefault(len(idx), ([], []))
+                rows.append(idx)
+                radii.append(float(r))
+        cones = [(np.vstack(rows), np.asarray(radii)) for rows, radii in by_dim.values()]
         return y, pr.lb[y], pr.ub[y], cones
 
     def dropped_violation(self, x: FloatArray) -> float:
@@ -208,7 +216,7 @@ class HullRelaxation:
         xy = x[y]
         worst = max(0.0, float(np.max(lo - xy, initial=0.0)), float(np.max(xy - hi, initial=0.0)))
         for idx, radius in cones:
-            worst = max(worst, float(np.linalg.norm(x[idx])) - radius)
+            worst = max(worst, float(np.max(np.linalg.norm(x[idx], axis=1) - radius)))
         return worst
 
     def recover(self, x: FloatArray) -> FloatArray:
