@@ -384,3 +384,7 @@ def test_members_of_another_problem_are_bad_input() -> None:
     other = live_members(sc, sc.robot, PlannerOptions(), 5)
     with pytest.raises(InputError, match="members"):
         restrict_members(fp, other)
+    mine = live_members(sc, sc.robot, PlannerOptions(), 4)
+    for planner, n in (("kinematic", 4), ("miqcqp", None)):
+        with pytest.raises(InputError, match="members"):
+            make_plan(sc, planner, n, members=mine)

@@ -69,6 +69,8 @@ def make_plan(
     check_planning_arguments(scene, robot, options)
     check_planner_name(planner)
     options = options or PlannerOptions()
+    if members is not None and (planner != "miqcqp" or n_steps is None):
+        raise InputError("members", "given", "only with the miqcqp planner and a given N")
     if planner == "reactive":
         from footfall.planning.reactive import plan_reactive
 
