@@ -24,7 +24,7 @@ from typing import TypeAlias
 import numpy as np
 
 from footfall._typing import FloatArray
-from footfall._validate import finite, positive
+from footfall._validate import check_fields, finite, positive
 from footfall.errors import InputError
 
 #: steepest inclination a ground may have anywhere (as for the document's slope)
@@ -212,8 +212,7 @@ class Stairs:
     edge_margin: float = 0.04
 
     def __post_init__(self) -> None:
-        for name in ("rise", "run", "start_x", "landing", "edge_margin"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        check_fields(self, positive, ("rise", "run", "start_x", "landing", "edge_margin"))
         steps = self.steps
         if isinstance(steps, bool) or not isinstance(steps, int) or not 1 <= steps <= MAX_STEPS:
             raise InputError("steps", steps, f"an integer in 1..{MAX_STEPS}")
