@@ -205,6 +205,12 @@ def test_miqcqp_plan_lies_in_the_sets() -> None:
     _check_plan_in_sets(sc, options, plan)
 
 
+def _fixed(x: float) -> float:
+    """``x`` rounded to what a fixed-point YAML number holds: YAML 1.1 (PyYAML) reads ``1e-07``,
+    which Python prints for small floats, as a string."""
+    return round(x, 6)
+
+
 @st.composite
 def _stones_scene(draw: st.DrawFn) -> str:
     """A start floor, one to three stones of random size, place and height, a goal floor."""
@@ -213,17 +219,17 @@ def _stones_scene(draw: st.DrawFn) -> str:
     ]
     x, z = 0.1, 0.0
     for k in range(draw(st.integers(1, 3))):
-        x0 = x + draw(st.floats(0.05, 0.3))
-        x1 = x0 + draw(st.floats(0.05, 0.4))
-        y0 = draw(st.floats(-0.4, 0.1))
-        y1 = y0 + draw(st.floats(0.08, 0.6))
+        x0 = _fixed(x + draw(st.floats(0.05, 0.3)))
+        x1 = _fixed(x0 + draw(st.floats(0.05, 0.4)))
+        y0 = _fixed(draw(st.floats(-0.4, 0.1)))
+        y1 = _fixed(y0 + draw(st.floats(0.08, 0.6)))
         z = round(z + draw(st.floats(-0.2, 0.2)), 3)
         lines.append(
             f"  - {{name: s{k}, height: {z}, vertices: [[{x0}, {y0}], [{x1}, {y0}], [{x1}, {y1}], "
             f"[{x0}, {y1}]]}}"
         )
         x = x1
-    g0 = x + draw(st.floats(0.05, 0.3))
+    g0 = _fixed(x + draw(st.floats(0.05, 0.3)))
     heading = draw(st.sampled_from([0, 20, -30]))
     return (
         f"""
@@ -384,6 +390,17 @@ def test_members_of_another_problem_are_bad_input() -> None:
     other = live_members(sc, sc.robot, PlannerOptions(), 5)
     with pytest.raises(InputError, match="members"):
         restrict_members(fp, other)
+    for bad in ("5", 2.5, 0, -1, float("nan"), True):
+        with pytest.raises(InputError, match="n_steps"):
+            live_members(sc, sc.robot, PlannerOptions(), bad)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="options"):
+        live_members(sc, sc.robot, "fast", 5)  # type: ignore[arg-type]
+    # sets cut short by their horizon would read as footsteps with no place: refused
+    short = ForwardSets(sc, sc.robot, PlannerOptions(), 3)
+    with pytest.raises(InputError, match="forward"):
+        live_members(sc, sc.robot, PlannerOptions(), 5, short)
+    with pytest.raises(InputError, match="forward"):
+        reachable_steps_bound(sc, sc.robot, PlannerOptions(), 10, short)
     mine = live_members(sc, sc.robot, PlannerOptions(), 4)
     for planner, n in (("kinematic", 4), ("miqcqp", None)):
         with pytest.raises(InputError, match="members"):

@@ -70,9 +70,16 @@ from footfall._geometry import (
     rot2,
 )
 from footfall._typing import FloatArray
+from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.miqcqp import SWING_SIDES
-from footfall.planning.plan import PlannerOptions, goal_feet, wrap_near
+from footfall.planning.plan import (
+    PlannerOptions,
+    check_n_steps,
+    check_planning_arguments,
+    goal_feet,
+    wrap_near,
+)
 from footfall.terrain.scene import Scene
 
 #: slack [m] added to every row the sets are cut by, and to every membership test: the sets stay
@@ -423,6 +430,12 @@ class ForwardSets:
         self._done: list[tuple[int, _Sets, Callable[[int], bool]]] = []
         self._ended = False
 
+    def check_reaches(self, horizon: int) -> None:
+        """Refuse to serve a caller that needs the sets up to ``horizon``, beyond this one's:
+        sets cut short by the horizon would read as footsteps that cannot be placed."""
+        if self.horizon < horizon:
+            raise InputError("forward", self.horizon, f"reachable sets with a horizon >= {horizon}")
+
     def upto(self, last: int) -> Iterator[tuple[int, _Sets, Callable[[int], bool]]]:
         """``(i, sets, goal)`` of :func:`footstep_sets` for i = 1..``last`` (fewer when the
         sets run out or ``last`` passes the horizon)."""
@@ -470,6 +483,7 @@ def reachable_steps_bound(
     )
     if forward is None:
         forward = ForwardSets(scene, robot, options, horizon)
+    forward.check_reaches(horizon)
     for i, sets, goal in forward.upto(horizon - 1):
         n = i + 1  # footstep N - 1 = i must be the goal foot
         if not sets:
@@ -558,6 +572,8 @@ def live_members(
     is. The goal feet (footsteps N - 1 and N) and footstep 0 are left live. ``forward``: the
     reachable sets of these arguments to reuse (:class:`ForwardSets`).
     """
+    check_planning_arguments(scene, robot, options)
+    check_n_steps(n_steps)
     s = _setup(scene, robot, options, n_steps)
     both = options.reach_both_frames
     n_seg = options.heading_segments
@@ -570,6 +586,7 @@ def live_members(
     firsts, lasts = _bucket_segments(n_seg)
     if forward is None:
         forward = ForwardSets(scene, robot, options, n_steps)
+    forward.check_reaches(n_steps)
     fwd_sets = {i: sets for i, sets, _ in forward.upto(n_steps - 2)}
     for i in range(1, n_steps - 1):
         fwd, bwd = fwd_sets.get(i, {}), backward[i - 1]

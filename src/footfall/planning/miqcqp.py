@@ -59,9 +59,9 @@ from footfall._typing import FloatArray, IntArray
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import (
-    MAX_STEPS,
     FootstepPlan,
     PlannerOptions,
+    check_n_steps,
     check_planning_arguments,
     goal_feet,
     result_meta,
@@ -175,8 +175,7 @@ def build_footstep_problem(
     check_planning_arguments(scene, robot, options)
     robot = robot or scene.robot
     options = options or PlannerOptions()
-    if isinstance(n_steps, bool) or not isinstance(n_steps, int) or not 1 <= n_steps <= MAX_STEPS:
-        raise InputError("n_steps", n_steps, f"an integer in 1..{MAX_STEPS}")
+    check_n_steps(n_steps)
     start = scene.start
     theta0 = float(start.heading)
     theta_goal = wrap_near(float(scene.goal.heading), theta0)

@@ -391,6 +391,14 @@ class FootstepPlan:
         return _plan_from_dict(data, robot, source)
 
 
+def check_n_steps(n_steps: object) -> int:
+    """``n_steps`` as the footsteps N of a plan: an integer in 1..``MAX_STEPS``, else
+    :class:`InputError`."""
+    if isinstance(n_steps, bool) or not isinstance(n_steps, int) or not 1 <= n_steps <= MAX_STEPS:
+        raise InputError("n_steps", n_steps, f"an integer in 1..{MAX_STEPS}")
+    return n_steps
+
+
 def check_planning_arguments(scene: object, robot: object = None, options: object = None) -> None:
     """The argument types every planner takes: a :class:`Scene`, a :class:`BipedParams` or None,
     :class:`PlannerOptions` or None; :class:`InputError` naming the argument otherwise."""
