@@ -6,6 +6,7 @@ first vertex. "CCW" means a positive signed (shoelace) area.
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -266,30 +267,40 @@ def convex_hull(points: ArrayLike) -> FloatArray:
             return pts[ConvexHull(pts).vertices]  # CCW in 2-D
         except QhullError:
             pass
-    return _monotone_chain(pts)
+    hull = monotone_chain([(float(x), float(y)) for x, y in pts])
+    return np.array(hull, dtype=float).reshape(-1, 2)
 
 
-def _monotone_chain(points: FloatArray) -> FloatArray:
-    """Convex hull of ``points`` (M, 2) by Andrew's monotone chain, CCW, collinear points dropped."""
-    pts = np.unique(points, axis=0)
-    if pts.shape[0] <= 2:
-        return pts
+def monotone_chain(
+    points: list[tuple[float, float]], eps: float = 0.0
+) -> list[tuple[float, float]]:
+    """Convex hull of ``points`` (Python floats [m]) by Andrew's monotone chain, CCW, without
+    repeated end point. Points within ``eps`` of each other in both coordinates count as one and
+    vertices whose turn is at most ``eps`` (collinear) are dropped; one or two points come back
+    as they are (deduplicated). Python floats on purpose: for the handful of points of a support
+    polygon, numpy's per-call overhead costs more than the hull."""
+    xy = sorted(points)
+    p = xy[:1] + [
+        b for a, b in itertools.pairwise(xy) if abs(b[0] - a[0]) > eps or abs(b[1] - a[1]) > eps
+    ]
+    if len(p) <= 2:
+        return p
 
-    def cross(o: FloatArray, a: FloatArray, b: FloatArray) -> float:
-        return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
+    def turn(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
 
-    lower: list[FloatArray] = []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0.0:
+    lower: list[tuple[float, float]] = []
+    for pt in p:
+        while len(lower) >= 2 and turn(lower[-2], lower[-1], pt) <= eps:
             lower.pop()
-        lower.append(p)
-    upper: list[FloatArray] = []
-    for p in pts[::-1]:
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0.0:
+        lower.append(pt)
+    upper: list[tuple[float, float]] = []
+    for pt in p[::-1]:
+        while len(upper) >= 2 and turn(upper[-2], upper[-1], pt) <= eps:
             upper.pop()
-        upper.append(p)
-    hull = np.array(lower[:-1] + upper[:-1], dtype=float).reshape(-1, 2)
-    return hull if hull.shape[0] >= 2 else pts[[0, -1]]
+        upper.append(pt)
+    hull = lower[:-1] + upper[:-1]
+    return hull if len(hull) >= 2 else [p[0], p[-1]]
 
 
 def minkowski_sum(p: FloatArray, q: FloatArray) -> FloatArray:

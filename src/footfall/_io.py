@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import json
 import math
+import stat
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from footfall.errors import InputError
 
 
 def json_ready(value: Any) -> Any:
@@ -33,3 +36,32 @@ def write_json(path: Path, payload: dict[str, Any]) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(json_ready(payload), indent=2, allow_nan=False) + "\n")
     return path
+
+
+def read_bounded(
+    path: Path, what: str, max_bytes: int, kind: str, error: type[InputError] = InputError
+) -> str:
+    """The UTF-8 text of ``path``: a regular file (not a folder, device or pipe) of at most
+    ``max_bytes`` bytes, read no further than that even if it grows meanwhile. Anything else
+    raises ``error`` naming ``what``, the file and what was expected (``kind``, e.g. "a YAML
+    file")."""
+    path = Path(path)
+    try:
+        info = path.stat()
+    except OSError as e:
+        raise error(what, str(path), f"a readable {kind} ({e.strerror})") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise error(what, str(path), "a regular file (not a folder, device or pipe)")
+    if info.st_size > max_bytes:
+        raise error(what, f"{path} ({info.st_size} bytes)", f"at most {max_bytes} bytes")
+    try:
+        with path.open("rb") as fh:
+            raw = fh.read(max_bytes + 1)
+    except OSError as e:
+        raise error(what, str(path), f"a readable {kind} ({e.strerror})") from None
+    if len(raw) > max_bytes:
+        raise error(what, f"{path} (over {max_bytes} bytes)", f"at most {max_bytes} bytes")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise error(what, str(path), f"UTF-8 text ({e.reason} at byte {e.start})") from None

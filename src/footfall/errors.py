@@ -1,7 +1,9 @@
 """Exception hierarchy of footfall.
 
 Every error footfall raises on purpose derives from :class:`FootfallError`, so a caller can catch
-one type. Input errors name the offending field, the value given and what was expected.
+one type. Input errors name the offending field, the value given and what was expected. A stop
+signal is :class:`Stopped`, which (like ``KeyboardInterrupt``) is not an error: code that records
+a failed trial with ``except Exception`` and goes on must not swallow it.
 """
 
 from __future__ import annotations
@@ -68,3 +70,17 @@ class SolverUnavailableError(FootfallError):
 class MissingExtraError(FootfallError, ImportError):
     """An optional dependency group (a pip extra) is not installed; the message names it and the
     command that installs it."""
+
+
+class Stopped(BaseException):
+    """SIGINT or SIGTERM arrived (the command line raises it from its signal handler): it unwinds
+    the command like Ctrl-C. A :class:`BaseException`, not a :class:`FootfallError`: a study that
+    records a trial's exception as a row and goes on must stop instead.
+
+    Attributes:
+        signum: the signal's number.
+    """
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum

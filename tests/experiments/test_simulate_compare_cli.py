@@ -39,7 +39,10 @@ def test_simulate_writes_metrics_and_figures(tmp_path: Path) -> None:
         assert (tmp_path / name).stat().st_size > 0
 
 
-def test_compare_runs_trials_and_writes_the_table(tmp_path: Path) -> None:
+def test_compare_is_a_study_of_its_options(tmp_path: Path) -> None:
+    pytest.importorskip("pyarrow")
+    from footfall.experiments.study.store import read_rows
+
     r = run(
         "compare",
         "--scenes",
@@ -48,18 +51,29 @@ def test_compare_runs_trials_and_writes_the_table(tmp_path: Path) -> None:
         "reactive",
         "--trials",
         "2",
+        "--push",
+        "4",
         "--workers",
         "1",
         "--out",
         str(tmp_path),
     )
     assert r.returncode == 0, r.stderr
-    rows = (tmp_path / "compare.csv").read_text().strip().splitlines()
-    assert len(rows) == 3  # header + 2 trials
-    assert "| flat | reactive |" in (tmp_path / "compare.md").read_text()
-    assert (tmp_path / "compare_zmp_mean.png").is_file()
+    rows = read_rows(tmp_path / "trials.parquet")
+    assert [(x["seed"], x["push_impulse"], x["simulator"]) for x in rows] == [
+        (0, 4.0, "reduced"),
+        (1, 4.0, "reduced"),
+    ]
+    design = json.loads((tmp_path / "study.json").read_text())["design"]
+    assert design["name"] == "compare" and design["push_levels"] == []
+    assert design["initial_impulse"] == 0.0
+    assert "| flat |" in (tmp_path / "summary.md").read_text()
     assert list((tmp_path / "plans").glob("plan-*.json"))
     assert not list((tmp_path / "plans").glob("*.pkl"))
+    # a second run finds every walk done
+    again = run("compare", "--scenes", "flat", "--planners", "reactive", "--trials", "2",
+                "--push", "4", "--workers", "1", "--out", str(tmp_path))  # fmt: skip
+    assert again.returncode == 0 and "2 walks" not in again.stderr + again.stdout
 
 
 @pytest.mark.parametrize(
@@ -68,14 +82,17 @@ def test_compare_runs_trials_and_writes_the_table(tmp_path: Path) -> None:
         (("simulate", "--scene", "moon"), "discrete_steps"),
         (("simulate", "--planner", "astar"), "miqcqp, kinematic, reactive"),
         (("simulate", "--rate", "-500"), "control_rate"),
-        (("simulate", "--push", "-3"), "push.impulse"),
+        (("simulate", "--push", "-3"), "push impulse [N s]"),
+        (("simulate", "--push-dv", "nan"), "push velocity change [m/s]"),
+        (("simulate", "--push-phase", "2"), "push phase"),
+        (("simulate", "--seed", "-1"), "seed"),
         (("compare", "--planners", "reactive,dijkstra"), "miqcqp, kinematic, reactive"),
-        (("compare", "--trials", "0"), "trials"),
+        (("compare", "--trials", "0"), "seeds"),
         (("compare", "--scenes", "flat", "--workers", "0"), "workers"),
-        (("compare", "--scenes", "flat", "--steps", "flat=0"), "step counts >= 1"),
-        (("compare", "--sim", "mujoco", "--scenes", "flat", "--steps", "x"), "scene=N"),
-        (("compare", "--sim", "mujoco", "--scenes", "flat", "--push-max", "nan"), "push_max"),
-        (("compare", "--scenes", "flat", "--push-max", "nan"), "push_max"),
+        (("compare", "--scenes", "flat", "--steps", "fewest"), "smallest, equal"),
+        (("compare", "--scenes", "moon.yaml"), "scene file"),
+        (("compare", "--sim", "mujoco", "--scenes", "flat", "--push", "nan"), "default_push"),
+        (("compare", "--scenes", "flat", "--push", "-1"), "default_push"),
     ],
 )
 def test_bad_input_exits_2_with_the_valid_choices(

@@ -1,5 +1,5 @@
-"""`footfall study` (issue 25) without walking: the design file, the paired disturbance, the
-statistics against hand values and scipy used directly, and the Parquet store."""
+"""`footfall study` without walking: the design file, the statistics against hand values and scipy
+used directly, and the Parquet store (the paired disturbance: tests/sim/test_disturbance.py)."""
 
 from __future__ import annotations
 
@@ -17,7 +17,6 @@ from footfall.errors import InputError
 from footfall.experiments.study import (
     BUILTIN_STUDIES,
     COLUMNS,
-    Disturbance,
     StudyDesign,
     builtin_study,
     load_study,
@@ -25,12 +24,7 @@ from footfall.experiments.study import (
 )
 from footfall.experiments.study import stats as st
 from footfall.experiments.study import store as store_mod
-from footfall.experiments.study.design import (
-    MAX_TRIALS,
-    PUSH_PHASE_WINDOW,
-    PUSH_STEP_WINDOW,
-    study_from_dict,
-)
+from footfall.experiments.study.design import MAX_TRIALS, study_from_dict
 from footfall.experiments.study.store import TrialStore
 from footfall.experiments.study.trials import normalise_row
 
@@ -215,32 +209,6 @@ def test_max_trials_hand_counted() -> None:
     e = replace(d, level_steps=None)
     assert e.level_steps == ("smallest", "equal")
     assert e.max_trials() == 2 * (2 * (5 + 5 + 2 + 2 + 2 + 2) + 9) == 90
-
-
-# ---------------------------------------------------------------------------------------------
-# disturbance
-
-
-def test_disturbance_is_a_pure_function_of_the_seed() -> None:
-    ds = [Disturbance.of_seed(s) for s in range(40)]
-    assert Disturbance.of_seed(7) == ds[7]
-    assert Disturbance.of_seed(np.int64(7)) == ds[7]
-    assert len({(d.step_fraction, d.phase, d.direction) for d in ds}) == 40
-    for s, d in enumerate(ds):
-        assert d.seed == s
-        assert PUSH_STEP_WINDOW[0] <= d.step_fraction <= PUSH_STEP_WINDOW[1]
-        assert PUSH_PHASE_WINDOW[0] <= d.phase <= PUSH_PHASE_WINDOW[1]
-        assert 0.0 <= d.direction < 2 * math.pi
-        assert 0.0 <= d.initial_direction < 2 * math.pi
-        for n in (1, 2, 7, 11, 40):
-            k = d.push_step(n)
-            assert 0 <= k <= n - 1
-            assert k == min(n - 1, math.floor(d.step_fraction * n))
-    # directions cover the circle, not a corner of it
-    assert np.ptp([d.direction for d in ds]) > math.pi
-    for bad in (-1, 1.5, True):
-        with pytest.raises(InputError):
-            Disturbance.of_seed(bad)  # type: ignore[arg-type]
 
 
 # ---------------------------------------------------------------------------------------------

@@ -18,11 +18,12 @@ import pytest
 import yaml
 
 import footfall
-from footfall.experiments.study import COLUMNS, Disturbance, StudyDesign, run_study
+from footfall.experiments.study import COLUMNS, StudyDesign, run_study
 from footfall.experiments.study import trials as trials_mod
 from footfall.experiments.study.design import study_from_dict
 from footfall.experiments.study.runner import make_plans, make_trials
 from footfall.experiments.study.trials import RUN_DEPENDENT
+from footfall.sim.disturbance import Disturbance
 
 SRC = str(Path(footfall.__file__).resolve().parents[1])
 
@@ -150,14 +151,14 @@ def test_paired_design_same_disturbance_for_every_planner(reference: Any) -> Non
 
 
 def _raise_on_seed(monkeypatch: pytest.MonkeyPatch, seed: int) -> None:
-    real = trials_mod._reduced
+    real = trials_mod.run_plant
 
-    def flaky(trial: Any) -> dict[str, Any]:
-        if trial.disturbance.seed == seed:
+    def flaky(plant: Any, scene: Any, plan: Any, disturbance: Disturbance) -> Any:
+        if disturbance.seed == seed:
             raise RuntimeError(f"boom on seed {seed}")
-        return real(trial)
+        return real(plant, scene, plan, disturbance)
 
-    monkeypatch.setattr(trials_mod, "_reduced", flaky)
+    monkeypatch.setattr(trials_mod, "run_plant", flaky)
 
 
 def test_a_trial_that_raises_is_recorded_with_its_error(
@@ -380,16 +381,16 @@ def test_region_aware_reaches_the_walker(
     mode: str, plans: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """The study's ``region_aware`` is the option the reduced-order walker runs with."""
-    from footfall.sim.reduced import closed_loop
+    from footfall.sim.reduced import trial as reduced_trial
 
     seen: list[str] = []
-    real = closed_loop.simulate
+    real = reduced_trial.simulate
 
     def spy(plan, opts, **kw):  # type: ignore[no-untyped-def]
         seen.append(opts.region_aware)
         return real(plan, opts, **kw)
 
-    monkeypatch.setattr(closed_loop, "simulate", spy)
+    monkeypatch.setattr(reduced_trial, "simulate", spy)
     design = _design(region_aware=mode, planners=["miqcqp"], push_levels=[], level_seeds=0)
     entries = make_plans(design, plans)
     rows = [trials_mod.run_trial(t) for t in make_trials(design, entries)[:1]]

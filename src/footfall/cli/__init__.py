@@ -14,15 +14,7 @@ import sys
 import time
 
 from footfall.cli._common import _say_error, app
-from footfall.errors import FootfallError, InputError
-
-
-class _Stopped(BaseException):
-    """SIGINT or SIGTERM arrived: unwinds the command like Ctrl-C (not caught by click)."""
-
-    def __init__(self, signum: int) -> None:
-        super().__init__(signum)
-        self.signum = signum
+from footfall.errors import FootfallError, InputError, Stopped
 
 
 def _end_children() -> None:
@@ -49,7 +41,7 @@ def _on_signal(signum: int, frame: object) -> None:
         os._exit(128 + signum)
     signal.signal(signum, signal.SIG_IGN)  # a second signal must not interrupt the clean-up
     _end_children()
-    raise _Stopped(signum)
+    raise Stopped(signum)
 
 
 def main() -> None:
@@ -72,7 +64,7 @@ def main() -> None:
     except FootfallError as exc:
         _say_error("failed", str(exc))
         sys.exit(1)
-    except _Stopped as exc:
+    except Stopped as exc:
         _say_error("stopped", f"by {signal.Signals(exc.signum).name}")
         sys.exit(128 + exc.signum)
 

@@ -2,16 +2,21 @@
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.console import Console
 from rich.text import Text
 
 from footfall.errors import InputError
+
+if TYPE_CHECKING:
+    from footfall.sim.disturbance import Disturbance
 
 app = typer.Typer(
     name="footfall",
@@ -99,3 +104,83 @@ def _positive_int(field: str, value: int) -> int:
     if value < 1:
         raise InputError(field, value, "an integer >= 1")
     return value
+
+
+# --- pushes: one disturbance type for every command (footfall.sim.disturbance) ---
+#: ``--push`` [N s]
+PushOption = Annotated[
+    float,
+    typer.Option(
+        "--push",
+        help="Push impulse [N s] (0: none): one horizontal push on the body lasting "
+        "--push-duration, whose direction, step and phase of single support are drawn from --seed "
+        "unless given.",
+    ),
+]
+#: ``--push-dv`` [m/s]
+PushDvOption = Annotated[
+    float | None,
+    typer.Option(
+        "--push-dv",
+        help="The push as a velocity change [m/s] instead of --push: impulse = robot mass x "
+        "velocity change.",
+    ),
+]
+#: ``--seed``
+SeedOption = Annotated[
+    int,
+    typer.Option(
+        "--seed",
+        help="Seed of the push's direction, step and phase (the same draw for a seed in footfall "
+        "walk, simulate, compare and study) and of any estimate noise.",
+    ),
+]
+#: ``--push-step``, ``--push-phase``, ``--push-direction`` [deg], ``--push-duration`` [s]
+PushStepOption = Annotated[
+    int | None,
+    typer.Option(
+        "--push-step", help="Single support the push comes in (0-based). [default: drawn]"
+    ),
+]
+PushPhaseOption = Annotated[
+    float | None,
+    typer.Option(
+        "--push-phase",
+        help="When in that single support, as a share of it in [0, 1]. [default: drawn]",
+    ),
+]
+PushDirectionOption = Annotated[
+    float | None,
+    typer.Option(
+        "--push-direction",
+        help="Push direction in the world frame [deg] (0 = +x, 90 = +y). [default: drawn]",
+    ),
+]
+PushDurationOption = Annotated[float, typer.Option("--push-duration", help="Push length [s].")]
+
+
+def disturbance_of(
+    push: float,
+    push_dv: float | None,
+    seed: int,
+    step: int | None,
+    phase: float | None,
+    direction_deg: float | None,
+    duration: float,
+) -> Disturbance:
+    """The :class:`~footfall.sim.disturbance.Disturbance` of a command's push options: the
+    seed's draw (:meth:`Disturbance.of_seed`) with the given step, phase and direction."""
+    from dataclasses import replace
+
+    from footfall._validate import finite
+    from footfall.sim.disturbance import Disturbance
+
+    given: dict[str, object] = {}
+    if step is not None:
+        given["step"] = step
+    if phase is not None:
+        given["phase"] = phase
+    if direction_deg is not None:
+        given["direction"] = math.radians(finite("--push-direction [deg]", direction_deg))
+    d = Disturbance.of_seed(seed, impulse=push, dv=push_dv, duration=duration)
+    return replace(d, **given)  # type: ignore[arg-type]

@@ -16,7 +16,7 @@ from footfall.cli._common import (
 )
 from footfall.errors import InputError
 
-# --- bench (issue 5) ---
+# --- bench ---
 bench_app = typer.Typer(help="Benchmarks.", no_args_is_help=True)
 app.add_typer(bench_app, name="bench")
 
@@ -86,7 +86,7 @@ def bench_sim_cmd(
     rate: float = typer.Option(500.0, help="Control rate [Hz]."),
     out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_sim.json/.md."),
 ) -> None:
-    """Reduced-order closed loop (issue 4): x real time of the python and compiled engines.
+    """Reduced-order closed loop: x real time of the python and compiled engines.
 
     The walk has estimate noise and two pushes; the engines run alternately in the same run.
     """

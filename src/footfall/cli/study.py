@@ -8,12 +8,15 @@ import os
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
 from footfall.cli._common import app, console, output_folder
 from footfall.errors import FootfallError, InputError
+
+if TYPE_CHECKING:
+    from footfall.experiments.study.design import StudyDesign
 
 #: least time between two progress lines without a terminal [s]
 LOG_PERIOD = 5.0
@@ -49,8 +52,7 @@ def study_command(
     (one row per walk, resumable), summary.md (CIs, paired tests, verdict) and figures.
 
     Exit 1 when a walk raised an error (its row says which and why) or a plan is missing."""
-    from footfall.experiments.study import builtin_study, load_study, run_study, write_report
-    from footfall.planning.plan import available_cores
+    from footfall.experiments.study import builtin_study, load_study
 
     chosen = [x for x in (study_file is not None, builtin is not None, quick) if x]
     if len(chosen) != 1:
@@ -62,6 +64,23 @@ def study_command(
         if study_file is not None
         else builtin_study("quick" if quick else str(builtin))
     )
+    run_design(design, out, executor, workers, address, limit, quiet)
+
+
+def run_design(
+    design: StudyDesign,
+    out: Path,
+    executor: str,
+    workers: int | None,
+    address: str | None,
+    limit: int | None,
+    quiet: bool,
+) -> None:
+    """Run ``design`` into ``out`` with progress lines, write the report and say the verdict
+    (``footfall study`` and its presets, such as ``footfall compare``)."""
+    from footfall.experiments.study import run_study, write_report
+    from footfall.planning.plan import available_cores
+
     if workers is None:
         workers = available_cores()
     if limit is not None and limit < 0:

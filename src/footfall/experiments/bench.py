@@ -320,7 +320,7 @@ def rows_from_dict(runs: Sequence[dict[str, Any]]) -> list[BenchRow]:
     return out
 
 
-# --- reduced-order simulation speed (issue 4) ---
+# --- reduced-order simulation speed ---
 
 #: engines of the reduced-order simulation, in the order they are run and reported
 SIM_ENGINES = ("python", "compiled")
@@ -515,7 +515,8 @@ def benchmark_quadruped(
     robot = QuadrupedRobot()
     slope, pitch = math.radians(slope_deg), math.radians(body_deg)
     plan = plan_gait(robot, GaitParams(slope, pitch, cycles=sim_cycles))
-    res = simulate(plan)
+    done = simulate(plan)
+    res = done.trace
     loop_rtf = res.sim_time / res.wall_time
 
     base = QuadrupedSim(robot, slope)
@@ -551,7 +552,7 @@ def benchmark_quadruped(
         "overhead_ratio": base_rtf / loop_rtf,
         "realtime_goal": 5.0,
         "realtime_vs_goal": loop_rtf / 5.0,
-        "fell": res.metrics.fell,
+        "fell": done.metrics.fell,
         "plan_cycles": plan_cycles,
         "plan_ms_median": plan_ms,
         "sample_100hz_ms_median": sample_ms,

@@ -114,8 +114,8 @@ def _quadruped(out: Path, lines: list[str]) -> dict[str, Any]:
     res = simulate(plan)
     folder = out / "quadruped"
     folder.mkdir(parents=True, exist_ok=True)
-    qp.plot_stability(plan, res, folder / "stability.png")
-    qp.plot_foot_path(plan, res, folder / "fig10_lf_foot_path.png")
+    qp.plot_stability(plan, res.trace, folder / "stability.png")
+    qp.plot_foot_path(plan, res.trace, folder / "fig10_lf_foot_path.png")
     write_json(folder / "quadruped.json", res.metrics.to_dict())
     m = res.metrics
     lines.append(

@@ -11,7 +11,7 @@ from footfall.quadruped.gait import GaitParams, GaitPlan, ZmpStrategy, plan_gait
 from footfall.quadruped.robot import QuadrupedRobot
 
 if TYPE_CHECKING:
-    from footfall.sim.quadruped.sim import QuadrupedMetrics, SimResult
+    from footfall.results.quadruped import QuadrupedMetrics, QuadrupedResult
 
 
 def plan_strategies(
@@ -52,7 +52,7 @@ def _row(m: QuadrupedMetrics) -> dict[str, Any]:
 
 
 def compare_strategies(
-    plans: dict[ZmpStrategy, GaitPlan], done: SimResult
+    plans: dict[ZmpStrategy, GaitPlan], done: QuadrupedResult
 ) -> dict[str, dict[str, Any]]:
     """Table of body sway, margin and speed by strategy value, simulating every plan but the first
     (whose simulation is ``done``), with ``done``'s controller."""

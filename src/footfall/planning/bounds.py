@@ -72,8 +72,8 @@ from footfall._geometry import (
 from footfall._typing import FloatArray
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
-from footfall.planning.miqcqp import SWING_SIDES
 from footfall.planning.plan import (
+    SWING_SIDES,
     PlannerOptions,
     check_n_steps,
     check_planning_arguments,

@@ -59,6 +59,7 @@ from footfall._typing import FloatArray, IntArray
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import (
+    SWING_SIDES,
     FootstepPlan,
     PlannerOptions,
     check_n_steps,
@@ -74,10 +75,6 @@ from footfall.terrain.scene import Scene
 
 if TYPE_CHECKING:
     from footfall.planning.bounds import LiveMembers
-
-#: sides M of the regular polygon inscribed in the swing disc ``||d|| <= L_swing`` (option
-#: ``swing_max``): 16 facets lose at most 1 - cos(pi / 16) = 1.9 % of L_swing (about 1 cm)
-SWING_SIDES = 16
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,12 @@ from footfall.solvers.base import SolverOptions, SolverResult, SolveStatus
 from footfall.solvers.settings import BnbSettings
 from footfall.terrain.scene import Scene, robot_to_dict
 
+#: sides M of the regular polygon inscribed in the swing disc ``||d|| <= L_swing`` (option
+#: ``swing_max``, eq. rows of :mod:`footfall.planning.miqcqp` and the reachable sets of
+#: :mod:`footfall.planning.bounds`): 16 facets lose at most 1 - cos(pi / 16) = 1.9 % of L_swing
+#: (about 1 cm)
+SWING_SIDES = 16
+
 PLANNERS = ("miqcqp", "kinematic", "reactive")
 #: the words of plan.json's ``alip.layout`` (see :meth:`FootstepPlan.to_dict`)
 ALIP_LAYOUT = (
@@ -217,6 +223,10 @@ class FootstepPlan:
         heading_segments: L of the :class:`PlannerOptions` a miqcqp plan was made with (the
             conservative reach rows of each segment, eq. 5.12f-h, depend on it); None for the
             planners without heading segments.
+        riser_inset: the landing tolerance [m] by which the riser edges of the scene's regions
+            were moved in before planning (:func:`footfall.terrain.edges.inset_riser_edges`;
+            0: the regions as they are). A walker keeps its corrected footsteps in the same
+            regions the plan was made on.
     """
 
     planner: str
@@ -241,6 +251,7 @@ class FootstepPlan:
     reach_both_frames: bool = False
     swing_max: float | None = None
     heading_segments: int | None = None
+    riser_inset: float = 0.0
 
     def __post_init__(self) -> None:
         """Shapes agree and every number that positions the robot is finite: a NaN footstep
@@ -256,6 +267,7 @@ class FootstepPlan:
             if not np.all(np.isfinite(arr)):
                 bad = int(np.argwhere(~np.isfinite(arr))[0][0])
                 raise InputError(f"plan.{name}[{bad}]", arr[bad].tolist(), "finite numbers")
+        object.__setattr__(self, "riser_inset", non_negative("plan.riser_inset", self.riser_inset))
         for name in ("sides", "regions"):
             if len(getattr(self, name)) != rows:
                 raise InputError(f"plan.{name}", f"{len(getattr(self, name))} entries", f"{rows}")
@@ -319,7 +331,8 @@ class FootstepPlan:
 
         Keys: ``status``, ``planner``, ``scene``, ``message``, ``objective``, ``bound``, ``gap``,
         ``solve_time_s``, ``solver``, ``region_margin`` [m], ``reach_both_frames``, ``swing_max``
-        [m] (null: no swing bound), ``heading_segments``, ``stats``, ``robot``, ``footsteps``
+        [m] (null: no swing bound), ``heading_segments``, ``riser_inset`` [m], ``stats``,
+        ``robot``, ``footsteps``
         (``index``, ``side``, ``position``, ``heading``, ``region``; index 0 is the initial stance
         foot) and ``alip``. Unknown numbers (NaN, inf) are null.
 
@@ -354,6 +367,7 @@ class FootstepPlan:
             "reach_both_frames": self.reach_both_frames,
             "swing_max": self.swing_max,
             "heading_segments": self.heading_segments,
+            "riser_inset": self.riser_inset,
             "stats": stats,
             "robot": robot_to_dict(r),
             "footsteps": [
@@ -562,6 +576,7 @@ def _plan_from_dict(data: object, robot: BipedParams, source: str) -> FootstepPl
         reach_both_frames=r.flag(data.get("reach_both_frames", False), "reach_both_frames"),
         swing_max=None if swing is None else number(swing, "swing_max", math.nan),
         heading_segments=segments,
+        riser_inset=number(data.get("riser_inset"), "riser_inset", 0.0),
     )
 
 

@@ -6,13 +6,13 @@ support polygons are returned counter-clockwise.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from footfall._geometry import monotone_chain
 from footfall._typing import FloatArray
 from footfall.errors import InputError
 from footfall.models.lip import GRAVITY
@@ -38,27 +38,8 @@ def support_polygon(points: ArrayLike) -> FloatArray:
     pts = np.asarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[0] == 0 or pts.shape[1] < 2:
         raise InputError("points", pts.shape, "an array of shape (N, 2) or (N, 3), N >= 1")
-    # a handful of points: Python floats are faster here than numpy's per-call overhead
-    xy = sorted(map(tuple, pts[:, :2].tolist()))  # by x then y (monotone chain)
-    # drop duplicates, which would stall the chain
-    p = xy[:1] + [
-        b
-        for a, b in itertools.pairwise(xy)
-        if abs(b[0] - a[0]) > _GEOM_EPS or abs(b[1] - a[1]) > _GEOM_EPS
-    ]
-    if len(p) <= 2:
-        return np.array(p)
-    lower: list[tuple[float, ...]] = []
-    for pt in p:
-        while len(lower) >= 2 and _cross(lower[-2], lower[-1], pt) <= _GEOM_EPS:
-            lower.pop()
-        lower.append(pt)
-    upper: list[tuple[float, ...]] = []
-    for pt in p[::-1]:
-        while len(upper) >= 2 and _cross(upper[-2], upper[-1], pt) <= _GEOM_EPS:
-            upper.pop()
-        upper.append(pt)
-    return np.array(lower[:-1] + upper[:-1])
+    hull = monotone_chain([(float(x), float(y)) for x, y in pts[:, :2].tolist()], _GEOM_EPS)
+    return np.array(hull)
 
 
 def _point_segment_distance(p: FloatArray, a: FloatArray, b: FloatArray) -> float:

@@ -90,6 +90,34 @@ ROBOT_MATERIALS = """<material name="body" rgba="0.25 0.35 0.6 1"/>
     <material name="foot" rgba="0.15 0.15 0.15 1"/>"""
 
 
+#: the terrain's material (the region geoms of :mod:`footfall.sim.biped.terrain_mjcf`)
+TERRAIN_MATERIAL = '<material name="terrain" texture="grid" texrepeat="4 4" texuniform="true"/>'
+#: the light of every generated world
+LIGHT = '<light pos="0 -3 6" dir="0 0.4 -1" directional="true"/>'
+
+
+def mjcf_document(model: str, preamble: str, assets: str, world: str, actuators: str) -> str:
+    """An MJCF document of a generated world: ``preamble`` (:func:`mjcf_preamble`), the ground
+    texture and robot materials plus ``assets``, the light plus ``world`` (terrain geoms and the
+    robot's bodies), and ``actuators``."""
+    return f"""<mujoco model="{model}">
+  {preamble}
+  <asset>
+    {GRID_TEXTURE}
+    {ROBOT_MATERIALS}
+    {assets}
+  </asset>
+  <worldbody>
+    {LIGHT}
+    {world}
+  </worldbody>
+  <actuator>
+    {actuators}
+  </actuator>
+</mujoco>
+"""
+
+
 def position_actuator(name: str, joint_attr: str, settings: SimSettings) -> str:
     """A position servo on a joint (``joint_attr`` is the quoted attribute value) with the
     settings' gains and torque limit."""

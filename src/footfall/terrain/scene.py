@@ -9,7 +9,6 @@ pydantic, then builds the frozen dataclasses (which validate the geometry); ever
 from __future__ import annotations
 
 import math
-import stat
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -21,6 +20,7 @@ from numpy.typing import ArrayLike
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from footfall._geometry import outward_halfspaces, polygon_distance, rot2
+from footfall._io import read_bounded
 from footfall._typing import FloatArray
 from footfall._validate import finite, finite_vector
 from footfall.errors import InputError, SceneError
@@ -411,27 +411,7 @@ MAX_SCENE_NODES = 1_000_000
 
 def _read_scene_file(path: Path) -> str:
     """The text of a scene file: a regular file (not a device or a pipe) of bounded size."""
-    try:
-        info = path.stat()
-    except OSError as e:
-        raise SceneError("scene file", str(path), f"a readable YAML file ({e.strerror})") from None
-    if not stat.S_ISREG(info.st_mode):
-        raise SceneError("scene file", str(path), "a regular file (not a folder, device or pipe)")
-    if info.st_size > MAX_SCENE_BYTES:
-        raise SceneError(
-            "scene file", f"{path} ({info.st_size} bytes)", f"at most {MAX_SCENE_BYTES} bytes"
-        )
-    try:
-        with path.open("rb") as fh:
-            raw = fh.read(MAX_SCENE_BYTES + 1)
-    except OSError as e:
-        raise SceneError("scene file", str(path), f"a readable YAML file ({e.strerror})") from None
-    try:
-        return raw.decode("utf-8")
-    except UnicodeDecodeError as e:
-        raise SceneError(
-            "scene file", str(path), f"UTF-8 text ({e.reason} at byte {e.start})"
-        ) from None
+    return read_bounded(path, "scene file", MAX_SCENE_BYTES, "YAML file", SceneError)
 
 
 def _check_expanded_size(root: yaml.Node | None, source: str | None) -> None:

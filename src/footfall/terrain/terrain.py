@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,6 +16,25 @@ from footfall.terrain.region import Region
 #: most regions of a terrain: one binary per region and footstep, and the region graph is
 #: quadratic in the count
 MAX_REGIONS = 1000
+#: a landed foot stands on a region when its sole centre is inside the region's polygon in plan
+#: view and within this height of its surface [m] (a measured sole centre sits a few millimetres
+#: above the plane); every plant's report counts footsteps off the terrain by this one test
+LANDING_Z_TOL = 0.03
+
+
+def region_of(regions: Sequence[Region], p: ArrayLike) -> str:
+    """Name of the first of ``regions`` that a landed foot at ``p`` [m] stands on, "" for none.
+
+    ``p`` (3,): inside the polygon in plan view and within ``LANDING_Z_TOL`` of the surface;
+    ``p`` (2,): plan view only (the reduced-order plant has no heights).
+    """
+    q = np.asarray(p, dtype=float)
+    for r in regions:
+        if float(r.signed_distance(q[:2])) <= 0.0 and (
+            q.shape[0] == 2 or abs(float(r.height_at(q[:2])) - float(q[2])) <= LANDING_Z_TOL
+        ):
+            return r.name
+    return ""
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,8 +86,14 @@ class Terrain:
         raise UnknownNameError("region", name, f"one of {', '.join(self.names)}")
 
     def locate(self, p: ArrayLike, tol: float = 1e-6) -> list[str]:
-        """Names of the regions containing the 3-D point ``p`` (3,) [m] (on plane and inside)."""
+        """Names of the regions containing the 3-D point ``p`` (3,) [m] (on plane and inside,
+        within ``tol``): the exact test of a scene's start feet and goal. Where a landed foot
+        stands is :meth:`region_of`."""
         return [r.name for r in self.regions if r.contains(p, tol)]
+
+    def region_of(self, p: ArrayLike) -> str:
+        """The region a landed foot at ``p`` (3,) or (2,) [m] stands on (:func:`region_of`)."""
+        return region_of(self.regions, p)
 
     def nearest(self, p: ArrayLike) -> tuple[str, float, float]:
         """Closest region to ``p`` (3,) [m] in plan view.

@@ -1,4 +1,4 @@
-"""Regions recovered from a height map, drawn over the map (issue 22)."""
+"""Regions recovered from a height map, drawn over the map."""
 
 from __future__ import annotations
 

@@ -1,14 +1,14 @@
 """Figures of the document-001 quadruped walk (like the document's figs. 4, 8, 10 and 11).
 
-All functions take plain arrays, the planner's results or anything shaped like a simulated walk
-(:class:`MeasuredWalk`) and write one PNG each; they use matplotlib's non-interactive Agg backend
+All functions take plain arrays, the planner's results or a simulated walk's measurements
+(:class:`~footfall.results.quadruped.QuadrupedTrace`) and write one PNG each; they use matplotlib's non-interactive Agg backend
 (no display needed).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -16,39 +16,12 @@ from footfall._typing import FloatArray
 from footfall.quadruped.kinematics import body_rotation, foot_in_leg_frame
 from footfall.quadruped.robot import LEGS, Leg
 from footfall.quadruped.swing import SwingProfile, slope_to_leg_rotation, swing_in_leg_frame
+from footfall.results.quadruped import QuadrupedTrace
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-    from footfall.quadruped.gait import GaitPlan, GaitTrajectory
-
-
-class MeasuredWalk(Protocol):
-    """What the figures read of a simulated walk (T samples)."""
-
-    @property
-    def t(self) -> FloatArray:
-        """Time since the gait started, shape (T,) [s]."""
-
-    @property
-    def trunk_pos(self) -> FloatArray:
-        """Measured trunk centre, shape (T, 3) [m]."""
-
-    @property
-    def cop(self) -> FloatArray:
-        """Measured centre of pressure, shape (T, 2) [m]."""
-
-    @property
-    def margin(self) -> FloatArray:
-        """Measured stability margin, shape (T,) [m]."""
-
-    @property
-    def feet(self) -> FloatArray:
-        """Measured foot centres, shape (T, 4, 3) [m]."""
-
-    @property
-    def planned(self) -> GaitTrajectory:
-        """The planned references at the same instants."""
+    from footfall.quadruped.gait import GaitPlan
 
 
 #: length of the drawn frame axes [m]
@@ -145,7 +118,9 @@ def plot_swing_frames(plan: GaitPlan, path: Path, leg: Leg = Leg.LF) -> Path:
     return path
 
 
-def plot_foot_path(plan: GaitPlan, res: MeasuredWalk | None, path: Path, leg: Leg = Leg.LF) -> Path:
+def plot_foot_path(
+    plan: GaitPlan, res: QuadrupedTrace | None, path: Path, leg: Leg = Leg.LF
+) -> Path:
     """Fig. 10: the ``leg`` foot path in the x-z plane of {W}, planned and measured."""
     plt = _plt()
     i = leg.idx
@@ -191,7 +166,7 @@ def plot_body_height(
     return path
 
 
-def plot_stability(plan: GaitPlan, res: MeasuredWalk | None, path: Path) -> Path:
+def plot_stability(plan: GaitPlan, res: QuadrupedTrace | None, path: Path) -> Path:
     """Top view of the first cycle (support triangles, OSPs, ZMP path; like figs. 3-4) and the
     stability margin over time (planned, and measured from the CoP of the contact forces)."""
     from footfall.quadruped.gait import PhaseKind
@@ -244,7 +219,7 @@ def plot_stability(plan: GaitPlan, res: MeasuredWalk | None, path: Path) -> Path
     return path
 
 
-def save_walk_figures(plan: GaitPlan, res: MeasuredWalk, out: Path, label: str) -> list[Path]:
+def save_walk_figures(plan: GaitPlan, res: QuadrupedTrace, out: Path, label: str) -> list[Path]:
     """The figures of one simulated walk in ``out``: swing frames (fig. 8), the LF foot path
     (fig. 10), body height (fig. 11, one run called ``label``) and the stability plot."""
     return [

@@ -1,110 +1,21 @@
 """Figures of the closed-loop simulation and of the planner comparison (document 000, section 5.5).
 
-The figures read a run through :class:`ClosedLoopRun`, the shape of the reduced-order simulation's
-result, so that viz never imports the simulator.
+The figures read a :class:`~footfall.results.reduced.SimResult`, so that viz never imports the
+simulator.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 from matplotlib.patches import Polygon
-from numpy.typing import NDArray
 
 from footfall._geometry import rot2
-from footfall._typing import FloatArray
+from footfall.results.reduced import SimResult
 from footfall.terrain.terrain import Terrain
 from footfall.viz._mpl import plt, save
-
-
-class RunSummary(Protocol):
-    """The metrics the figures print."""
-
-    @property
-    def fell(self) -> bool:
-        """The robot fell."""
-
-    @property
-    def stopped(self) -> bool:
-        """The robot came to rest."""
-
-    @property
-    def zmp_offset_mean(self) -> float:
-        """Mean CoP offset from the stance foot centre in single support [m]."""
-
-
-class ClosedLoopRun(Protocol):
-    """What the figures read of a closed-loop run (T samples, n landed footsteps, N planned)."""
-
-    @property
-    def metrics(self) -> RunSummary:
-        """Summary of the run."""
-
-    @property
-    def t(self) -> FloatArray:
-        """Sample times, shape (T,) [s]."""
-
-    @property
-    def single(self) -> NDArray[np.bool_]:
-        """True in single support, shape (T,)."""
-
-    @property
-    def com(self) -> FloatArray:
-        """World CoM horizontal position, shape (T, 2) [m]."""
-
-    @property
-    def cop(self) -> FloatArray:
-        """Realised world CoP, shape (T, 2) [m]."""
-
-    @property
-    def cop_offset(self) -> FloatArray:
-        """CoP minus the stance foot centre in the foot frame, shape (T, 2) [m]."""
-
-    @property
-    def torque_cmd(self) -> FloatArray:
-        """Commanded ankle torque, shape (T, 2) [N m]."""
-
-    @property
-    def torque(self) -> FloatArray:
-        """Applied ankle torque, shape (T, 2) [N m]."""
-
-    @property
-    def saturated(self) -> NDArray[np.bool_]:
-        """CoP clipped at the sole edge, shape (T,)."""
-
-    @property
-    def footsteps(self) -> FloatArray:
-        """Landed footsteps, shape (n + 1, 3) [m]."""
-
-    @property
-    def plan_footsteps(self) -> FloatArray:
-        """Planned footsteps, shape (N + 1, 3) [m]."""
-
-    @property
-    def headings(self) -> FloatArray:
-        """Landed footstep headings, shape (n + 1,) [rad]."""
-
-    @property
-    def goal(self) -> FloatArray:
-        """Goal position, shape (2,) [m]."""
-
-    @property
-    def u_max(self) -> float:
-        """Torque bound U_max [N m]."""
-
-    @property
-    def foot_length(self) -> float:
-        """Sole length [m]."""
-
-    @property
-    def foot_width(self) -> float:
-        """Sole width [m]."""
-
-    @property
-    def planner(self) -> str:
-        """Name of the planner of the plan."""
 
 
 def _sole(
@@ -115,9 +26,7 @@ def _sole(
     ax.add_patch(Polygon(foot[:2] + half @ rot.T, closed=True, **kw))
 
 
-def plot_top(
-    res: ClosedLoopRun, path: Path, terrain: Terrain | None = None, title: str = ""
-) -> Path:
+def plot_top(res: SimResult, path: Path, terrain: Terrain | None = None, title: str = "") -> Path:
     """Top view: terrain, planned and landed soles, CoM path and CoP (ZMP) path [m]."""
     fig, ax = plt.subplots(figsize=(10, 5), constrained_layout=True)
     if terrain is not None:
@@ -161,7 +70,7 @@ def plot_top(
     return save(fig, path)
 
 
-def plot_zmp_offset(res: ClosedLoopRun, path: Path) -> Path:
+def plot_zmp_offset(res: SimResult, path: Path) -> Path:
     """CoP offset from the stance foot centre, in the foot frame, over time, with the sole limits."""
     fig, axes = plt.subplots(2, 1, figsize=(9, 5), sharex=True, constrained_layout=True)
     ss = res.single
@@ -179,7 +88,7 @@ def plot_zmp_offset(res: ClosedLoopRun, path: Path) -> Path:
     return save(fig, path)
 
 
-def plot_torques(res: ClosedLoopRun, path: Path) -> Path:
+def plot_torques(res: SimResult, path: Path) -> Path:
     """Commanded and applied ankle torques and their norm, with U_max [N m]."""
     fig, axes = plt.subplots(2, 1, figsize=(9, 5), sharex=True, constrained_layout=True)
     for j, name in ((0, "tau_x"), (1, "tau_y")):
@@ -196,7 +105,7 @@ def plot_torques(res: ClosedLoopRun, path: Path) -> Path:
     return save(fig, path)
 
 
-def save_sim_figures(res: ClosedLoopRun, out: Path, terrain: Terrain | None = None) -> list[Path]:
+def save_sim_figures(res: SimResult, out: Path, terrain: Terrain | None = None) -> list[Path]:
     """Write sim_top.png, sim_zmp.png and sim_torque.png into ``out``."""
     return [
         plot_top(res, out / "sim_top.png", terrain),

@@ -12,6 +12,7 @@ from matplotlib.colors import Colormap, Normalize
 from matplotlib.patches import Polygon
 from matplotlib.tri import Triangulation
 
+from footfall._geometry import convex_hull
 from footfall.terrain.scene import Scene
 from footfall.terrain.terrain import Terrain
 
@@ -100,7 +101,7 @@ def plot_terrain_side(
     for region in terrain:
         xz = region.vertices3d[:, [0, 2]]
         pts = np.vstack([xz, [[xz[:, 0].min(), floor], [xz[:, 0].max(), floor]]])
-        hull = _hull(pts)
+        hull = convex_hull(pts)
         colour = sm.cmap(float(norm(float(region.centroid[2]))))
         patch = Polygon(hull, closed=True, fc=colour, ec="k", lw=0.8, alpha=alpha)
         ax.add_patch(patch)
@@ -110,28 +111,6 @@ def plot_terrain_side(
     ax.set_xlabel("x [m]")
     ax.set_ylabel("z [m]")
     return patches
-
-
-def _hull(points: np.ndarray) -> np.ndarray:
-    """Convex hull (monotone chain) of 2-D points (N, 2), CCW without repeated end point."""
-    pts = sorted({(float(x), float(y)) for x, y in points})
-    if len(pts) < 3:
-        return np.array(pts)
-
-    def cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower: list[tuple[float, float]] = []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    upper: list[tuple[float, float]] = []
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return np.array(lower[:-1] + upper[:-1])
 
 
 def plot_scene(scene: Scene, path: Path, dpi: int = 120) -> Path:

@@ -1,8 +1,7 @@
 """Figure of a simulated biped walk: footsteps, CoM path, measured ZMP offset, CoM height.
 
-The figure reads a walk result through :class:`WalkLike` and the sole through :class:`SoleLike`
-(both satisfied by :class:`footfall.sim.biped.result.WalkResult` and the walker models), so that
-pictures never import the simulation.
+The figure reads a :class:`~footfall.results.walk.WalkResult` and the sole through
+:class:`SoleLike` (a walker model), so that pictures never import the simulation.
 """
 
 from __future__ import annotations
@@ -10,63 +9,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Protocol
 
-import numpy as np
-from numpy.typing import NDArray
-
-from footfall._typing import FloatArray
+from footfall.results.walk import WalkResult
 from footfall.terrain.scene import Scene
 
 #: the sole drawn without a model: our biped's (``footfall.sim.biped.model.BipedModel``) [m]
 DEFAULT_FOOT_LENGTH, DEFAULT_FOOT_WIDTH = 0.20, 0.10
-
-
-class ZMPSummaryLike(Protocol):
-    """Mean and max norm [m] of the measured single-support ZMP offsets."""
-
-    @property
-    def mean(self) -> float: ...
-    @property
-    def max(self) -> float: ...
-
-
-class WalkMetricsLike(Protocol):
-    """The walk's summary numbers the figure prints."""
-
-    @property
-    def zmp(self) -> ZMPSummaryLike: ...
-
-
-class WalkLike(Protocol):
-    """What :func:`plot_walk` reads of a walk (shapes and units as in ``WalkResult``)."""
-
-    @property
-    def t(self) -> FloatArray: ...
-    @property
-    def phase(self) -> NDArray[np.int_]: ...
-    @property
-    def com(self) -> FloatArray: ...
-    @property
-    def com_ref(self) -> FloatArray: ...
-    @property
-    def zmp_offset(self) -> FloatArray: ...
-    @property
-    def zmp_planned(self) -> FloatArray: ...
-    @property
-    def feet(self) -> FloatArray: ...
-    @property
-    def landed(self) -> FloatArray: ...
-    @property
-    def targets(self) -> FloatArray: ...
-    @property
-    def planned(self) -> FloatArray: ...
-    @property
-    def n_planned(self) -> int: ...
-    @property
-    def fell(self) -> bool: ...
-    @property
-    def fall_time(self) -> float: ...
-    @property
-    def metrics(self) -> WalkMetricsLike: ...
 
 
 class SoleLike(Protocol):
@@ -79,7 +26,7 @@ class SoleLike(Protocol):
 
 
 def plot_walk(
-    res: WalkLike, scene: Scene, path: Path, params: SoleLike | None = None, title: str = ""
+    result: WalkResult, scene: Scene, path: Path, params: SoleLike | None = None, title: str = ""
 ) -> Path:
     """Write a three-panel PNG: top view, single-support ZMP offset in the foot frame, heights.
 
@@ -91,6 +38,7 @@ def plot_walk(
     import matplotlib.pyplot as plt
     from matplotlib.patches import Polygon, Rectangle
 
+    res = result.trace
     length = params.foot_length if params is not None else DEFAULT_FOOT_LENGTH
     width = params.foot_width if params is not None else DEFAULT_FOOT_WIDTH
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.8))
@@ -123,7 +71,7 @@ def plot_walk(
     ax.set_aspect("equal")
     ax.set_xlabel("x in the foot frame [m]")
     ax.set_ylabel("y [m]")
-    m = res.metrics.zmp
+    m = result.metrics.zmp
     ax.set_title(
         f"single-support ZMP offset: mean {m.mean:.3f} m, max {m.max:.3f} m",
         fontsize=9,

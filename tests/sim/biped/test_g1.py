@@ -245,7 +245,7 @@ def test_g1_walks_a_short_flat_plan_made_for_it() -> None:
     plan = make_plan(scene, "kinematic", WALK_STEPS, opts, robot)
     res = walk(scene, plan, model_params=g)
     m = res.metrics
-    assert not res.fell
+    assert not res.trace.fell
     assert m.reached_goal
     assert m.steps_landed == plan.n_steps
     assert m.footstep_error_vs_target_m.mean < WALK_LANDING_TOL

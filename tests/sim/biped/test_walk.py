@@ -27,7 +27,7 @@ from footfall.sim.biped.options import WalkOptions  # noqa: E402
 from footfall.sim.biped.plant import BipedSim, ankle_joint_torque, sole_cop  # noqa: E402
 from footfall.sim.biped.references import ds_propagator  # noqa: E402
 from footfall.sim.biped.walk import walk  # noqa: E402
-from footfall.sim.pushes import Push  # noqa: E402
+from footfall.sim.disturbance import Push  # noqa: E402
 from footfall.terrain import Goal, Region, builtin_scene  # noqa: E402
 
 #: exact arithmetic of the CoP formula
@@ -110,7 +110,7 @@ def test_short_flat_walk_lands_every_planned_footstep(short_walk) -> None:  # ty
         + WalkOptions().shift_time
         + plan.n_steps * (plan.robot.t_ss + plan.robot.t_ds)
     )
-    assert (not res.fell) or res.fall_time >= t_last - 1e-9
+    assert (not res.trace.fell) or res.trace.fall_time >= t_last - 1e-9
     assert m.footstep_error_vs_target_m.mean < LANDING_TOL
     # the single-support CoP is measured and lies inside the sole
     assert m.zmp.samples > 0
@@ -331,7 +331,7 @@ def test_flat_walk_of_twenty_steps_reaches_the_goal() -> None:
     assert steps.max() < 0.45  # a stride is two steps apart
     res = walk(scene, plan)
     m = res.metrics
-    assert not res.fell
+    assert not res.trace.fell
     assert m.steps_landed == plan.n_steps
     assert m.reached_goal
     assert m.footstep_error_m.mean < FLAT20_FOOTSTEP_TOL
@@ -340,10 +340,10 @@ def test_flat_walk_of_twenty_steps_reaches_the_goal() -> None:
     # for one on average (regression slope; measured with the default whole-body QP 0.78
     # sagittal, 0.97 lateral; with the servo walker 0.85 and 1.09). The swing leg's reaction
     # scatters the sagittal CoP around it, hence no tighter bound.
-    ok = ~np.isnan(res.zmp_offset[:, 0]) & ~np.isnan(res.zmp_planned[:, 0])
+    ok = ~np.isnan(res.trace.zmp_offset[:, 0]) & ~np.isnan(res.trace.zmp_planned[:, 0])
     assert ok.sum() > 20 * 30
     for ax in range(2):
-        slope = np.polyfit(res.zmp_planned[ok, ax], res.zmp_offset[ok, ax], 1)[0]
+        slope = np.polyfit(res.trace.zmp_planned[ok, ax], res.trace.zmp_offset[ok, ax], 1)[0]
         assert COP_SLOPE[0] < slope < COP_SLOPE[1]
 
 
@@ -354,21 +354,26 @@ def test_long_flat_steps_reach_the_goal_with_a_limp_landing_ankle() -> None:
     plan = make_plan(scene, "miqcqp", robot=planner_params(base=scene.robot))
     assert np.linalg.norm(np.diff(plan.footsteps[:, :2], axis=0), axis=1).max() > 0.35
     res = walk(scene, plan, WalkOptions(controller="servo", passive_landing=True))
-    assert not res.fell
+    assert not res.trace.fell
     assert res.metrics.reached_goal
 
 
-def test_cli_compare_mujoco_writes_the_table(tmp_path) -> None:  # type: ignore[no-untyped-def]
+def test_cli_compare_mujoco_writes_the_study_table(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    # compare --sim mujoco is the study runner with the MuJoCo plant: one row per walk
+    pytest.importorskip("pyarrow")
+    from footfall.experiments.study.store import read_rows
+
     args = ["compare", "--sim", "mujoco", "--scenes", "flat", "--planners", "reactive"]
-    res = CliRunner().invoke(app, [*args, "--trials", "1", "--out", str(tmp_path)])
+    res = CliRunner().invoke(app, [*args, "--trials", "1", "--out", str(tmp_path), "--quiet"])
     assert res.exit_code == 0, res.output
-    md = (tmp_path / "compare_mujoco.md").read_text()
-    assert "| flat | reactive | 1 |" in md
-    assert (tmp_path / "compare_mujoco.png").stat().st_size > 0
-    rows = (tmp_path / "compare_mujoco.csv").read_text().splitlines()
-    assert len(rows) == 2 and "zmp_mean_m" in rows[0]
+    (row,) = read_rows(tmp_path / "trials.parquet")
+    assert row["simulator"] == "mujoco" and row["controller"] == "wbc" and row["error"] is None
+    assert row["success"] and row["push_impulse"] == 3.0
+    assert 0.0 < row["zmp_offset_mean"] <= row["zmp_offset_max"] < 0.15
+    assert row["footsteps_off_terrain"] == 0
+    assert "| flat |" in (tmp_path / "summary.md").read_text()
     bad = CliRunner().invoke(app, [*args, "--sim", "bogus", "--out", str(tmp_path / "x")])
-    assert isinstance(bad.exception, InputError) and bad.exception.field == "sim"
+    assert isinstance(bad.exception, InputError) and bad.exception.field == "simulator"
 
 
 def test_walk_plan_cache_round_trip_keeps_the_region_margin(tmp_path) -> None:  # type: ignore[no-untyped-def]
@@ -512,33 +517,6 @@ def test_cli_walk_plans_robot_aware_unless_document_reach(  # type: ignore[no-un
     assert saved["reach_both_frames"] is both_frames
     assert saved.get("swing_max") == (SWING_MAX if both_frames else None)
     assert json.loads((out / "walk.json").read_text())["metrics"]["reached_goal"]
-
-
-@pytest.mark.parametrize(
-    ("flag", "aware", "segments"),
-    [
-        ([], True, None),
-        (["--document-reach"], False, None),
-        (["--heading-segments", "32"], True, 32),
-    ],
-)
-def test_cli_compare_mujoco_passes_the_reach_choice_to_its_plans(  # type: ignore[no-untyped-def]
-    flag: list[str], aware: bool, segments: int | None, tmp_path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    # compare --sim mujoco plans through plan_for_walk like `walk`, with the same choices
-    import footfall.experiments.compare_mujoco as bc
-
-    seen = []
-
-    def capture(*args, **kwargs):  # type: ignore[no-untyped-def]
-        seen.append((kwargs.get("robot_aware"), kwargs.get("heading_segments")))
-        raise RuntimeError("captured")
-
-    monkeypatch.setattr(bc, "plan_for_walk", capture)
-    args = ["compare", "--sim", "mujoco", "--scenes", "flat", "--planners", "kinematic"]
-    res = CliRunner().invoke(app, [*args, "--trials", "1", "--out", str(tmp_path), *flag])
-    assert isinstance(res.exception, RuntimeError)
-    assert seen == [(aware, segments)]
 
 
 def test_cli_walk_rejects_too_few_heading_segments(tmp_path) -> None:  # type: ignore[no-untyped-def]

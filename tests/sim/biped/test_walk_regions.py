@@ -1,4 +1,4 @@
-"""Region-aware corrections in MuJoCo (issue 23): the walker walks stepping_stones with the
+"""Region-aware corrections in MuJoCo: the walker walks stepping_stones with the
 miqcqp plan of ``footfall walk`` (stored in data/, so the test does not plan for minutes) and a
 2 N s push, every footstep landing on a stone; the walk metrics' region counts are checked
 against shapely on the landed soles."""
@@ -17,8 +17,10 @@ from shapely.geometry import Point, Polygon  # noqa: E402
 
 from footfall.planning.plan_file import load_plan  # noqa: E402
 from footfall.sim.biped.options import WalkOptions  # noqa: E402
-from footfall.sim.biped.plans import random_push  # noqa: E402
+from footfall.sim.biped.trial import MujocoBipedPlant  # noqa: E402
 from footfall.sim.biped.walk import walk  # noqa: E402
+from footfall.sim.disturbance import Disturbance  # noqa: E402
+from footfall.sim.trial import run_trial  # noqa: E402
 from footfall.terrain import builtin_scene  # noqa: E402
 
 PLAN = Path(__file__).parent / "data" / "stepping_stones_miqcqp.json"
@@ -30,12 +32,13 @@ def test_region_aware_walk_keeps_every_footstep_on_a_stone() -> None:
     scene = builtin_scene("stepping_stones")
     plan = load_plan(PLAN, scene)
     opts = WalkOptions(region_aware="planned")
-    push = random_push(0, 20.0, plan, opts)  # 20 N for 0.1 s: 2 N s
-    res = walk(scene, plan, WalkOptions(region_aware="planned", pushes=(push,)))
+    outcome = run_trial(MujocoBipedPlant(opts), scene, plan, Disturbance.of_seed(0, impulse=2.0))
+    res = outcome.detail
     m = res.metrics
+    assert outcome.footsteps_off_terrain == m.footsteps_off_regions
     assert not m.fell and m.reached_goal
     polys = [(Polygon(r.vertices), r) for r in scene.terrain.regions]
-    landed = res.landed[~np.isnan(res.landed[:, 0])]
+    landed = res.trace.landed[~np.isnan(res.trace.landed[:, 0])]
     assert landed.shape[0] == plan.n_steps + opts.stop_steps
     for p in landed:
         on = [
@@ -50,7 +53,7 @@ def test_region_aware_walk_keeps_every_footstep_on_a_stone() -> None:
     assert all(c["region"] == c["planned"] for c in m.region_choices)
     assert m.region_changes == ()
     # corrections are the distances of the commanded footsteps from the plan
-    corr = np.linalg.norm((res.targets - res.planned)[: plan.n_steps, :2], axis=1)
+    corr = np.linalg.norm((res.trace.targets - res.trace.planned)[: plan.n_steps, :2], axis=1)
     assert m.correction_m.max == pytest.approx(corr.max(), abs=1e-12)
     assert 0.0 < m.correction_m.max < 0.1
 
@@ -101,7 +104,7 @@ def test_a_retargeted_swing_is_raised_over_the_regions_under_its_new_path(mode: 
 
 @pytest.mark.parametrize("name", ["narrow_stones_gap", "roll_ramps", "corridor_corner"])
 def test_new_scenes_are_walked_with_every_footstep_on_a_region(name: str) -> None:
-    """Smoke test of the issue's new scenes (plans of ``footfall walk`` stored in data/): the
+    """Smoke test of the region scenes (plans of ``footfall walk`` stored in data/): the
     walker's default (region-aware: ``planned``) reaches the goal and no landed sole centre is
     off the terrain (shapely)."""
     scene = builtin_scene(name)
@@ -110,7 +113,7 @@ def test_new_scenes_are_walked_with_every_footstep_on_a_region(name: str) -> Non
     assert opts.region_aware == "planned"
     res = walk(scene, plan, opts)
     assert not res.metrics.fell and res.metrics.reached_goal
-    landed = res.landed[~np.isnan(res.landed[:, 0])]
+    landed = res.trace.landed[~np.isnan(res.trace.landed[:, 0])]
     for p in landed:
         assert any(
             Polygon(r.vertices).covers(Point(p[:2]))

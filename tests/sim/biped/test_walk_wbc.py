@@ -41,7 +41,7 @@ def wbc_walk():  # type: ignore[no-untyped-def]
 def test_flat_walk_on_torques_reaches_the_goal(wbc_walk) -> None:  # type: ignore[no-untyped-def]
     _, plan, res = wbc_walk
     m = res.metrics
-    assert not res.fell
+    assert not res.trace.fell
     assert m.reached_goal
     assert m.steps_landed == plan.n_steps
     assert m.zmp.inside_share == 1.0
@@ -51,21 +51,21 @@ def test_measured_cop_is_the_commanded_ankle_torque(wbc_walk) -> None:  # type: 
     # the planner's (adjuster's) ALIP torque is commanded as the stance foot's centre of
     # pressure; the CoP measured from MuJoCo's contact forces must follow it one for one
     _, _, res = wbc_walk
-    ok = ~np.isnan(res.zmp_offset[:, 0]) & ~np.isnan(res.zmp_planned[:, 0])
+    ok = ~np.isnan(res.trace.zmp_offset[:, 0]) & ~np.isnan(res.trace.zmp_planned[:, 0])
     assert ok.sum() > 300
     for ax in range(2):
-        slope = np.polyfit(res.zmp_planned[ok, ax], res.zmp_offset[ok, ax], 1)[0]
+        slope = np.polyfit(res.trace.zmp_planned[ok, ax], res.trace.zmp_offset[ok, ax], 1)[0]
         assert COP_SLOPE[0] < slope < COP_SLOPE[1]
-        rms = np.sqrt(np.mean((res.zmp_offset[ok, ax] - res.zmp_planned[ok, ax]) ** 2))
+        rms = np.sqrt(np.mean((res.trace.zmp_offset[ok, ax] - res.trace.zmp_planned[ok, ax]) ** 2))
         assert rms < COP_RMS[ax]
 
 
 def test_every_qp_respects_torques_friction_and_the_sole(wbc_walk) -> None:  # type: ignore[no-untyped-def]
     _, _, res = wbc_walk
-    c = res.controller
+    c = res.trace.controller
     assert c["name"] == "wbc"
     # one QP per physics step from the first tick to the last
-    assert c["qp_solves"] == round(res.sim_time / 0.002)
+    assert c["qp_solves"] == round(res.trace.sim_time / 0.002)
     assert c["qp_failures"] == 0
     assert 0.0 < c["max_torque_share"] <= 1.0
     assert c["max_friction_excess_N"] <= QP_TOL

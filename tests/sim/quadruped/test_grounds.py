@@ -85,12 +85,12 @@ def test_climbs_two_10cm_stairs(controller: str) -> None:
     params = GaitParams(slope=0.0, body_pitch=0.0, ground=g, swing_height=0.15, cycles=5)
     plan, res = _walk(params, controller)
     m = res.metrics
-    assert not m.fell and res.qp_failures == 0
+    assert not m.fell and res.trace.qp_failures == 0
     # measured: the trunk ends on top, 0.2 m up, where the plan puts it
-    assert res.trunk_pos[-1, 2] == pytest.approx(plan.phases[-1].body_end[2], abs=0.03)
+    assert res.trace.trunk_pos[-1, 2] == pytest.approx(plan.phases[-1].body_end[2], abs=0.03)
     assert plan.phases[-1].body_end[2] == pytest.approx(0.2 + ROBOT.stance_height, abs=0.01)
     # every foot ends resting on the top tread (foot centre R above it)
-    np.testing.assert_allclose(res.feet[-1, :, 2], 0.2, atol=0.01)
+    np.testing.assert_allclose(res.trace.feet[-1, :, 2], 0.2, atol=0.01)
     if controller == "wbc":
         assert m.zmp_error_mean_m is not None and m.zmp_error_max_m is not None
         assert m.zmp_error_mean_m <= 0.02 and m.zmp_error_max_m <= 0.05
@@ -102,7 +102,7 @@ def test_wbc_walks_a_side_slope_with_the_cop_on_the_plan() -> None:
     )
     _, res = _walk(params, "wbc")
     m = res.metrics
-    assert not m.fell and res.qp_failures == 0
+    assert not m.fell and res.trace.qp_failures == 0
     assert m.zmp_error_mean_m is not None and m.zmp_error_max_m is not None
     assert m.zmp_error_mean_m <= 0.02 and m.zmp_error_max_m <= 0.05
     assert m.trunk_drift_from_plan_m < 0.03
@@ -114,12 +114,12 @@ def test_wbc_pitches_with_a_varying_slope() -> None:
     params = GaitParams(slope=0.0, body_pitch=0.0, ground=g, cycles=4)
     _, res = _walk(params, "wbc")
     m = res.metrics
-    assert not m.fell and res.qp_failures == 0
+    assert not m.fell and res.trace.qp_failures == 0
     assert m.zmp_error_mean_m is not None and m.zmp_error_max_m is not None
     assert m.zmp_error_mean_m <= 0.02 and m.zmp_error_max_m <= 0.05
     # the measured trunk pitch follows the planned one, which changes along the walk
-    assert np.ptp(res.planned.body_pitch) > math.radians(4.0)
-    assert np.max(np.abs(res.trunk_pitch - res.planned.body_pitch)) < math.radians(2.0)
+    assert np.ptp(res.trace.planned.body_pitch) > math.radians(4.0)
+    assert np.max(np.abs(res.trace.trunk_pitch - res.trace.planned.body_pitch)) < math.radians(2.0)
 
 
 def test_cli_walks_a_scene(tmp_path) -> None:  # type: ignore[no-untyped-def]

@@ -104,7 +104,7 @@ def test_two_cycles_up_15_degrees_without_falling(walk) -> None:
     assert m.distance_up_slope_m > 0.8 * m.planned_distance_up_slope_m
     assert m.planned_distance_up_slope_m > 0.7
     # it rose by the slope's share of that distance
-    rise = res.trunk_pos[-1, 2] - res.trunk_pos[0, 2]
+    rise = res.trace.trunk_pos[-1, 2] - res.trace.trunk_pos[0, 2]
     assert rise == pytest.approx(m.distance_up_slope_m * math.sin(SLOPE), abs=0.03)
 
 

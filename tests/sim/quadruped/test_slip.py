@@ -187,9 +187,9 @@ def steep() -> Steep:
 
 def _slide_after(res: SimResult, t0: float) -> float:
     """Summed length of every foot's sliding displacement after gait time t0 [m]."""
-    sel = res.t > t0
-    dt = float(res.t[1] - res.t[0])
-    return float(np.linalg.norm(res.slip_vel[sel].sum(axis=0) * dt, axis=1).sum())
+    sel = res.trace.t > t0
+    dt = float(res.trace.t[1] - res.trace.t[0])
+    return float(np.linalg.norm(res.trace.slip_vel[sel].sum(axis=0) * dt, axis=1).sum())
 
 
 def test_the_guard_stops_the_slide_on_a_slippery_30_deg_slope(steep: Steep) -> None:
@@ -214,19 +214,19 @@ def test_the_guard_holds_four_planned_contacts_and_the_robot_stands_on_them(
 ) -> None:
     plan, stop = steep.plan, steep.stop
     ev = stop.slip_stop
-    t = stop.t
+    t = stop.trace.t
     assert ev is not None
     assert ev.hold_time_s >= ev.time_s
     # the hold starts at a phase boundary (never mid-swing)
     assert min(abs(p.t1 - ev.hold_time_s) for p in plan.phases) < 1e-9
     hold = t >= ev.hold_time_s - 1e-9
-    ref = stop.planned
+    ref = stop.trace.planned
     assert ref.contact[hold].all()
     np.testing.assert_array_equal(
         ref.joints[hold], np.broadcast_to(ref.joints[hold][0], ref.joints[hold].shape)
     )
     # measured: all four feet carry load over almost all of the hold
-    assert np.mean(stop.n_contacts[hold] == 4) > 0.95
+    assert np.mean(stop.trace.n_contacts[hold] == 4) > 0.95
     # and the planned stances before it end with the plan's (same stances, same times)
     before = [s for s in stop.metrics.stance_slips if s.t_end_s < ev.time_s]
     off_before = [s for s in steep.off.metrics.stance_slips if s.t_end_s < ev.time_s]
@@ -245,8 +245,8 @@ def test_the_guard_does_not_trigger_on_the_nominal_15_deg_walk() -> None:
     assert on.slip_stop is None
     assert on.metrics.foot_slip_max_m < DEFAULT_SLIP_LIMIT
     # a guard that does not act leaves the walk exactly as it was
-    np.testing.assert_array_equal(on.trunk_pos, off.trunk_pos)
-    np.testing.assert_array_equal(on.planned.contact, off.planned.contact)
+    np.testing.assert_array_equal(on.trace.trunk_pos, off.trace.trunk_pos)
+    np.testing.assert_array_equal(on.trace.planned.contact, off.trace.planned.contact)
 
 
 def test_the_guard_stops_the_whole_body_controller_on_a_slippery_climb() -> None:
@@ -261,12 +261,12 @@ def test_the_guard_stops_the_whole_body_controller_on_a_slippery_climb() -> None
     res = simulate(plan, SimSettings(friction=SLIPPERY), controller="wbc", slip_guard=SlipGuard())
     ev = res.slip_stop
     assert ev is not None
-    hold = res.t >= ev.hold_time_s - 1e-9
+    hold = res.trace.t >= ev.hold_time_s - 1e-9
     assert hold.sum() > 400  # more than four seconds held
-    assert res.planned.contact[hold].all()
+    assert res.trace.planned.contact[hold].all()
     assert not res.metrics.fell
-    assert res.qp_failures == 0
-    assert np.linalg.norm(res.trunk_pos[hold][-1] - res.trunk_pos[hold][0]) < 0.03
+    assert res.trace.qp_failures == 0
+    assert np.linalg.norm(res.trace.trunk_pos[hold][-1] - res.trace.trunk_pos[hold][0]) < 0.03
 
 
 def test_simulate_refuses_a_guard_of_the_wrong_type() -> None:

@@ -107,13 +107,17 @@ def walks() -> dict[tuple[float, str], object]:
 def test_wbc_puts_the_measured_cop_on_the_planned_zmp(walks: dict, slope: float) -> None:
     res = walks[(slope, "wbc")]
     m = res.metrics
-    assert not m.fell and res.qp_failures == 0 and res.controller == "wbc"
+    assert not m.fell and res.trace.qp_failures == 0 and res.controller == "wbc"
     assert m.zmp_error_mean_m <= COP_MEAN_MAX
     assert m.zmp_error_max_m <= COP_MAX_MAX
     # recomputed here from the recorded CoP and plan, over the samples with three or four feet
     # planned and measured down
-    ok = (res.planned.contact.sum(axis=1) >= 3) & (res.n_contacts >= 3) & np.isfinite(res.margin)
-    err = np.linalg.norm(res.cop - res.planned.zmp, axis=1)[ok]
+    ok = (
+        (res.trace.planned.contact.sum(axis=1) >= 3)
+        & (res.trace.n_contacts >= 3)
+        & np.isfinite(res.trace.margin)
+    )
+    err = np.linalg.norm(res.trace.cop - res.trace.planned.zmp, axis=1)[ok]
     assert ok.sum() > 0.9 * ok.size
     assert err.mean() == pytest.approx(m.zmp_error_mean_m)
     # the document's servos on the same plan leave the CoP much further away
@@ -139,16 +143,16 @@ def test_controller_and_gains_are_checked() -> None:
 def test_a_push_moves_the_trunk_by_its_impulse() -> None:
     """A lateral push of J [N s] moves the trunk sideways by at most what it would move in free
     flight over the pulse, 1/2 (J / m) T, and by a good part of it (the legs resist)."""
-    from footfall.sim.pushes import Push
+    from footfall.sim.disturbance import Push
 
     plan = _plan(15.0, 10.0, cycles=1)
     push = Push.horizontal(0.5, 40.0, math.pi / 2, 0.1)
     quiet = simulate(plan, controller="wbc")
     pushed = simulate(plan, controller="wbc", pushes=(push,))
-    k0, k1 = np.searchsorted(quiet.t, [0.5, 0.6])
+    k0, k1 = np.searchsorted(quiet.trace.t, [0.5, 0.6])
     # the same walk until the push, then pushed sideways (+y) relative to the quiet walk
-    np.testing.assert_allclose(pushed.trunk_pos[:k0], quiet.trunk_pos[:k0], atol=1e-9)
-    dy = pushed.trunk_pos[k1, 1] - quiet.trunk_pos[k1, 1]
+    np.testing.assert_allclose(pushed.trace.trunk_pos[:k0], quiet.trace.trunk_pos[:k0], atol=1e-9)
+    dy = pushed.trace.trunk_pos[k1, 1] - quiet.trace.trunk_pos[k1, 1]
     # free flight would move the trunk 1/2 (J / m) * 0.1 s = 2 cm; the stance legs resist
     free = 0.5 * 40.0 / plan.robot.total_mass * 0.1
     assert 0.2 * free < dy < 1.2 * free
@@ -163,9 +167,9 @@ def test_downhill_walk_descends_with_the_cop_on_the_plan() -> None:
     plan = _plan(-15.0, -10.0)
     res = simulate(plan, controller="wbc")
     m = res.metrics
-    assert not m.fell and res.qp_failures == 0
-    dx = res.trunk_pos[-1, 0] - res.trunk_pos[0, 0]
-    dz = res.trunk_pos[-1, 2] - res.trunk_pos[0, 2]
+    assert not m.fell and res.trace.qp_failures == 0
+    dx = res.trace.trunk_pos[-1, 0] - res.trace.trunk_pos[0, 0]
+    dz = res.trace.trunk_pos[-1, 2] - res.trace.trunk_pos[0, 2]
     assert dx > 0.3
     assert dz == pytest.approx(dx * math.tan(math.radians(-15.0)), abs=0.03)
     assert m.zmp_error_mean_m <= COP_MEAN_MAX and m.zmp_error_max_m <= COP_MAX_MAX
@@ -213,5 +217,5 @@ def test_forty_degrees_is_walked_with_the_pyramid_edge_downhill() -> None:
     )
     plan = plan_gait(QuadrupedRobot(), params)
     res = simulate(plan, controller="wbc")
-    assert not res.metrics.fell and res.qp_failures == 0
+    assert not res.metrics.fell and res.trace.qp_failures == 0
     assert res.metrics.zmp_error_mean_m <= COP_MEAN_MAX

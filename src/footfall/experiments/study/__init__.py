@@ -2,7 +2,7 @@
 push levels x seeds, walked on a local process pool or Ray, stored one row per trial in Parquet
 (resumable), summarised with confidence intervals and paired tests.
 
-- :mod:`.design`: :class:`StudyDesign`, the study YAML, the paired :class:`Disturbance` of a seed.
+- :mod:`.design`: :class:`StudyDesign`, the study YAML.
 - :mod:`.trials`: one walk as one row (:func:`run_trial`).
 - :mod:`.store`: ``trials.parquet`` written as trials finish.
 - :mod:`.runner`: plans, trials, executors (:func:`run_study`).
@@ -11,7 +11,6 @@ push levels x seeds, walked on a local process pool or Ray, stored one row per t
 
 from footfall.experiments.study.design import (
     BUILTIN_STUDIES,
-    Disturbance,
     StudyDesign,
     builtin_study,
     load_study,
@@ -25,7 +24,6 @@ __all__ = [
     "BUILTIN_STUDIES",
     "COLUMNS",
     "EXECUTORS",
-    "Disturbance",
     "StudyDesign",
     "StudyRun",
     "Summary",

@@ -5,16 +5,15 @@ A study file is YAML (read with the safe loader, so it is data, never code) vali
 (:func:`builtin_study`): ``section55`` (the final study, MuJoCo biped with the whole-body
 controller) and ``quick`` (a tiny reduced-order study that checks a setup in about a minute).
 
-Paired design: trial ``seed`` draws its :class:`Disturbance` (which step and when in its single
-support the push comes, its direction, the direction of the initial perturbation) from the seed
-alone, so every planner, step count and push level of that seed gets the same disturbance and
-only its impulse varies between levels (common random numbers).
+Paired design: trial ``seed`` draws its :class:`~footfall.sim.disturbance.Disturbance` (which step
+and when in its single support the push comes, its direction, the direction of the initial
+perturbation) from the seed alone (:meth:`~footfall.sim.disturbance.Disturbance.of_seed`), so every
+planner, step count and push level of that seed gets the same disturbance and only its impulse
+varies between levels (common random numbers).
 """
 
 from __future__ import annotations
 
-import math
-import stat
 from dataclasses import dataclass, fields
 from importlib import resources
 from pathlib import Path
@@ -23,6 +22,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from footfall._io import read_bounded
 from footfall._validate import non_negative, positive
 from footfall.errors import InputError
 from footfall.planning.plan import PLANNERS
@@ -41,50 +41,6 @@ BUILTIN_STUDIES = ("section55", "section55_reduced", "quick")
 MAX_STUDY_BYTES = 100_000
 #: most trials one study may declare (a typo like ``seeds: 2000000`` is refused, not queued)
 MAX_TRIALS = 200_000
-#: the seed of the disturbance generator is ``[seed, DISTURBANCE_STREAM]``
-DISTURBANCE_STREAM = 55_000
-#: the push comes in the single support of the step at this fraction of the plan's N
-PUSH_STEP_WINDOW = (0.3, 0.7)
-#: ... at this fraction of that single support
-PUSH_PHASE_WINDOW = (0.2, 0.6)
-
-
-@dataclass(frozen=True)
-class Disturbance:
-    """What trial ``seed`` does to every walk (the same for every planner, N and push level).
-
-    Attributes:
-        seed: the trial seed (>= 0).
-        step_fraction: the push comes in the single support of step ``floor(f N)``, f in
-            ``PUSH_STEP_WINDOW``.
-        phase: ... at this fraction of that single support, in ``PUSH_PHASE_WINDOW``.
-        direction: push direction in the world frame [rad] (0 = +x).
-        initial_direction: direction of the initial perturbation [rad].
-    """
-
-    seed: int
-    step_fraction: float
-    phase: float
-    direction: float
-    initial_direction: float
-
-    @classmethod
-    def of_seed(cls, seed: int) -> Disturbance:
-        """The disturbance of trial ``seed`` (a pure function of the seed)."""
-        if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-            raise InputError("seed", seed, "an integer >= 0")
-        rng = np.random.default_rng([int(seed), DISTURBANCE_STREAM])
-        f, ph, a, b = (
-            rng.uniform(*PUSH_STEP_WINDOW),
-            rng.uniform(*PUSH_PHASE_WINDOW),
-            rng.uniform(0.0, 2.0 * math.pi),
-            rng.uniform(0.0, 2.0 * math.pi),
-        )
-        return cls(int(seed), float(f), float(ph), float(a), float(b))
-
-    def push_step(self, n_steps: int) -> int:
-        """The step (0-based single-support phase) of a plan with ``n_steps`` steps pushed."""
-        return min(n_steps - 1, int(self.step_fraction * n_steps))
 
 
 @dataclass(frozen=True)
@@ -96,7 +52,8 @@ class StudyDesign:
         simulator: ``reduced`` (the ALIP closed loop of :mod:`footfall.sim.reduced`) or ``mujoco``
             (the MuJoCo biped of :mod:`footfall.sim.biped`).
         controller: the MuJoCo walker's controller (``wbc`` or ``servo``); None with ``reduced``.
-        scenes: built-in scene names.
+        scenes: built-in scene names or scene YAML files (a file's path relative to the study
+            file's folder when the study was read from a file).
         planners: planner names (``miqcqp``, ``kinematic``, ``reactive``).
         steps: step-count modes of the horizon planners (``smallest``, ``equal``); the reactive
             planner walks to the goal in both.
@@ -159,7 +116,7 @@ class StudyDesign:
             if self.simulator == "mujoco" and v != 0.0:
                 raise InputError(name, v, "0 with simulator mujoco (a reduced-order option)")
             object.__setattr__(self, name, v)
-        object.__setattr__(self, "scenes", _names("scenes", self.scenes, builtin_scene_names()))
+        object.__setattr__(self, "scenes", _scenes(self.scenes))
         object.__setattr__(self, "planners", _names("planners", self.planners, PLANNERS))
         object.__setattr__(self, "steps", _names("steps", self.steps, STEP_MODES))
         if self.level_steps is None:
@@ -247,6 +204,23 @@ class StudyDesign:
         return out
 
 
+def _scenes(value: object) -> tuple[str, ...]:
+    """Scene entries: built-in names or paths of existing files, each once."""
+    builtin = builtin_scene_names()
+    if isinstance(value, str) or not isinstance(value, list | tuple) or not value:
+        raise InputError("scenes", value, f"a non-empty list of: {', '.join(builtin)} or files")
+    out: list[str] = []
+    for i, v in enumerate(value):
+        if not isinstance(v, str) or not (v in builtin or Path(v).is_file()):
+            raise InputError(
+                f"scenes[{i}]", v, f"a built-in scene ({', '.join(builtin)}) or a scene file"
+            )
+        if v in out:
+            raise InputError(f"scenes[{i}]", v, "each scene once")
+        out.append(v)
+    return tuple(out)
+
+
 def _names(field: str, value: object, valid: tuple[str, ...] | list[str]) -> tuple[str, ...]:
     if isinstance(value, str) or not isinstance(value, list | tuple) or not value:
         raise InputError(field, value, f"a non-empty list of: {', '.join(valid)}")
@@ -263,8 +237,9 @@ def _names(field: str, value: object, valid: tuple[str, ...] | list[str]) -> tup
 _FIELDS = {f.name for f in fields(StudyDesign)}
 
 
-def study_from_dict(data: object, source: str = "study") -> StudyDesign:
-    """Validate plain data (a parsed study file) into a :class:`StudyDesign`."""
+def study_from_dict(data: object, source: str = "study", base: Path | None = None) -> StudyDesign:
+    """Validate plain data (a parsed study file) into a :class:`StudyDesign`; ``base``: the
+    folder that relative scene file paths are relative to (the study file's)."""
     if not isinstance(data, dict):
         raise InputError(source, type(data).__name__, "a mapping of study fields")
     unknown = sorted((k for k in data if k not in _FIELDS), key=str)
@@ -278,27 +253,28 @@ def study_from_dict(data: object, source: str = "study") -> StudyDesign:
         raise InputError(f"{source}: name", None, "a name for the study")
     if data.get("simulator", "mujoco") == "reduced" and "controller" not in data:
         data = {**data, "controller": None}
+    scenes = data.get("scenes")
+    if base is not None and isinstance(scenes, list):
+        builtin = builtin_scene_names()
+        data = {
+            **data,
+            "scenes": [
+                str(base / v) if isinstance(v, str) and v not in builtin else v for v in scenes
+            ],
+        }
     return StudyDesign(**{str(k): v for k, v in data.items()})
 
 
 def load_study(path: Path) -> StudyDesign:
     """Read and validate a study YAML file (a regular file of at most ``MAX_STUDY_BYTES``)."""
     path = Path(path)
-    try:
-        info = path.stat()
-    except OSError as e:
-        raise InputError("study file", str(path), f"a readable YAML file ({e.strerror})") from None
-    if not stat.S_ISREG(info.st_mode):
-        raise InputError("study file", str(path), "a regular file")
-    if info.st_size > MAX_STUDY_BYTES:
-        raise InputError(
-            "study file", f"{path} ({info.st_size} bytes)", f"at most {MAX_STUDY_BYTES} bytes"
-        )
-    return parse_study(path.read_bytes(), str(path))
+    text = read_bounded(path, "study file", MAX_STUDY_BYTES, "YAML file")
+    return parse_study(text, str(path), base=path.parent)
 
 
-def parse_study(text: str | bytes, source: str = "study") -> StudyDesign:
-    """Validate study YAML text (safe loader: tags that build Python objects are refused)."""
+def parse_study(text: str | bytes, source: str = "study", base: Path | None = None) -> StudyDesign:
+    """Validate study YAML text (safe loader: tags that build Python objects are refused);
+    ``base``: the folder of relative scene file paths."""
     if isinstance(text, bytes):
         try:
             text = text.decode("utf-8")
@@ -312,7 +288,7 @@ def parse_study(text: str | bytes, source: str = "study") -> StudyDesign:
         raise InputError(
             f"{source}{where}", None, f"valid YAML ({getattr(e, 'problem', e)})"
         ) from None
-    return study_from_dict(data, source)
+    return study_from_dict(data, source, base)
 
 
 def builtin_study(name: str) -> StudyDesign:

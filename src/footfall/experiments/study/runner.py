@@ -23,12 +23,14 @@ from pathlib import Path
 from typing import Any
 
 from footfall.errors import InputError
-from footfall.experiments.study.design import Disturbance, StudyDesign
+from footfall.experiments.study.design import StudyDesign
 from footfall.experiments.study.store import TrialStore
 from footfall.experiments.study.trials import Trial, plan_digest, run_trial, trial_key
 from footfall.planning.plan import FootstepPlan
 from footfall.planning.run import SearchMonitor
-from footfall.terrain.scene import Scene, builtin_scene
+from footfall.sim.disturbance import Disturbance
+from footfall.terrain.resolve import resolve_scene
+from footfall.terrain.scene import Scene
 
 #: the executors of ``footfall study --executor``
 EXECUTORS = ("local", "ray")
@@ -102,6 +104,17 @@ def _planner(design: StudyDesign, folder: Path) -> Planner:
     return plan_reduced
 
 
+def design_scenes(design: StudyDesign) -> dict[str, Scene]:
+    """The study's scenes by name (built-in or read from their files)."""
+    scenes: dict[str, Scene] = {}
+    for entry in design.scenes:
+        scene = resolve_scene(entry)
+        if scene.name in scenes:
+            raise InputError("scenes", entry, f"scenes with distinct names ({scene.name!r} twice)")
+        scenes[scene.name] = scene
+    return scenes
+
+
 def make_plans(
     design: StudyDesign,
     folder: Path,
@@ -128,8 +141,8 @@ def make_plans(
             say(f"  {p.status.value}, N = {n_txt}, {entry.plan_time:.1f} s")
         return entry
 
-    for name in design.scenes:
-        scene = builtin_scene(name)
+    for scene in design_scenes(design).values():
+        name = scene.name
         reactive = None
         if "reactive" in design.planners or "equal" in design.steps:
             reactive = timed(scene, "reactive", None, "goal")
@@ -160,7 +173,7 @@ def make_trials(design: StudyDesign, plans: list[PlanEntry]) -> list[Trial]:
     holds the same seeds in every cell it reached, paired and balanced.
 
     A walk that serves both step modes is one trial with both flags."""
-    scenes = {name: builtin_scene(name) for name in design.scenes}
+    scenes = design_scenes(design)
     flags: dict[str, list[bool]] = {}
     spec: dict[str, tuple[PlanEntry, float, int]] = {}
     for entry in plans:
@@ -183,8 +196,12 @@ def make_trials(design: StudyDesign, plans: list[PlanEntry]) -> list[Trial]:
                 plan=entry.plan,
                 smallest_n=flags[key][0],
                 equal_n=flags[key][1],
-                impulse=impulse,
-                disturbance=Disturbance.of_seed(seed),
+                disturbance=Disturbance.of_seed(
+                    seed,
+                    impulse=impulse,
+                    duration=design.push_duration,
+                    initial_impulse=design.initial_impulse,
+                ),
                 design=design,
             )
         )

@@ -17,12 +17,16 @@ from typing import Any
 
 import numpy as np
 
-from footfall.experiments.study.design import Disturbance, StudyDesign
+from footfall.experiments.study.design import StudyDesign
 from footfall.planning.plan import FootstepPlan
-from footfall.sim.pushes import Push
+from footfall.results.outcome import OUTCOME_COLUMNS
+from footfall.sim.disturbance import Disturbance
+from footfall.sim.trial import Plant, make_plant, shared_plant
+from footfall.sim.trial import run_trial as run_plant
 from footfall.terrain.scene import Scene
 
-#: the columns of ``trials.parquet`` in order, with their Arrow types (see ``store.py``)
+#: the columns of ``trials.parquet`` in order, with their Arrow types (see ``store.py``): the
+#: trial's identity and push, the plant's :class:`~footfall.results.outcome.Outcome`, the error
 COLUMNS: tuple[tuple[str, str], ...] = (
     ("key", "string"),
     ("scene", "string"),
@@ -38,18 +42,18 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("push_step", "int64"),
     ("push_time", "float64"),
     ("push_direction", "float64"),
-    ("success", "bool"),
-    ("fell", "bool"),
-    ("zmp_offset_mean", "float64"),
-    ("zmp_offset_max", "float64"),
-    ("footstep_error_mean", "float64"),
-    ("goal_error", "float64"),
-    ("steps_landed", "int64"),
-    ("wall_time", "float64"),
+    *OUTCOME_COLUMNS,
     ("error", "string"),
 )
 #: columns a table written before they existed may lack (read as None)
-OPTIONAL_COLUMNS = ("plan",)
+OPTIONAL_COLUMNS = (
+    "plan",
+    "fall_time",
+    "cop_error_mean",
+    "cop_error_max",
+    "footsteps_off_terrain",
+    "sim_time",
+)
 #: the columns that vary between runs of the same trial (left out when runs are compared)
 RUN_DEPENDENT = ("wall_time",)
 
@@ -65,8 +69,8 @@ class Trial:
         plan: the plan walked (its ``n_steps`` is N).
         smallest_n: the plan is the planner's smallest-N plan.
         equal_n: the plan has the reactive walk's N.
-        impulse: push impulse [N s] (0: no push).
-        disturbance: the seed's disturbance.
+        disturbance: the seed's disturbance with this trial's push impulse [N s] (0: no
+            push) and the study's push duration and initial perturbation.
         design: the study (simulator, controller, noise, durations).
     """
 
@@ -76,7 +80,6 @@ class Trial:
     plan: FootstepPlan
     smallest_n: bool
     equal_n: bool
-    impulse: float
     disturbance: Disturbance
     design: StudyDesign
 
@@ -98,82 +101,28 @@ def trial_key(scene: str, planner: str, n_steps: int, impulse: float, seed: int)
     return f"{scene}|{planner}|N={n_steps}|J={impulse:g}|seed={seed}"
 
 
-def _pushes(trial: Trial, walk_start: float) -> tuple[tuple[Push, ...], int, float]:
-    """The initial perturbation and the trial's push; the pushed step and the push time [s].
+def study_plant(design: StudyDesign) -> Plant:
+    """The plant of the study's simulator (:data:`footfall.sim.trial.PLANTS`) with its settings."""
+    if design.simulator == "mujoco":
+        from footfall.sim.biped.options import WalkOptions
 
-    ``walk_start``: when the first single support starts [s]; the initial perturbation ends
-    before it (reduced: it starts at 0 and the first support starts then too)."""
-    d, design, robot = trial.disturbance, trial.design, trial.plan.robot
-    step = d.push_step(trial.plan.n_steps)
-    t_push = walk_start + step * (robot.t_ss + robot.t_ds) + d.phase * robot.t_ss
-    pushes = []
-    if design.initial_impulse > 0:
-        t0 = max(0.0, walk_start - 1.5 * design.push_duration)
-        pushes.append(
-            Push.horizontal(t0, design.initial_impulse, d.initial_direction, design.push_duration)
-        )
-    if trial.impulse > 0:
-        pushes.append(Push.horizontal(t_push, trial.impulse, d.direction, design.push_duration))
-    return tuple(pushes), step, t_push
+        options = WalkOptions(controller=str(design.controller), region_aware=design.region_aware)
+        return make_plant("mujoco", options=options)
+    from footfall.sim.reduced.closed_loop import SimOptions
 
-
-def _reduced(trial: Trial) -> dict[str, Any]:
-    from footfall.sim.reduced.closed_loop import SimOptions, simulate
-
-    pushes, step, t_push = _pushes(trial, 0.0)
-    design = trial.design
-    opts = SimOptions(
+    sim = SimOptions(
         noise_pos=design.noise_pos,
         noise_vel=design.noise_vel,
         placement_error=design.placement_error,
-        pushes=pushes,
-        seed=trial.disturbance.seed,
         region_aware=design.region_aware,
     )
-    # the regions only when the MPC needs them (the off rows stay those of earlier studies)
-    regions = trial.scene.terrain.regions if design.region_aware != "off" else None
-    m = simulate(trial.plan, opts, goal=trial.scene.goal.position, regions=regions).metrics
-    return {
-        "push_step": step,
-        "push_time": t_push,
-        "success": bool(m.success),
-        "fell": bool(m.fell),
-        "zmp_offset_mean": m.zmp_offset_mean,
-        "zmp_offset_max": m.zmp_offset_max,
-        "footstep_error_mean": m.footstep_dev_mean,
-        "goal_error": m.goal_error,
-        "steps_landed": int(m.steps_taken),
-    }
-
-
-def _mujoco(trial: Trial) -> dict[str, Any]:
-    from footfall.sim.biped.options import WalkOptions
-    from footfall.sim.biped.walk import walk
-
-    base = WalkOptions(controller=str(trial.design.controller))
-    start = base.settle_time + base.shift_time
-    pushes, step, t_push = _pushes(trial, start)
-    opts = WalkOptions(
-        controller=base.controller, pushes=pushes, region_aware=trial.design.region_aware
-    )
-    res = walk(trial.scene, trial.plan, opts)
-    m = res.metrics
-    return {
-        "push_step": step,
-        "push_time": t_push,
-        "success": bool(m.reached_goal and not m.fell),
-        "fell": bool(m.fell),
-        "zmp_offset_mean": m.zmp.mean,
-        "zmp_offset_max": m.zmp.max,
-        "footstep_error_mean": m.footstep_error_m.mean,
-        "goal_error": m.goal_error_m,
-        "steps_landed": int(m.steps_landed),
-    }
+    return make_plant("reduced", options=sim)
 
 
 def run_trial(trial: Trial) -> dict[str, Any]:
     """Walk ``trial`` and return its row (``COLUMNS``); an exception becomes the row's ``error``."""
     t0 = time.perf_counter()
+    d = trial.disturbance
     row: dict[str, Any] = {
         "key": trial.key,
         "scene": trial.scene.name,
@@ -182,21 +131,23 @@ def run_trial(trial: Trial) -> dict[str, Any]:
         "plan": plan_digest(trial.plan),
         "smallest_n": trial.smallest_n,
         "equal_n": trial.equal_n,
-        "push_impulse": float(trial.impulse),
-        "seed": int(trial.disturbance.seed),
+        "push_impulse": float(d.impulse),
+        "seed": d.seed,
         "simulator": trial.design.simulator,
         "controller": trial.design.controller,
-        "push_direction": trial.disturbance.direction if trial.impulse > 0 else math.nan,
+        "push_direction": d.direction if d.impulse > 0 else math.nan,
         "error": None,
     }
     try:
-        out = _mujoco(trial) if trial.design.simulator == "mujoco" else _reduced(trial)
-        row.update(out)
+        plant = shared_plant(study_plant(trial.design))
+        row["push_step"] = d.push_step(trial.plan.n_steps)
+        row["push_time"] = d.push_time(plant.timeline(trial.plan))
+        row.update(run_plant(plant, trial.scene, trial.plan, d).row())
     except Exception as exc:  # recorded, not dropped: the table says which trial failed and why
         last = traceback.extract_tb(exc.__traceback__)[-1:]
         where = f" at {last[0].filename.rsplit('/', 1)[-1]}:{last[0].lineno}" if last else ""
         row["error"] = f"{type(exc).__name__}: {exc}{where}"
-    row["wall_time"] = time.perf_counter() - t0
+        row["wall_time"] = time.perf_counter() - t0
     return normalise_row(row)
 
 

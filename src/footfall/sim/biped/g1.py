@@ -1,4 +1,4 @@
-"""The Unitree G1 humanoid of ``example-robot-data`` as a walker model (issue 7, beyond the document).
+"""The Unitree G1 humanoid of ``example-robot-data`` as a walker model (beyond the document).
 
 Optional extra: ``pip install 'footfall[robots]'`` (the ``example-robot-data`` wheel bundles the
 G1's URDF, ``g1_29dof_rev_1_0.urdf``). :func:`g1_spec` builds a MuJoCo model from that URDF through
@@ -42,6 +42,7 @@ from footfall._typing import FloatArray
 from footfall._validate import check_fields, non_negative, positive
 from footfall.errors import FootfallError, InputError
 from footfall.models.biped import Side
+from footfall.sim._mjcf import GRID_TEXTURE, LIGHT, TERRAIN_MATERIAL
 from footfall.sim.biped import names as nm
 from footfall.sim.biped.model import require_mujoco
 
@@ -362,22 +363,13 @@ def _g1_xml(params: G1Model) -> str:
     return str(g1_spec(params).to_xml())
 
 
-#: the terrain's grid material (the region geoms of :mod:`terrain_mjcf` use ``material="terrain"``)
-_TERRAIN_ASSETS = (
-    '<texture name="grid" type="2d" builtin="checker" rgb1="0.55 0.6 0.55" rgb2="0.45 0.5 0.45" '
-    'width="512" height="512"/>'
-    '<material name="terrain" texture="grid" texrepeat="4 4" texuniform="true"/>'
-)
-
-
 def _with_terrain(robot_xml: str, terrain: tuple[str, str]) -> str:
     """``robot_xml`` with the terrain's assets and geoms and a light added."""
     root = ET.fromstring(robot_xml)
     asset_xml, world_xml = terrain
     extra = ET.fromstring(
-        f"<mujoco><asset>{_TERRAIN_ASSETS}{asset_xml}</asset><worldbody>"
-        '<light pos="0 -3 6" dir="0 0.4 -1" directional="true"/>'
-        f"{world_xml}</worldbody></mujoco>"
+        f"<mujoco><asset>{GRID_TEXTURE}{TERRAIN_MATERIAL}{asset_xml}</asset><worldbody>"
+        f"{LIGHT}{world_xml}</worldbody></mujoco>"
     )
     for tag in ("asset", "worldbody"):
         dest = root.find(tag)

@@ -30,11 +30,11 @@ from footfall.control.adjusters import U_MAX_FOOT_SHARE
 from footfall.errors import FootfallError, InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.sim._mjcf import (
-    GRID_TEXTURE,
-    ROBOT_MATERIALS,
+    TERRAIN_MATERIAL,
     SimSettings,
     box_inertia,
     fmt,
+    mjcf_document,
     mjcf_preamble,
     position_actuator,
     rod_inertia,
@@ -154,7 +154,7 @@ class BipedModel:
             (roll and yaw limits are mirrored for the right leg). The ankle pitch reaches -1.3 rad
             of dorsiflexion (Talos: -1.27): stepping down 0.18 m, the rear ankle sat at a -1.0
             limit in double support, the rear foot's heel lifted and the landing foot never took
-            the weight (``discrete_steps``, issue 7 note).
+            the weight (``discrete_steps``).
     """
 
     pelvis_mass: float = 8.0
@@ -388,17 +388,7 @@ def biped_mjcf(
     )
     preamble = mjcf_preamble(s, 0.5, f'solref="0.004 1" group="{nm.ROBOT_GROUP}"', 2048)
     col = f'contype="{nm.ROBOT_CONTYPE}" conaffinity="{nm.ROBOT_CONAFFINITY}"'
-    return f"""<mujoco model="{nm.MODEL_NAME}">
-  {preamble}
-  <asset>
-    {GRID_TEXTURE}
-    <material name="terrain" texture="grid" texrepeat="4 4" texuniform="true"/>
-    {ROBOT_MATERIALS}
-    {asset_xml}
-  </asset>
-  <worldbody>
-    <light pos="0 -3 6" dir="0 0.4 -1" directional="true"/>
-    {world_xml}
+    world = f"""{world_xml}
     <body name="{nm.PELVIS_BODY}" pos="0 0 {p.pelvis_height:.6g}">
       <freejoint name="{nm.ROOT_JOINT}"/>
       <camera name="{nm.TRACK_CAMERA}" mode="trackcom" pos="0.3 -2.6 0.6"
@@ -411,13 +401,10 @@ def biped_mjcf(
         <geom name="{nm.TORSO_GEOM}" type="box" size="{fmt(*(c / 2 for c in p.torso_size))}"
               material="body" {col}/>
       </body>{legs}
-    </body>
-  </worldbody>
-  <actuator>
-    {actuators}
-  </actuator>
-</mujoco>
-"""
+    </body>"""
+    return mjcf_document(
+        nm.MODEL_NAME, preamble, f"{TERRAIN_MATERIAL}\n    {asset_xml}", world, actuators
+    )
 
 
 @dataclass(frozen=True)

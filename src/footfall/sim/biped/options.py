@@ -15,7 +15,7 @@ from footfall.models.biped import BipedParams
 from footfall.planning.plan import FootstepPlan
 from footfall.sim.biped.model import BipedModel, WalkerModel, measure_model
 from footfall.sim.biped.wbc import WbcGains
-from footfall.sim.pushes import Push
+from footfall.sim.disturbance import Push
 from footfall.terrain.scene import Scene
 
 #: landing error [m] the walk leaves room for at riser edges (:mod:`footfall.terrain.edges`):
@@ -94,12 +94,6 @@ class WalkOptions:
             than the plan did (its ``region_margin``, half the sole length for
             :func:`footfall.sim.biped.plans.plan_for_walk`) [m]: landings fall short of their
             targets, and a heel over a block's edge on a step down tips the landing foot.
-        riser_tolerance: the MPC keeps each footstep in its region with the riser edges moved
-            in by :func:`footfall.terrain.edges.inset_riser_edges` with this landing tolerance
-            [m] (on top of ``region_margin`` + ``landing_margin``), as
-            :func:`footfall.sim.biped.plans.plan_for_walk` plans; 0 = the regions as they are.
-            Without it the MPC may move a footstep below a riser toward it until the heel lands
-            on the riser's edge.
         region_aware: how the walker's MPC keeps footsteps on the terrain
             (:attr:`footfall.control.adjusters.MPCAdjuster.region_aware`): ``off`` keeps each
             footstep ``region_margin + landing_margin`` inside its planned region (a uniform
@@ -111,7 +105,7 @@ class WalkOptions:
             9 built-in scenes (miqcqp plans, 2 N s pushes on seeds 0-9) it reached the goal in
             90 of 90 walks against 70 of 90 with ``off`` (which falls on every walk of
             stepping_stones and narrow_stones_gap, pushed or not), and no walk of either landed
-            a footstep off the terrain (benchmarks/RESULTS.md, issue 23). The section 5.5 study
+            a footstep off the terrain (benchmarks/RESULTS.md, "Footsteps on the terrain"). The section 5.5 study
             runs ``off``, document 000's MPC, unless its file says otherwise.
         passive_landing: the swing ankle goes limp (torque mode, zero torque) from the first
             contact of the swing sole during its descent until the double support, where the
@@ -149,7 +143,6 @@ class WalkOptions:
     stop_on_fall: bool = True
     closed_loop_ik: bool = True
     landing_margin: float = 0.02
-    riser_tolerance: float = RISER_LANDING_TOLERANCE
     region_aware: str = "planned"
     passive_landing: bool = True
     check_robot: bool = True
@@ -172,7 +165,6 @@ class WalkOptions:
                 "landing_margin",
                 "swing_side_gap",
                 "heel_strike",
-                "riser_tolerance",
             ),
         )
         fb = non_negative("com_feedback", self.com_feedback)

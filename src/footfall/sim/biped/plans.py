@@ -1,21 +1,16 @@
-"""Plans made for a MuJoCo walker, and the seeded pushes of its walks.
+"""Plans made for a MuJoCo walker.
 
 :func:`plan_for_walk` makes (or loads from the plan cache, :mod:`footfall.planning.cache`) the plan
 of a scene for a walker model's measured robot (:func:`~footfall.sim.biped.model.planner_params`),
-with the options beyond the document that the walks need; :func:`robot_model` names the walkers;
-:func:`random_push` draws a seeded push inside the walk.
+with the options beyond the document that the walks need; :func:`robot_model` names the walkers.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from footfall._validate import non_negative
 from footfall.errors import InputError
 from footfall.planning.cache import PlanCache, cached_plan
 from footfall.planning.plan import (
@@ -32,18 +27,13 @@ from footfall.sim.biped.model import (
     WalkerModel,
     planner_params,
 )
-from footfall.sim.biped.options import RISER_LANDING_TOLERANCE, WalkOptions
-from footfall.sim.pushes import Push
+from footfall.sim.biped.options import RISER_LANDING_TOLERANCE
 from footfall.terrain.edges import inset_riser_edges
 from footfall.terrain.scene import Scene
 
 #: robots the walker can walk (``footfall walk --robot``): our biped and the Unitree G1 of
 #: example-robot-data (``footfall[robots]``)
 ROBOTS = ("biped", "g1")
-#: pushes last this long [s]
-PUSH_DURATION = 0.1
-#: a push starts at a random single support between these shares of the walk
-PUSH_WINDOW = (0.3, 0.7)
 
 
 #: the controller each walker model walks best with (``footfall walk --controller``'s default):
@@ -137,7 +127,7 @@ def plan_for_walk(
         threads=threads,
         **aware,
     )
-    return cached_plan(
+    plan = cached_plan(
         scene,
         planner,
         n_steps,
@@ -146,6 +136,9 @@ def plan_for_walk(
         PlanCache(cache_dir) if cache_dir is not None else None,
         monitor,
     )
+    # the walker keeps its corrections in the regions the plan was made on (a cached plan is
+    # keyed by those regions, so it was made on them too)
+    return replace(plan, riser_inset=RISER_LANDING_TOLERANCE)
 
 
 def walk_planner_options(planner: str) -> dict[str, Any]:
@@ -161,24 +154,3 @@ def walk_planner_options(planner: str) -> dict[str, Any]:
     if planner == "reactive":
         return {}
     return {"reach_both_frames": True, "swing_max": SWING_MAX}
-
-
-def random_push(seed: int, magnitude: float, plan: FootstepPlan, options: WalkOptions) -> Push:
-    """A horizontal push of ``magnitude`` [N] in a seeded random direction, lasting
-    ``PUSH_DURATION``, starting mid single support of a seeded step in ``PUSH_WINDOW`` of the walk.
-    """
-    magnitude = non_negative("push", magnitude)
-    rng = np.random.default_rng(seed)
-    n = plan.n_steps
-    lo, hi = (max(0, int(f * n)) for f in PUSH_WINDOW)
-    step = int(rng.integers(lo, max(lo + 1, hi)))
-    robot = plan.robot
-    t0 = (
-        options.settle_time
-        + options.shift_time
-        + step * (robot.t_ss + robot.t_ds)
-        + 0.25 * robot.t_ss
-    )
-    angle = float(rng.uniform(0.0, 2.0 * math.pi))
-    force = magnitude * np.array([math.cos(angle), math.sin(angle), 0.0])
-    return Push(start=t0, duration=PUSH_DURATION, force=force)

@@ -3,29 +3,22 @@
 :class:`~footfall.sim.biped.walk.BipedWalk` keeps each concern in one small object: where the feet
 are (:class:`FeetState`), the current single support and its swing path (:class:`SwingState`),
 the ALIP reference (:class:`ReferenceState`, eq. 5.1, 5.5, 5.8-5.10), the actuators' modes and
-last set points (:class:`ActuationState`), and the measurements (:class:`WalkLog`). Per tick,
+last set points (:class:`ActuationState`); the measurements are a
+:class:`~footfall.results.walk.WalkTrace`. Per tick,
 :class:`Observation` is what the robot measured and :class:`Command` what the schedule asks of the
-whole body. :class:`Video` writes the frames.
+whole body.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field, replace
-from pathlib import Path
-from typing import Any
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
 from footfall._typing import FloatArray
 from footfall.models.biped import Side
-from footfall.planning.plan import FootstepPlan
-from footfall.sim.biped import names as nm
 from footfall.sim.biped.references import SWING_SHARES
-
-#: video frame rate [1/s]
-VIDEO_FPS = 30
 
 #: sole targets of the IK: position (3,) [m] and rotation (3, 3) per side
 SolePoses = dict[Side, tuple[FloatArray, FloatArray]]
@@ -129,100 +122,3 @@ class Command:
     phase: int = -1
     tp: float = 0.0
     single: bool = False
-
-
-@dataclass
-class WalkLog:
-    """Measurements of the walk, named as :class:`~footfall.sim.biped.result.WalkResult`'s fields
-    (whose docstring gives shapes and units); per tick arrays are NaN where not measured."""
-
-    t: FloatArray
-    phase: NDArray[np.int_]
-    com: FloatArray
-    com_ref: FloatArray
-    zmp_offset: FloatArray
-    zmp_planned: FloatArray
-    feet: FloatArray
-    landed: FloatArray
-    targets: FloatArray
-    planned: FloatArray
-    n_planned: int
-    timing: dict[str, float]
-    fell: bool = False
-    fall_time: float = math.nan
-    sim_time: float = 0.0
-    controller: dict[str, Any] = field(default_factory=dict)
-
-    @classmethod
-    def empty(cls, n_ticks: int, dt: float, plan: FootstepPlan, n_planned: int) -> WalkLog:
-        """An unmeasured log of ``n_ticks`` ticks of ``dt`` [s] for the (extended) ``plan``."""
-        n = plan.n_steps
-        return cls(
-            t=np.arange(n_ticks, dtype=np.float64) * dt,
-            phase=np.full(n_ticks, -1, dtype=int),
-            com=np.full((n_ticks, 3), np.nan),
-            com_ref=np.full((n_ticks, 3), np.nan),
-            zmp_offset=np.full((n_ticks, 2), np.nan),
-            zmp_planned=np.full((n_ticks, 2), np.nan),
-            feet=np.full((n_ticks, 2, 3), np.nan),
-            landed=np.full((n, 3), np.nan),
-            targets=np.array(plan.footsteps[1:], dtype=float),
-            planned=np.array(plan.footsteps[1:]),
-            n_planned=n_planned,
-            timing={"control": 0.0, "ik": 0.0, "physics": 0.0, "render": 0.0},
-        )
-
-    def trimmed(self, k_end: int, dt: float) -> WalkLog:
-        """The first ``k_end`` ticks (the walk ended there), with its simulated time."""
-        return replace(
-            self,
-            t=self.t[:k_end],
-            phase=self.phase[:k_end],
-            com=self.com[:k_end],
-            com_ref=self.com_ref[:k_end],
-            zmp_offset=self.zmp_offset[:k_end],
-            zmp_planned=self.zmp_planned[:k_end],
-            feet=self.feet[:k_end],
-            sim_time=k_end * dt,
-        )
-
-
-class Video:
-    """MP4 of the walk from the tracking camera (offscreen GL), one frame every ``1 / VIDEO_FPS``.
-
-    Without GL there is no video and :attr:`note` says why; the walk goes on.
-    """
-
-    def __init__(
-        self, mujoco: Any, model: Any, path: Path | None, size: tuple[int, int], dt: float
-    ) -> None:
-        self.renderer: Any = None
-        self.writer: Any = None
-        self.note = ""
-        self.frame_every = max(1, round(1.0 / (VIDEO_FPS * dt)))
-        if path is None:
-            return
-        try:
-            self.renderer = mujoco.Renderer(model, height=size[1], width=size[0])
-        except Exception as exc:  # any GL failure means "no video", never a crash
-            self.note = f"no offscreen GL ({type(exc).__name__}: {exc}); video skipped"
-            return
-        import imageio.v2 as imageio
-
-        path.parent.mkdir(parents=True, exist_ok=True)
-        self.writer = imageio.get_writer(str(path), fps=VIDEO_FPS, macro_block_size=8)
-
-    def frame(self, k: int, data: Any) -> bool:
-        """Render tick ``k`` if a frame is due; whether one was."""
-        if self.writer is None or k % self.frame_every != 0:
-            return False
-        self.renderer.update_scene(data, camera=nm.TRACK_CAMERA)
-        self.writer.append_data(self.renderer.render())
-        return True
-
-    def close(self) -> None:
-        """Finish the file and free the renderer."""
-        if self.writer is not None:
-            self.writer.close()
-        if self.renderer is not None:
-            self.renderer.close()

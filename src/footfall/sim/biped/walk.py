@@ -53,6 +53,9 @@ from footfall.control.adjusters import (
 from footfall.errors import InputError, SolverError
 from footfall.models.biped import Side
 from footfall.planning.plan import FootstepPlan
+from footfall.results.walk import WalkResult, WalkTrace
+from footfall.sim._video import Video
+from footfall.sim.biped import names as nm
 from footfall.sim.biped.ik import WholeBodyIK
 from footfall.sim.biped.metrics import summarise
 from footfall.sim.biped.model import BipedSimSettings, WalkerModel
@@ -69,7 +72,6 @@ from footfall.sim.biped.references import (
     swing_shares,
     terrain_height_along,
 )
-from footfall.sim.biped.result import WalkResult
 from footfall.sim.biped.state import (
     ActuationState,
     Command,
@@ -78,20 +80,15 @@ from footfall.sim.biped.state import (
     ReferenceState,
     SolePoses,
     SwingState,
-    Video,
-    WalkLog,
 )
 from footfall.sim.biped.wbc import BipedWbc, CopTarget
+from footfall.sim.disturbance import push_force
+from footfall.sim.falls import HUMANOID_FALL
 from footfall.terrain.edges import inset_riser_edges
 from footfall.terrain.scene import Scene
 
 #: a foot is loaded when its contact force exceeds this share of the weight
 CONTACT_FORCE_SHARE = 0.02
-#: the robot has fallen when the pelvis is lower than this share of its nominal height above the
-#: stance sole ...
-FALL_HEIGHT_SHARE = 0.6
-#: ... or the torso tilts more than this [rad], or the pelvis or torso touches the terrain
-FALL_TILT = math.radians(40.0)
 #: a swing target that moved this far [m] from the one its apex was set for gets its apex checked
 SWING_RETARGET = 0.01
 
@@ -144,7 +141,8 @@ class BipedWalk:
         opts = self.opts
         terrain = self.scene.terrain
         regions = {r.name: r for r in terrain.regions}
-        inner = inset_riser_edges(terrain, opts.riser_tolerance) if opts.riser_tolerance else None
+        # the regions the plan was made on (its riser inset), not recomputed here
+        inner = inset_riser_edges(terrain, plan.riser_inset) if plan.riser_inset else None
         return MPCAdjuster(
             plan,
             {r.name: r for r in inner.regions} if inner is not None else regions,
@@ -178,7 +176,7 @@ class BipedWalk:
             },
         )
         self.normals = [regions[name].normal for name in plan.regions]
-        self.log = WalkLog.empty(self.n_ticks, self.dt, plan, self.n_planned)
+        self.log = WalkTrace.empty(self.n_ticks, self.dt, plan.footsteps, self.n_planned)
         stance = plan.sides[0]
         self.swing = SwingState(
             stance=stance,
@@ -207,7 +205,7 @@ class BipedWalk:
     ) -> WalkResult:
         """Walk until the end of the hold (or a fall with ``stop_on_fall``) and measure it."""
         sim = self.sim
-        self.video = Video(sim.mujoco, sim.model, video_path, video_size, self.dt)
+        self.video = Video(sim.mujoco, sim.model, video_path, video_size, self.dt, nm.TRACK_CAMERA)
         wall0 = time.perf_counter()
         k = 0
         for k in range(self.n_ticks):
@@ -216,8 +214,8 @@ class BipedWalk:
             if progress is not None and k % 100 == 0:
                 progress(k / self.n_ticks)
         wall = time.perf_counter() - wall0
-        self.video.close()
-        return self._result(k + 1, wall, video_path)
+        self.log.timing["render"] = self.video.render_time
+        return self._result(k + 1, wall, self.video.close())
 
     def step(self, k: int) -> bool:
         """Control tick ``k``; False when the walk ends at it (a fall with ``stop_on_fall``)."""
@@ -237,16 +235,13 @@ class BipedWalk:
         timing["control"] += c1 - c0
         if self.wbc is not None:
             self._torque_physics(self.wbc, t, cmd, obs)
-            c3 = time.perf_counter()
         else:
             ctrl, servoed = self._whole_body(cmd, obs)
             c2 = time.perf_counter()
             timing["ik"] += c2 - c1
             self._physics(t, ctrl, servoed)
-            c3 = time.perf_counter()
-            timing["physics"] += c3 - c2
-        if self.video.frame(k, self.sim.data):
-            timing["render"] += time.perf_counter() - c3
+            timing["physics"] += time.perf_counter() - c2
+        self.video.frame(k, self.sim.data)
         return True
 
     def _observe(self, k: int) -> Observation:
@@ -452,9 +447,9 @@ class BipedWalk:
         self.log.com_ref[k] = cmd.com_ref
 
     def _detect_fall(self, t: float, cmd: Command, obs: Observation) -> bool:
-        """Whether the robot falls at ``t`` (first detection only): the pelvis below
-        ``FALL_HEIGHT_SHARE`` of its height above the stance sole, the torso tilted beyond
-        ``FALL_TILT``, or the pelvis or torso on the terrain."""
+        """Whether the robot falls at ``t`` (first detection only): the pelvis too low above the
+        stance sole or the torso tilted too far (:data:`~footfall.sim.falls.HUMANOID_FALL`), or
+        the pelvis or torso on the terrain."""
         sim, pos = self.sim, self.feet.pos
         if cmd.single:
             stance_z = pos[self.swing.stance][2]
@@ -463,8 +458,8 @@ class BipedWalk:
         pelvis_z = float(sim.data.xpos[sim.pelvis][2]) - float(stance_z)
         up = sim.data.xmat[sim.torso].reshape(3, 3)[:, 2]
         tilt = math.acos(max(-1.0, min(1.0, float(up[2]))))
-        low = pelvis_z < FALL_HEIGHT_SHARE * sim.params.pelvis_height
-        if self.log.fell or not (obs.body_hit or tilt > FALL_TILT or low):
+        fallen = HUMANOID_FALL.fallen(tilt, pelvis_z, sim.params.pelvis_height)
+        if self.log.fell or not (obs.body_hit or fallen):
             return False
         self.log.fell, self.log.fall_time = True, t
         return True
@@ -549,7 +544,7 @@ class BipedWalk:
 
         The feet in contact are the stance foot in single support and both otherwise. A QP
         without a solution (a robot already falling) keeps the last torques and is counted in
-        the controller's tally (``WalkResult.controller``).
+        the controller's tally (``WalkTrace.controller``).
         """
         sim, timing = self.sim, self.log.timing
         mj, m, d = sim.mujoco, sim.model, sim.data
@@ -570,7 +565,7 @@ class BipedWalk:
             self.act.ctrl_prev = tau
             c1 = time.perf_counter()
             timing["ik"] += c1 - c0
-            d.xfrc_applied[sim.torso, :3] = self._push_force(t + j * step)
+            d.xfrc_applied[sim.torso, :3] = push_force(self.opts.pushes, t + j * step)
             d.ctrl[sim.actuators] = tau
             mj.mj_step(m, d)
             timing["physics"] += time.perf_counter() - c1
@@ -601,14 +596,6 @@ class BipedWalk:
         return ctrl, servoed
 
     # --------------------------------------------------------------------------- physics
-    def _push_force(self, t: float) -> FloatArray:
-        """Sum of the pushes' forces (3,) [N] active at ``t``."""
-        force = np.zeros(3)
-        for p in self.opts.pushes:
-            if p.active(t):
-                force += p.force
-        return force
-
     def _physics(self, t: float, ctrl: FloatArray, servoed: NDArray[np.bool_]) -> None:
         """Apply the pushes and step MuJoCo through one control period.
 
@@ -618,7 +605,7 @@ class BipedWalk:
         """
         sim, act = self.sim, self.act
         mj, m, d = sim.mujoco, sim.model, sim.data
-        d.xfrc_applied[sim.torso, :3] = self._push_force(t)
+        d.xfrc_applied[sim.torso, :3] = push_force(self.opts.pushes, t)
         ramp = servoed & act.pos_prev
         for j in range(self.substeps):
             w = (j + 1) / self.substeps
@@ -627,7 +614,7 @@ class BipedWalk:
         act.ctrl_prev, act.pos_prev = ctrl, servoed
 
     # ---------------------------------------------------------------------------- result
-    def _result(self, k_end: int, wall: float, video_path: Path | None) -> WalkResult:
+    def _result(self, k_end: int, wall: float, video: Path | None) -> WalkResult:
         """The measurements of the first ``k_end`` ticks and their summary."""
         self.log.timing["total"] = wall
         if self.wbc is not None:
@@ -645,12 +632,10 @@ class BipedWalk:
             metrics = dataclasses.replace(
                 metrics, region_choices=tuple(c.to_dict() for c in choices.values())
             )
-        # WalkLog's fields are WalkResult's measurements under the same names
-        measured = {f.name: getattr(log, f.name) for f in dataclasses.fields(log)}
         return WalkResult(
-            **measured,
+            trace=log,
             metrics=metrics,
-            video=video_path if self.video.writer is not None else None,
+            video=video,
             video_note=self.video.note,
         )
 
@@ -673,7 +658,8 @@ def walk(
         plan: a footstep plan with ALIP states and torques (any planner).
         options: controller options.
         adjuster: footstep / torque source; default :class:`MPCAdjuster` (eq. 5.19) on the
-            scene's regions with their riser edges moved in by ``options.riser_tolerance``.
+            scene's regions with their riser edges moved in by ``plan.riser_inset`` (the regions
+            the plan was made on).
         model_params: the robot (default: our biped, :class:`BipedModel`); any
             :class:`~footfall.sim.biped.model.WalkerModel`, e.g. the G1 of
             :mod:`footfall.sim.biped.g1`. The plan should be made for it

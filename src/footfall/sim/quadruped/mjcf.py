@@ -28,11 +28,10 @@ from footfall.errors import InputError
 from footfall.quadruped.ground import PlaneGround, QuadrupedGround, VaryingSlope
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
 from footfall.sim._mjcf import (
-    GRID_TEXTURE,
-    ROBOT_MATERIALS,
     SimSettings,
     box_inertia,
     fmt,
+    mjcf_document,
     mjcf_preamble,
     position_actuator,
     rod_inertia,
@@ -209,17 +208,11 @@ def quadruped_mjcf(
     )
     preamble = mjcf_preamble(s, 2.0, 'solref="0.005 1"', 0)
     half = (robot.body_length / 2, robot.body_width / 2, robot.body_height / 2)
-    return f"""<mujoco model="{nm.MODEL_NAME}">
-  {preamble}
-  <asset>
-    {GRID_TEXTURE}
-    <material name="ground" texture="grid" texrepeat="8 8" texuniform="true"/>
-    <material name="stairs" rgba="0.6 0.55 0.5 1"/>
-    {ROBOT_MATERIALS}
-  </asset>
-  <worldbody>
-    <light pos="0 -3 6" dir="0 0.4 -1" directional="true"/>
-    {ground_xml}
+    assets = (
+        '<material name="ground" texture="grid" texrepeat="8 8" texuniform="true"/>\n'
+        '    <material name="stairs" rgba="0.6 0.55 0.5 1"/>'
+    )
+    world = f"""{ground_xml}
     <body name="{nm.TRUNK_BODY}" pos="0 0 1">
       <freejoint name="{nm.ROOT_JOINT}"/>
       <camera name="{nm.TRACK_CAMERA}" mode="trackcom" pos="0.6 -3.2 0.9"
@@ -227,13 +220,8 @@ def quadruped_mjcf(
       <inertial pos="0 0 0" mass="{robot.body_mass:.6g}" diaginertia="{fmt(*bi)}"/>
       <geom name="{nm.TRUNK_GEOM}" type="box" size="{fmt(*half)}" material="body"
             contype="{nm.ROBOT_CONTYPE}" conaffinity="{nm.ROBOT_CONAFFINITY}"/>{legs}
-    </body>
-  </worldbody>
-  <actuator>
-    {actuators}
-  </actuator>
-</mujoco>
-"""
+    </body>"""
+    return mjcf_document(nm.MODEL_NAME, preamble, assets, world, actuators)
 
 
 def slope_scene(robot: QuadrupedRobot, slope: float, settings: SimSettings | None = None) -> str:

@@ -12,9 +12,8 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,14 +26,21 @@ from footfall.quadruped.gait import GaitParams, GaitPlan, GaitTrajectory, PhaseK
 from footfall.quadruped.ground import PlaneGround, QuadrupedGround
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
 from footfall.quadruped.stability import centre_of_pressure, stability_margin, support_polygon
-from footfall.sim.pushes import Push
+from footfall.results.quadruped import (
+    BodySway,
+    QuadrupedMetrics,
+    QuadrupedResult,
+    QuadrupedTrace,
+    StanceSlip,
+)
+from footfall.sim._video import Video
+from footfall.sim.disturbance import Push, push_force
+from footfall.sim.falls import QUADRUPED_FALL
 from footfall.sim.quadruped import names as nm
 from footfall.sim.quadruped.mjcf import SimSettings, ground_scene
 from footfall.sim.quadruped.slip import (
     SlipGuard,
     SlipMonitor,
-    SlipStop,
-    StanceSlip,
     check_guard,
     downhill,
     stance_slips,
@@ -42,190 +48,8 @@ from footfall.sim.quadruped.slip import (
 
 #: a foot counts as in contact when it carries more than this fraction of the robot's weight
 CONTACT_FORCE_FRACTION = 0.01
-#: the robot has fallen when the trunk drops below this fraction of the planned height ...
-FALL_HEIGHT_FRACTION = 0.5
-#: ... or tilts this far from its planned attitude [rad]
-FALL_TILT = math.radians(30.0)
-#: video frame rate [1/s]
-VIDEO_FPS = 30
 #: the quadruped's controllers (``simulate(controller=...)``)
 CONTROLLERS = ("servo", "wbc")
-
-
-@dataclass(frozen=True)
-class BodySway:
-    """Body sway per gait cycle, averaged over the cycles (see :func:`body_sway`)."""
-
-    path_per_cycle_m: float
-    """Horizontal path length of the body centre per cycle [m]."""
-    lateral_path_per_cycle_m: float
-    """Lateral (y) path length of the body centre per cycle [m]."""
-    excess_path_per_cycle_m: float
-    """Path length minus net horizontal displacement per cycle: motion spent swaying [m]."""
-    shifts_per_cycle: float
-    """Body shifts per gait cycle (the final centring shift excluded)."""
-
-
-@dataclass(frozen=True)
-class QuadrupedMetrics:
-    """Summary of one simulated walk; measured in MuJoCo unless the name says ``planned``.
-
-    ``None`` marks a measure with no sample to average (for example no stance sample with three
-    loaded feet before a fall).
-    """
-
-    slope_deg: float
-    """Slope angle beta_S [deg]."""
-    body_deg: float
-    """Planned body angle beta_B to the horizontal [deg]."""
-    strategy: str
-    """ZMP placement strategy (:class:`~footfall.quadruped.gait.ZmpStrategy` value)."""
-    step_m: float
-    """Planned step length S along the slope [m]."""
-    swing_height_m: float
-    """Planned swing height H normal to the slope [m]."""
-    swing_period_s: float
-    """Planned swing period T_w [s]."""
-    shift_period_s: float
-    """Planned duration of each body shift [s]."""
-    cycles: int
-    """Number of gait cycles."""
-    gait_duration_s: float
-    """Duration of the gait, settling excluded [s]."""
-    distance_up_slope_m: float
-    """Trunk displacement along the slope direction [m]."""
-    planned_distance_up_slope_m: float
-    """Planned body displacement along the slope direction [m]."""
-    mean_speed_m_s: float
-    """Distance up the slope over gait duration [m/s] (NaN for a zero duration)."""
-    fell: bool
-    """Whether the trunk touched the ground, tilted past FALL_TILT or dropped too low."""
-    fall_time_s: float | None
-    """Gait time of the first fall sample [s], None when it did not fall."""
-    stability_margin_min_m: float | None
-    """Smallest measured stability margin over planned-stance samples with >= 3 contacts [m]."""
-    stability_margin_mean_m: float | None
-    """Mean measured stability margin over the same samples [m]."""
-    stability_margin_min_three_leg_m: float | None
-    """Smallest measured margin over samples with exactly three planned contacts [m]."""
-    stability_margin_mean_three_leg_m: float | None
-    """Mean measured margin over samples with exactly three planned contacts [m]."""
-    planned_margin_min_m: float
-    """Smallest planned stability margin [m]."""
-    planned_margin_min_three_leg_m: float
-    """Smallest planned margin with exactly three planned contacts [m] (NaN without such a
-    sample: the slip guard stopped the gait before the first swing)."""
-    stance_samples: int
-    """Number of samples where the plan has three or more feet down."""
-    stance_samples_with_fewer_than_3_contacts: int
-    """Planned-stance samples with fewer than three loaded feet measured."""
-    zmp_error_mean_m: float | None
-    """Mean distance of the measured CoP from the planned ZMP (eq. 5) [m]."""
-    zmp_error_max_m: float | None
-    """Largest distance of the measured CoP from the planned ZMP [m]."""
-    foot_slip_max_m: float
-    """Largest sliding displacement of a foot over one planned stance [m]."""
-    foot_slip_mean_m: float
-    """Mean sliding displacement of a foot over one planned stance [m]."""
-    foot_backward_slip_total_m: float
-    """Total sliding of the feet down the slope, summed over stances [m]."""
-    stance_slips: tuple[StanceSlip, ...]
-    """Sliding of every foot over each of its planned stances, ordered by start time."""
-    trunk_drift_from_plan_m: float
-    """Distance of the final trunk position from the planned final body position [m]."""
-    body_sway_measured: BodySway
-    """Sway of the measured trunk."""
-    body_sway_planned: BodySway
-    """Sway of the planned body."""
-    sim_time_s: float
-    """Simulated time, settling included [s]."""
-    wall_time_s: float
-    """Wall-clock time of the physics and control loop, video excluded [s]."""
-    realtime_factor: float
-    """Simulated seconds per wall-clock second."""
-    video: str | None
-    """Path of the MP4, None when no video was written."""
-    video_note: str
-    """Why there is no video, if there is none."""
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict with one key per field (the sways as nested dicts)."""
-        return asdict(self)
-
-
-class Measured(Protocol):
-    """What :func:`summarise` reads of a simulated walk (a :class:`SimResult` has it all)."""
-
-    @property
-    def t(self) -> FloatArray: ...
-    @property
-    def trunk_pos(self) -> FloatArray: ...
-    @property
-    def cop(self) -> FloatArray: ...
-    @property
-    def margin(self) -> FloatArray: ...
-    @property
-    def n_contacts(self) -> NDArray[np.int_]: ...
-    @property
-    def slip_vel(self) -> FloatArray: ...
-    @property
-    def planned(self) -> GaitTrajectory: ...
-    @property
-    def wall_time(self) -> float: ...
-    @property
-    def sim_time(self) -> float: ...
-    @property
-    def video(self) -> Path | None: ...
-    @property
-    def video_note(self) -> str: ...
-
-
-@dataclass(frozen=True)
-class SimResult:
-    """Measurements of one simulated walk (arrays sampled at the control period, T samples).
-
-    Attributes:
-        t: time since the gait started, shape (T,) [s].
-        trunk_pos: measured trunk centre, shape (T, 3) [m].
-        trunk_pitch: measured nose-up pitch, shape (T,) [rad].
-        cop: measured centre of pressure on the plane through the contacts, shape (T, 2) [m].
-        margin: measured stability margin of the CoP in the measured support polygon, (T,) [m].
-        n_contacts: number of feet in contact, shape (T,).
-        feet: measured foot centres, shape (T, 4, 3) [m].
-        slip_vel: tangential velocity of each foot's material point at its ground contact,
-            shape (T, 4, 3) [m/s]. A rolling sphere has none, so this is true sliding, not the
-            rolling of the spherical foot. A foot planned in stance but off the ground (it
-            bounced, or the ground is lower than planned) slides with its centre: the centre's
-            velocity along the ground; a swing foot off the ground has none.
-        planned: the commanded references at the same instants: the plan, held on four feet
-            from the slip guard's stop on (:mod:`.slip`; the plan itself without a stop).
-        metrics: summary numbers (see :func:`summarise`).
-        wall_time: wall-clock time of the physics + control loop [s] (video excluded).
-        sim_time: simulated time [s].
-        video: path of the MP4, or None.
-        video_note: why there is no video, if there is none.
-        controller: ``servo`` or ``wbc`` (see :func:`simulate`).
-        qp_failures: physics steps whose whole-body QP failed (``wbc``; the last torques held).
-        slip_stop: when and why the slip guard stopped the gait, None when it did not.
-    """
-
-    t: FloatArray
-    trunk_pos: FloatArray
-    trunk_pitch: FloatArray
-    cop: FloatArray
-    margin: FloatArray
-    n_contacts: NDArray[np.int_]
-    feet: FloatArray
-    slip_vel: FloatArray
-    planned: GaitTrajectory
-    metrics: QuadrupedMetrics
-    wall_time: float = 0.0
-    sim_time: float = 0.0
-    video: Path | None = None
-    video_note: str = ""
-    controller: str = "servo"
-    qp_failures: int = 0
-    slip_stop: SlipStop | None = None
 
 
 def _pitch_of(xmat: FloatArray) -> float:
@@ -346,156 +170,87 @@ class QuadrupedSim:
         return np.array(pts), np.array(frc), np.array(idx), trunk_hit
 
 
-def _make_renderer(sim: QuadrupedSim, width: int, height: int) -> tuple[Any, str]:
-    """An offscreen renderer, or (None, reason) when no GL backend works."""
-    try:
-        renderer = sim.mujoco.Renderer(sim.model, height=height, width=width)
-    except Exception as exc:  # any GL failure means "no video", never a crash
-        return None, f"no offscreen GL backend ({type(exc).__name__}: {exc}); video skipped"
-    return renderer, ""
-
-
-class _Video:
-    """Offscreen MP4 of the tracking camera; a no-op when there is no path or no GL backend."""
-
-    def __init__(self, sim: QuadrupedSim, path: Path | None, size: tuple[int, int]) -> None:
-        self.renderer: Any = None
-        self.writer: Any = None
-        self.note = ""
-        self.path = path
-        #: wall time spent rendering, subtracted from the loop's wall time [s]
-        self.render_time = 0.0
-        if path is None:
-            return
-        self.renderer, self.note = _make_renderer(sim, *size)
-        if self.renderer is not None:
-            import imageio.v2 as imageio
-
-            path.parent.mkdir(parents=True, exist_ok=True)
-            self.writer = imageio.get_writer(str(path), fps=VIDEO_FPS, macro_block_size=8)
-
-    def frame(self, data: Any) -> None:
-        """Append the current scene as a frame."""
-        if self.writer is None:
-            return
-        r0 = time.perf_counter()
-        self.renderer.update_scene(data, camera=nm.TRACK_CAMERA)
-        self.writer.append_data(self.renderer.render())
-        self.render_time += time.perf_counter() - r0
-
-    def close(self) -> Path | None:
-        """Finish the file; its path, or None when none was written."""
-        if self.writer is not None:
-            self.writer.close()
-        if self.renderer is not None:
-            self.renderer.close()
-        return self.path if self.writer is not None else None
-
-
 class _Recorder:
-    """Measured arrays of one walk, filled one control sample at a time (a :class:`Measured`)."""
+    """Measures one walk into a :class:`~footfall.results.quadruped.QuadrupedTrace`, one control
+    sample at a time, and detects a fall."""
 
     def __init__(self, sim: QuadrupedSim, plan: GaitPlan, ref: GaitTrajectory) -> None:
         self.sim = sim
         self.plan = plan
         #: the plan's ground, read once (GaitPlan.ground builds a checked PlaneGround per call)
         self.ground = plan.ground
-        self.planned = ref
-        self.t = ref.t
-        n = ref.t.shape[0]
-        self.trunk_pos = np.empty((n, 3))
-        self.trunk_pitch = np.empty(n)
-        self.cop = np.full((n, 2), np.nan)
-        self.margin = np.full(n, np.nan)
-        self.n_contacts = np.zeros(n, dtype=int)
-        self.feet = np.empty((n, 4, 3))
-        self.slip_vel = np.zeros((n, 4, 3))
-        #: gait time of the first fall sample [s], NaN while standing
-        self.fallen_at = math.nan
+        self.trace = QuadrupedTrace.empty(ref)
         self.weight = plan.robot.total_mass * float(-sim.model.opt.gravity[2])
-        self.wall_time = 0.0
-        self.sim_time = 0.0
-        self.video: Path | None = None
-        self.video_note = ""
-        #: whole-body QP solves that failed (the last torques held for that step)
-        self.qp_failures = 0
 
     def measure(self, k: int) -> None:
         """Record sample ``k``: trunk, feet, loaded contacts, CoP, margin, slip; detect a fall."""
-        sim, d = self.sim, self.sim.data
-        self.trunk_pos[k] = d.xpos[sim.trunk]
-        self.trunk_pitch[k] = _pitch_of(d.xmat[sim.trunk])
-        self.feet[k] = d.site_xpos[sim.foot_sites]
+        sim, d, tr = self.sim, self.sim.data, self.trace
+        tr.trunk_pos[k] = d.xpos[sim.trunk]
+        tr.trunk_pitch[k] = _pitch_of(d.xmat[sim.trunk])
+        tr.feet[k] = d.site_xpos[sim.foot_sites]
         pts, frc, idx, trunk_hit = sim.contacts()
         loaded = frc[:, 2] > CONTACT_FORCE_FRACTION * self.weight if frc.size else np.zeros(0, bool)
-        self.n_contacts[k] = np.unique(idx[loaded]).size
+        tr.n_contacts[k] = np.unique(idx[loaded]).size
         if loaded.any():
             z_p = float(pts[loaded, 2].mean())
-            self.cop[k], _ = centre_of_pressure(pts[loaded], frc[loaded], z_p)
+            tr.cop[k], _ = centre_of_pressure(pts[loaded], frc[loaded], z_p)
             # each foot touches at one point (sphere on plane), so the feet's points span it
-            self.margin[k] = stability_margin(self.cop[k], support_polygon(pts[loaded]))
+            tr.margin[k] = stability_margin(tr.cop[k], support_polygon(pts[loaded]))
         for j in range(idx.size):
             normal = self.ground.normal(float(pts[j, 0]), float(pts[j, 1]))
-            self.slip_vel[k, idx[j]] = sim.contact_slip_velocity(idx[j], pts[j], normal)
+            tr.slip_vel[k, idx[j]] = sim.contact_slip_velocity(idx[j], pts[j], normal)
         # a planned stance foot off the ground (bouncing, or the ground lower than planned)
         # moves with its whole centre: that motion along the ground is slip too
-        stance = self.planned.contact[k]
+        stance = tr.planned.contact[k]
         for leg in range(4):
             if stance[leg] and not np.any(idx == leg):
-                c = self.feet[k, leg]
+                c = tr.feet[k, leg]
                 normal = self.ground.normal(float(c[0]), float(c[1]))
-                self.slip_vel[k, leg] = sim.contact_slip_velocity(leg, c, normal)
-        if math.isnan(self.fallen_at) and (trunk_hit or self._fallen(k)):
-            self.fallen_at = float(self.t[k])
+                tr.slip_vel[k, leg] = sim.contact_slip_velocity(leg, c, normal)
+        if math.isnan(tr.fallen_at) and (trunk_hit or self._fallen(k)):
+            tr.fallen_at = float(tr.t[k])
 
     def _fallen(self, k: int) -> bool:
-        """Trunk tilted past FALL_TILT from its planned pitch, or too low above the ground."""
-        post = self.plan.posture
-        tilt = abs(self.trunk_pitch[k] - self.planned.body_pitch[k])
-        x, y = float(self.trunk_pos[k, 0]), float(self.trunk_pos[k, 1])
-        low = self.trunk_pos[k, 2] - self.ground.centre_height(x, y)
-        return bool(tilt > FALL_TILT or low < FALL_HEIGHT_FRACTION * post.height)
-
-
-def _push_force(sim: QuadrupedSim, pushes: tuple[Push, ...], t: float) -> None:
-    """Apply the pushes active at gait time ``t`` [s] to the trunk (world frame, at its centre)."""
-    f = np.zeros(3)
-    for p in pushes:
-        if p.active(t):
-            f += p.force
-    sim.data.xfrc_applied[sim.trunk, :3] = f
+        """Trunk tilted too far from its planned pitch, or too low above the ground
+        (:data:`~footfall.sim.falls.QUADRUPED_FALL`)."""
+        post, tr = self.plan.posture, self.trace
+        tilt = abs(tr.trunk_pitch[k] - tr.planned.body_pitch[k])
+        x, y = float(tr.trunk_pos[k, 0]), float(tr.trunk_pos[k, 1])
+        low = tr.trunk_pos[k, 2] - self.ground.centre_height(x, y)
+        return QUADRUPED_FALL.fallen(float(tilt), float(low), post.height)
 
 
 def _track(
     sim: QuadrupedSim,
     rec: _Recorder,
-    video: _Video,
+    video: Video,
     control_dt: float,
     progress: Callable[[float], None] | None,
     pushes: tuple[Push, ...] = (),
     guard: SlipMonitor | None = None,
 ) -> None:
     """Track the planned joint angles sample by sample, measuring after each control period
-    (``guard``: the slip guard, which may hold the reference, ``rec.planned``, still)."""
+    (``guard``: the slip guard, which may hold the reference, ``rec.trace.planned``, still)."""
     m, d, mj = sim.model, sim.data, sim.mujoco
     substeps = max(1, round(control_dt / m.opt.timestep))
-    frame_every = max(1, round(1.0 / (VIDEO_FPS * control_dt)))
-    n = rec.planned.joints.shape[0]
+    tr = rec.trace
+    n = tr.planned.joints.shape[0]
     for k in range(n):
-        joints = rec.planned.joints
+        joints = tr.planned.joints
         q0 = joints[k]
         q1 = joints[min(k + 1, n - 1)]
         # joint targets interpolated linearly between plan samples at every physics step
         for s in range(substeps):
             d.ctrl[sim.actuators] = q0 + (q1 - q0) * (s / substeps)
             if pushes:
-                _push_force(sim, pushes, float(rec.t[0]) + (k * substeps + s) * m.opt.timestep)
+                d.xfrc_applied[sim.trunk, :3] = push_force(
+                    pushes, float(tr.t[0]) + (k * substeps + s) * m.opt.timestep
+                )
             mj.mj_step(m, d)
         rec.measure(k)
-        if guard is not None and guard.update(k, rec.slip_vel[k]):
-            rec.planned = guard.reference
-        if k % frame_every == 0:
-            video.frame(d)
+        if guard is not None and guard.update(k, tr.slip_vel[k]):
+            tr.planned = guard.reference
+        video.frame(k, d)
         if progress is not None and k % 200 == 0:
             progress(k / n)
 
@@ -503,7 +258,7 @@ def _track(
 def _track_wbc(
     sim: QuadrupedSim,
     rec: _Recorder,
-    video: _Video,
+    video: Video,
     control_dt: float,
     progress: Callable[[float], None] | None,
     gains: Any,
@@ -517,17 +272,17 @@ def _track_wbc(
     from footfall.sim.quadruped.wbc import QuadrupedWbc
 
     m, d, mj = sim.model, sim.data, sim.mujoco
-    wbc = QuadrupedWbc(sim, rec.planned, rec.ground, gains)
+    tr = rec.trace
+    wbc = QuadrupedWbc(sim, tr.planned, rec.ground, gains)
     substeps = max(1, round(control_dt / m.opt.timestep))
-    frame_every = max(1, round(1.0 / (VIDEO_FPS * control_dt)))
-    t_start = float(rec.t[0])
+    t_start = float(tr.t[0])
     every = gains.qp_every
     for i in range(round(settle_time / m.opt.timestep)):
         mj.mj_step1(m, d)
         if i % every == 0:
             d.ctrl[sim.actuators] = wbc.torques(t_start)
         mj.mj_step2(m, d)
-    n = rec.t.shape[0]
+    n = tr.t.shape[0]
     for k in range(n):
         for s in range(substeps):
             mj.mj_step1(m, d)
@@ -535,17 +290,16 @@ def _track_wbc(
             if i % every == 0:
                 d.ctrl[sim.actuators] = wbc.torques(t_start + i * m.opt.timestep)
             if pushes:
-                _push_force(sim, pushes, t_start + i * m.opt.timestep)
+                d.xfrc_applied[sim.trunk, :3] = push_force(pushes, t_start + i * m.opt.timestep)
             mj.mj_step2(m, d)
         rec.measure(k)
-        if guard is not None and guard.update(k, rec.slip_vel[k]):
-            rec.planned = guard.reference
-            wbc.retarget(rec.planned)
-        if k % frame_every == 0:
-            video.frame(d)
+        if guard is not None and guard.update(k, tr.slip_vel[k]):
+            tr.planned = guard.reference
+            wbc.retarget(tr.planned)
+        video.frame(k, d)
         if progress is not None and k % 200 == 0:
             progress(k / n)
-    rec.qp_failures = wbc.failures
+    tr.qp_failures = wbc.failures
 
 
 def simulate(
@@ -560,14 +314,14 @@ def simulate(
     wbc_gains: Any = None,
     pushes: tuple[Push, ...] = (),
     slip_guard: SlipGuard | None = None,
-) -> SimResult:
+) -> QuadrupedResult:
     """Simulate ``plan`` in MuJoCo and measure it.
 
     ``controller``: ``servo`` (document 001: joint position servos on the planned angles) or
     ``wbc`` (joint torques from the whole-body QP that puts the centre of pressure on the planned
     ZMP, :mod:`footfall.sim.quadruped.wbc`); ``wbc_gains`` its
     :class:`~footfall.sim.quadruped.wbc.QuadrupedWbcGains` (None: the defaults). ``pushes``:
-    forces on the trunk (:class:`~footfall.sim.pushes.Push`, times since the gait started).
+    forces on the trunk (:class:`~footfall.sim.disturbance.Push`, times since the gait started).
     ``slip_guard``: stop the gait when a foot slips (:class:`~footfall.sim.quadruped.slip.SlipGuard`;
     None: off); the run keeps its planned length, holding still after a stop.
 
@@ -582,7 +336,7 @@ def simulate(
         progress: optional callback receiving the fraction done.
 
     Returns:
-        A :class:`SimResult` with metrics.
+        A :class:`~footfall.results.quadruped.QuadrupedResult`.
     """
     control_dt = positive("control_dt", control_dt)
     pushes = tuple(pushes)
@@ -600,7 +354,7 @@ def simulate(
     x = ref.feet[:, :, 0]
     sim = QuadrupedSim(plan.robot, plan.ground, settings, (float(x.min()) - 2, float(x.max()) + 2))
     sim.set_pose(ref.body_pos[0], float(ref.body_pitch[0]), ref.joints[0])
-    video = _Video(sim, video_path, video_size)
+    video = Video(sim.mujoco, sim.model, video_path, video_size, control_dt, nm.TRACK_CAMERA)
     rec = _Recorder(sim, plan, ref)
     guard = SlipMonitor(slip_guard, plan, ref) if slip_guard is not None else None
 
@@ -612,28 +366,17 @@ def simulate(
         for _ in range(round(settle_time / sim.model.opt.timestep)):
             sim.mujoco.mj_step(sim.model, sim.data)
         _track(sim, rec, video, control_dt, progress, pushes, guard)
-    rec.wall_time = time.perf_counter() - wall0 - video.render_time
-    rec.video = video.close()
-    rec.video_note = video.note
-    rec.sim_time = settle_time + float(ref.t[-1])
-    return SimResult(
-        t=ref.t,
-        trunk_pos=rec.trunk_pos,
-        trunk_pitch=rec.trunk_pitch,
-        cop=rec.cop,
-        margin=rec.margin,
-        n_contacts=rec.n_contacts,
-        feet=rec.feet,
-        slip_vel=rec.slip_vel,
-        planned=rec.planned,
-        metrics=summarise(plan, rec, rec.fallen_at),
-        wall_time=rec.wall_time,
-        sim_time=rec.sim_time,
-        video=rec.video,
-        video_note=rec.video_note,
+    tr = rec.trace
+    tr.wall_time = time.perf_counter() - wall0 - video.render_time
+    tr.sim_time = settle_time + float(ref.t[-1])
+    video_file = video.close()
+    return QuadrupedResult(
+        trace=tr,
+        metrics=summarise(plan, tr, video_file, video.note),
         controller=controller,
-        qp_failures=rec.qp_failures,
         slip_stop=guard.stop if guard is not None else None,
+        video=video_file,
+        video_note=video.note,
     )
 
 
@@ -676,7 +419,7 @@ def _last_swing_end(plan: GaitPlan) -> float:
 
 
 def _foot_slips(
-    plan: GaitPlan, res: Measured, u: FloatArray
+    plan: GaitPlan, res: QuadrupedTrace, u: FloatArray
 ) -> tuple[list[StanceSlip], list[float], list[float]]:
     """Each foot's sliding over each planned stance (:func:`.slip.stance_slips`), the lengths of
     those displacements and their parts against ``u`` [m].
@@ -695,8 +438,11 @@ def _min_mean(x: FloatArray) -> tuple[float | None, float | None]:
     return (float(x.min()), float(x.mean())) if x.size else (None, None)
 
 
-def summarise(plan: GaitPlan, res: Measured, fallen_at: float = math.nan) -> QuadrupedMetrics:
+def summarise(
+    plan: GaitPlan, res: QuadrupedTrace, video: Path | None = None, video_note: str = ""
+) -> QuadrupedMetrics:
     """Metrics of a simulated walk (all from measured data unless named ``planned``)."""
+    fallen_at = res.fallen_at
     ref = res.planned
     post = plan.posture
     prm = plan.params
@@ -751,8 +497,8 @@ def summarise(plan: GaitPlan, res: Measured, fallen_at: float = math.nan) -> Qua
         sim_time_s=res.sim_time,
         wall_time_s=res.wall_time,
         realtime_factor=res.sim_time / res.wall_time if res.wall_time > 0 else math.nan,
-        video=str(res.video) if res.video is not None else None,
-        video_note=res.video_note,
+        video=str(video) if video is not None else None,
+        video_note=video_note,
     )
 
 
@@ -761,7 +507,7 @@ def run_slope_walk(
     params: GaitParams,
     settings: SimSettings | None = None,
     video_path: Path | None = None,
-) -> tuple[GaitPlan, SimResult]:
+) -> tuple[GaitPlan, QuadrupedResult]:
     """Plan (raising InputError before any simulation on bad input) and simulate a slope walk."""
     plan = plan_gait(robot, params)
     return plan, simulate(plan, settings, video_path=video_path)

@@ -1,4 +1,4 @@
-"""Foot slip of the quadruped walk: per-stance report and an online slip guard (issue 21).
+"""Foot slip of the quadruped walk: per-stance report and an online slip guard.
 
 Slip is the sliding of a foot's material point at its ground contact (the recorder's
 ``slip_vel``, tangential to the contact, zero off the ground; a rolling sphere has none),
@@ -30,6 +30,7 @@ from footfall.errors import InputError
 from footfall.quadruped.gait import GaitPlan, GaitTrajectory, PhaseKind
 from footfall.quadruped.robot import LEGS
 from footfall.quadruped.stability import stability_margin, support_polygon
+from footfall.results.quadruped import SlipStop, StanceSlip
 
 #: what the guard does when a foot slips past its limit
 SLIP_ACTIONS = ("stop",)
@@ -58,46 +59,6 @@ class SlipGuard:
         object.__setattr__(self, "limit", positive("slip_guard.limit", self.limit))
         if self.action not in SLIP_ACTIONS:
             raise InputError("slip_guard.action", self.action, f"one of {', '.join(SLIP_ACTIONS)}")
-
-
-@dataclass(frozen=True)
-class SlipStop:
-    """When and why the slip guard stopped the gait.
-
-    Attributes:
-        leg: the foot whose slip crossed the limit (``LEGS`` name).
-        time_s: gait time of the sample at which it crossed [s].
-        slip_m: that foot's sliding displacement in its current stance then [m].
-        hold_time_s: gait time from which the four-foot stance is held (the end of the phase
-            the walk was in) [s].
-    """
-
-    leg: str
-    time_s: float
-    slip_m: float
-    hold_time_s: float
-
-
-@dataclass(frozen=True)
-class StanceSlip:
-    """Sliding of one foot over one planned stance (measured).
-
-    Attributes:
-        leg: the foot (``LEGS`` name).
-        t_start_s: gait time the stance starts [s].
-        t_end_s: gait time it ends (lift-off, or the end of the run) [s].
-        slip_m: length of the foot's sliding displacement over the stance [m].
-        displacement_m: that displacement in ``{W}`` (x, y, z) [m].
-        down_slope_m: its signed part down the slope [m] (negative: up the slope; on level ground
-            the part backwards, against the walking direction).
-    """
-
-    leg: str
-    t_start_s: float
-    t_end_s: float
-    slip_m: float
-    displacement_m: tuple[float, float, float]
-    down_slope_m: float
 
 
 def downhill(plan: GaitPlan, points: FloatArray) -> FloatArray:

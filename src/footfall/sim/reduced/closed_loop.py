@@ -49,7 +49,7 @@ import functools
 import math
 import time
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -72,7 +72,8 @@ from footfall.models._linear import zoh
 from footfall.models.alip import ALIP
 from footfall.models.biped import BipedParams
 from footfall.planning.plan import FootstepPlan
-from footfall.sim.pushes import Push
+from footfall.results.reduced import SimMetrics, SimResult
+from footfall.sim.disturbance import Push
 from footfall.sim.reduced.regions import RegionFeet, region_metrics
 from footfall.terrain.region import Region
 
@@ -197,126 +198,6 @@ class SimOptions:
         }
 
 
-@dataclass(frozen=True)
-class SimMetrics:
-    """Outcome of one closed-loop run (see the module docstring for the definitions).
-
-    Attributes:
-        fell: the capture point left the viable region (or the state blew up).
-        fall_time: time of the fall [s] (nan if none).
-        stopped: after the last footstep the capture point is inside the two final soles.
-        success: ``not fell and stopped``.
-        zmp_offset_mean: mean single-support CoP distance from the stance foot centre [m].
-        zmp_offset_rms: its RMS [m].
-        zmp_offset_max: its maximum [m].
-        zmp_offset_phase_mean: per single-support phase [m].
-        zmp_offset_phase_max: per single-support phase [m].
-        saturated_time: single-support time with the CoP clipped at the sole edge [s].
-        saturated_fraction: that time over the simulated single-support time.
-        footstep_dev_mean: mean horizontal distance of the landed footsteps from the plan [m].
-        footstep_dev_max: maximum of it [m].
-        goal_error: horizontal distance of the final CoM from the goal [m] (nan after a fall).
-        steps_taken: footsteps landed.
-        mpc_solves: MPC solves.
-        mpc_fallbacks: failed MPC solves replaced by the last good solution.
-        mpc_time_median: median MPC solve time [s].
-        mpc_time_p99: 99th percentile of the MPC solve time [s].
-        mpc_time_max: maximum MPC solve time [s].
-        sim_time: simulated time [s].
-        wall_time: wall time of the run [s].
-        engine: the engine that ran the loop, ``python`` or ``compiled`` (solve times of the
-            compiled engine are those of the compiled solve, read inside the kernel).
-        footsteps_off_regions: landed footsteps whose centre lies outside every region in plan
-            view (None without the scene's regions).
-        region_changes: indices of the landed footsteps outside their planned region.
-    """
-
-    fell: bool
-    fall_time: float
-    stopped: bool
-    success: bool
-    zmp_offset_mean: float
-    zmp_offset_rms: float
-    zmp_offset_max: float
-    zmp_offset_phase_mean: tuple[float, ...]
-    zmp_offset_phase_max: tuple[float, ...]
-    saturated_time: float
-    saturated_fraction: float
-    footstep_dev_mean: float
-    footstep_dev_max: float
-    goal_error: float
-    steps_taken: int
-    mpc_solves: int
-    mpc_fallbacks: int
-    mpc_time_median: float
-    mpc_time_p99: float
-    mpc_time_max: float
-    sim_time: float
-    wall_time: float
-    engine: str
-    footsteps_off_regions: int | None = None
-    region_changes: tuple[int, ...] = ()
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict (NaN becomes None)."""
-        out: dict[str, Any] = {}
-        for k, v in asdict(self).items():
-            if k == "region_changes":
-                out[k] = list(v)
-            elif isinstance(v, tuple):
-                out[k] = [None if not math.isfinite(x) else float(x) for x in v]
-            elif isinstance(v, float) and not math.isfinite(v):
-                out[k] = None
-            else:
-                out[k] = v
-        return out
-
-
-@dataclass(frozen=True, eq=False)
-class SimResult:
-    """Trajectories and metrics of one run; arrays have one row per plant sample (control tick).
-
-    Attributes:
-        metrics: :class:`SimMetrics`.
-        t: sample times [s], shape (T,).
-        stance: index of the stance footstep, shape (T,) (during double support: the old foot).
-        single: True in single support, shape (T,).
-        com: world CoM horizontal position [m], shape (T, 2).
-        cop: realised world CoP [m], shape (T, 2).
-        cop_offset: realised CoP minus the stance foot centre, in the foot frame [m], shape (T, 2).
-        torque_cmd: MPC torque command [N m], shape (T, 2) (zero in double support).
-        torque: applied (clipped) ankle torque [N m], shape (T, 2).
-        saturated: CoP clipped at the sole edge, shape (T,).
-        footsteps: landed footsteps [m], shape (n + 1, 3).
-        plan_footsteps: planned footsteps [m], shape (N + 1, 3).
-        headings: footstep headings [rad], shape (n + 1,).
-        goal: goal position (2,) [m].
-        u_max: torque bound U_max [N m].
-        foot_length: sole length [m].
-        foot_width: sole width [m].
-        planner: name of the planner of the plan.
-    """
-
-    metrics: SimMetrics
-    t: FloatArray
-    stance: NDArray[np.int64]
-    single: NDArray[np.bool_]
-    com: FloatArray
-    cop: FloatArray
-    cop_offset: FloatArray
-    torque_cmd: FloatArray
-    torque: FloatArray
-    saturated: NDArray[np.bool_]
-    footsteps: FloatArray
-    plan_footsteps: FloatArray
-    headings: FloatArray
-    goal: FloatArray
-    u_max: float
-    foot_length: float
-    foot_width: float
-    planner: str
-
-
 def viability_bounds(
     robot: BipedParams, omega: float, foot_length: float, foot_width: float
 ) -> tuple[FloatArray, FloatArray]:
@@ -347,21 +228,17 @@ def _sole_corners(foot: FloatArray, heading: float, length: float, width: float)
     return np.asarray(foot[:2] + half @ rot2(heading).T)
 
 
-#: condensed MPCs by (robot, weights, rate, nodes) description: trials of one plan build it once
-_MPC_CACHE: dict[str, CondensedMPC] = {}
-_MPC_CACHE_SIZE = 8
+def mpc_model(robot: BipedParams, opts: SimOptions) -> CondensedMPC:
+    """The condensed MPC (eq. 5.19) the loop runs for ``robot`` with ``opts``' weights, rate and
+    nodes (:func:`~footfall.control.mpc.build_mpc`; a plant that walks many plans of one robot
+    builds it once and passes it to :func:`simulate`)."""
+    return build_mpc(robot, opts.weights, 1.0 / opts.control_rate, opts.mpc_nodes)
 
 
-def _mpc_model(robot: BipedParams, opts: SimOptions) -> CondensedMPC:
-    # BipedParams compares by identity (unpickled copies differ), but its repr describes it fully.
-    key = f"{robot!r}|{opts.weights!r}|{opts.control_rate!r}|{opts.mpc_nodes!r}"
-    mdl = _MPC_CACHE.get(key)
-    if mdl is None:
-        if len(_MPC_CACHE) >= _MPC_CACHE_SIZE:
-            _MPC_CACHE.pop(next(iter(_MPC_CACHE)))
-        mdl = build_mpc(robot, opts.weights, 1.0 / opts.control_rate, opts.mpc_nodes)
-        _MPC_CACHE[key] = mdl
-    return mdl
+def mpc_key(robot: BipedParams, opts: SimOptions) -> str:
+    """What :func:`mpc_model` depends on, as text (``BipedParams`` compares by identity, and
+    unpickled copies differ, but its repr describes it fully)."""
+    return f"{robot!r}|{opts.weights!r}|{opts.control_rate!r}|{opts.mpc_nodes!r}"
 
 
 @dataclass(frozen=True, eq=False)
@@ -485,10 +362,12 @@ def _prepare(
     opts: SimOptions,
     goal: FloatArray | None,
     regions: tuple[Region, ...] = (),
+    mdl: CondensedMPC | None = None,
 ) -> _Walk:
     robot = plan.robot
     n = plan.n_steps
-    mdl = _mpc_model(robot, opts)
+    if mdl is None:
+        mdl = mpc_model(robot, opts)
     dt, m_ticks = mdl.control_dt, mdl.n_ticks
     n_ds = max(1, round(robot.t_ds / dt))
     dt_ds = robot.t_ds / n_ds
@@ -896,6 +775,7 @@ def simulate(
     options: SimOptions | None = None,
     goal: FloatArray | None = None,
     regions: Sequence[Region] | None = None,
+    mpc: CondensedMPC | None = None,
 ) -> SimResult:
     """Walk ``plan`` in closed loop: MPC (eq. 5.19) on the ALIP plant with a rectangular sole.
 
@@ -909,6 +789,8 @@ def simulate(
         goal: goal position (2,) or (3,) [m]; default the midpoint of the last two footsteps.
         regions: the scene's regions: the region metrics are computed with them, and
             ``options.region_aware`` needs them.
+        mpc: the condensed MPC of ``plan.robot`` and ``options`` (:func:`mpc_model`, keyed by
+            :func:`mpc_key`); None builds it.
 
     Returns:
         A :class:`SimResult`. Falls are reported in the metrics, never raised.
@@ -926,7 +808,7 @@ def simulate(
     if opts.region_aware != "off" and not regs:
         raise InputError("regions", regions, "the scene's regions (SimOptions.region_aware)")
     engine = resolve_engine(opts)
-    w = _prepare(plan, opts, goal, regs)
+    w = _prepare(plan, opts, goal, regs, mpc)
     tr = _walk_compiled(w) if engine == "compiled" else _walk_python(w)
     return _result(w, tr, engine, wall0)
 

@@ -1,4 +1,4 @@
-"""Region-aware footstep corrections in the reduced-order closed loop (issue 23).
+"""Region-aware footstep corrections in the reduced-order closed loop.
 
 Document 000's MPC (eq. 5.19) moves the next footstep freely; with ``SimOptions.region_aware``
 the reduced-order loop instead solves it with the footstep kept in its planned region inset by
@@ -21,6 +21,7 @@ from footfall.control.mpc import MPC, MPCSolution
 from footfall.control.region_mpc import RegionMPC, RegionRows, region_rows, regions_in_reach
 from footfall.planning.plan import FootstepPlan
 from footfall.terrain.region import Region
+from footfall.terrain.terrain import region_of
 
 
 @dataclass
@@ -100,26 +101,18 @@ class RegionFeet:
         )
 
 
-def region_of(regions: Sequence[Region], xy: FloatArray) -> str:
-    """Name of the first region whose polygon holds ``xy`` (2,) [m] in plan view, "" for none."""
-    for r in regions:
-        if float(r.signed_distance(xy)) <= 0.0:
-            return r.name
-    return ""
-
-
 def region_metrics(
     regions: Sequence[Region], plan: FootstepPlan, feet: FloatArray
 ) -> tuple[int, tuple[int, ...]]:
     """``(footsteps off every region, steps that changed region)`` of the landed ``feet``
-    (n + 1, 3) [m] (row 0 is the start stance foot): a footstep is off when its sole centre lies
-    outside every region in plan view; it changed region when the plan's region does not hold
-    it."""
+    (n + 1, 3) [m] (row 0 is the start stance foot): a footstep is off when it stands on no region
+    (:func:`footfall.terrain.terrain.region_of` in plan view: this plant has no heights); it
+    changed region when the plan's region does not hold it."""
     by_name = {r.name: r for r in regions}
     off = 0
     changed = []
     for j in range(1, feet.shape[0]):
-        off += not region_of(regions, feet[j, :2])
+        off += not region_of(regions, feet[j, :2])  # plan view: no heights here
         own = by_name.get(plan.regions[j])
         if own is None or float(own.signed_distance(feet[j, :2])) > 0.0:
             changed.append(j)

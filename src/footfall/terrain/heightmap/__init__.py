@@ -1,4 +1,4 @@
-"""Convex planar regions from a height map (issue 22), so an elevation map feeds the planner.
+"""Convex planar regions from a height map, so an elevation map feeds the planner.
 
 Pipeline (:func:`regions_from_heightmap`):
 
