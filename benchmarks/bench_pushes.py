@@ -6,9 +6,9 @@ Run (from the repository root, about 10-20 minutes on 2 cores)::
         --controllers wbc,servo --impulses 4,6,8,10,12,15 --seeds 10 --seed-start 0 --out out/pushes
 
 Every walk follows the scene's miqcqp plan (``plan_for_walk``, cached in ``OUT/plans``) with one
-horizontal push of ``impulse / PUSH_DURATION`` newtons for ``PUSH_DURATION`` seconds, in a seeded
-direction at a seeded single support (:func:`footfall.sim.biped.plans.random_push`): seed ``s``
-gives both controllers the same push. Success = the goal reached without a fall. Per scene,
+horizontal push of ``impulse`` N s over 0.1 s, its direction, step and phase drawn from the seed
+(:meth:`footfall.sim.disturbance.Disturbance.of_seed`, the draw of ``footfall walk --seed`` and
+of the study's trials): seed ``s`` gives both controllers the same push. Success = the goal reached without a fall. Per scene,
 controller and impulse the table gives the successes, the rate with its Wilson 95 % interval, and
 the impulse at which the success rate crosses 50 % (linear interpolation between the levels
 around it; "> max" when it never falls that low). Rows go to ``OUT/pushes.csv``.
@@ -20,7 +20,6 @@ import argparse
 import csv
 import math
 import os
-import time
 from multiprocessing import Pool
 from pathlib import Path
 
@@ -55,29 +54,28 @@ def crossing(levels: list[float], rates: list[float], level: float = 0.5) -> str
 
 def _walk(job: tuple[str, str, float, int, str]) -> dict[str, object]:
     from footfall.sim.biped.options import WalkOptions
-    from footfall.sim.biped.plans import PUSH_DURATION, plan_for_walk, random_push
-    from footfall.sim.biped.walk import walk
+    from footfall.sim.biped.plans import plan_for_walk
+    from footfall.sim.biped.trial import MujocoBipedPlant
+    from footfall.sim.disturbance import Disturbance
+    from footfall.sim.trial import run_trial
     from footfall.terrain.scene import builtin_scene
 
     scene_name, controller, impulse, seed, cache = job
     scene = builtin_scene(scene_name)
     plan = plan_for_walk(scene, "miqcqp", SCENES[scene_name], 600.0, Path(cache))
-    opts = WalkOptions(controller=controller)
-    push = random_push(seed, impulse / PUSH_DURATION, plan, opts)
-    t0 = time.perf_counter()
-    res = walk(scene, plan, WalkOptions(controller=controller, pushes=(push,)))
-    m = res.metrics
+    plant = MujocoBipedPlant(WalkOptions(controller=controller))
+    out = run_trial(plant, scene, plan, Disturbance.of_seed(seed, impulse=impulse))
     return {
         "scene": scene_name,
         "controller": controller,
         "impulse_Ns": impulse,
         "seed": seed,
-        "success": bool(m.reached_goal and not m.fell),
-        "fell": bool(m.fell),
-        "fall_time_s": res.fall_time,
-        "zmp_mean_m": m.zmp.mean,
-        "wall_s": time.perf_counter() - t0,
-        "sim_s": res.sim_time,
+        "success": out.success,
+        "fell": out.fell,
+        "fall_time_s": out.fall_time,
+        "zmp_mean_m": out.zmp_offset_mean,
+        "wall_s": out.wall_time,
+        "sim_s": out.sim_time,
     }
 
 

@@ -5,8 +5,10 @@ distance without a push) per impulse and controller, Wilson 95 % intervals, pair
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_quadruped_pushes.py --seeds 10 --impulses 20,40,60
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_quadruped_pushes.py --scene stairs_10cm --cycles 8
 
-Trial ``s`` pushes sideways (+y or -y from the seed) for 0.1 s at a seeded time within a seeded
-body shift or swing of cycles 2-4; both controllers get the same push (paired).
+Trial ``s`` pushes sideways for 0.1 s: the seed's draw of the one disturbance sampler
+(:meth:`footfall.sim.disturbance.Disturbance.of_seed`: a swing in 30-70 % of the walk, a phase of
+it, a direction) with the direction turned to the nearer of +y and -y; both controllers get the
+same push (paired).
 """
 
 from __future__ import annotations
@@ -15,13 +17,14 @@ import argparse
 import math
 from dataclasses import replace
 
-import numpy as np
 from scipy import stats
 
 from footfall.quadruped import GaitParams, QuadrupedRobot, plan_gait
 from footfall.quadruped.scene import resolve_quadruped_scene
-from footfall.sim.pushes import Push
+from footfall.sim.disturbance import Disturbance
 from footfall.sim.quadruped.sim import simulate
+from footfall.sim.quadruped.trial import QuadrupedPlant
+from footfall.sim.trial import run_trial
 
 
 def wilson(k: int, n: int) -> tuple[float, float]:
@@ -57,7 +60,6 @@ def main() -> None:
         what = f"{args.slope_deg:g} deg"
     plan = plan_gait(QuadrupedRobot(), params)
     base = simulate(plan).metrics.distance_up_slope_m
-    cycle = plan.duration / args.cycles
     print(
         f"{what}, {args.cycles} cycles ({plan.duration:.1f} s), "
         f"servo distance without push {base:.2f} m"
@@ -65,12 +67,11 @@ def main() -> None:
     for imp in (float(x) for x in args.impulses.split(",")):
         ok: dict[str, list[bool]] = {"servo": [], "wbc": []}
         for seed in range(args.seeds):
-            rng = np.random.default_rng([seed, 2101])
-            t0 = float(rng.uniform(1.0, min(3.0, args.cycles - 1.0)) * cycle)
-            side = 1.0 if rng.uniform() < 0.5 else -1.0
-            push = Push.horizontal(t0, imp, side * math.pi / 2, 0.1)
+            d = Disturbance.of_seed(seed, impulse=imp)
+            side = math.copysign(math.pi / 2, math.sin(d.direction))
+            d = replace(d, direction=side)
             for ctrl in ok:
-                m = simulate(plan, controller=ctrl, pushes=(push,)).metrics
+                m = run_trial(QuadrupedPlant(ctrl), None, plan, d).detail.metrics
                 ok[ctrl].append(bool(not m.fell and m.distance_up_slope_m >= 0.9 * base))
         line = [f"{imp:5.1f} N s:"]
         for ctrl, v in ok.items():

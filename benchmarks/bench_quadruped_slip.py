@@ -54,7 +54,7 @@ def main() -> None:
                     stopped, moved = "-", "-"
                 else:
                     stopped = f"{ev.leg}, {ev.time_s:.2f}, {ev.hold_time_s:.2f}"
-                    hold = res.trunk_pos[res.t >= ev.hold_time_s - 1e-9]
+                    hold = res.trace.trunk_pos[res.trace.t >= ev.hold_time_s - 1e-9]
                     moved = f"{100 * float(np.linalg.norm(hold[-1] - hold[0])):.1f}"
                 print(
                     f"| {slope:+g}° | {ctrl} | {'stop' if guard else 'off'} | {100 * total:.1f} "

@@ -30,13 +30,13 @@ def main() -> None:
             gains = QuadrupedWbcGains(qp_every=every) if ctrl == "wbc" else None
             res = simulate(plan, controller=ctrl, wbc_gains=gains)
             m = res.metrics
-            rtf = res.sim_time / res.wall_time
+            rtf = res.trace.sim_time / res.trace.wall_time
             if ctrl == "servo":
                 servo_rtf = rtf
             print(
                 f"{slope:g}/{body:g}  {ctrl:>6}  {every or '-':>4}  {rtf:8.1f}  "
                 f"{rtf / servo_rtf:8.2f}  {100 * m.zmp_error_mean_m:.2f} / "
-                f"{100 * m.zmp_error_max_m:.2f}  fell={m.fell} qp_failures={res.qp_failures}"
+                f"{100 * m.zmp_error_max_m:.2f}  fell={m.fell} qp_failures={res.trace.qp_failures}"
             )
 
 

@@ -1,4 +1,4 @@
-"""Built-in scenes walked by the MuJoCo biped with the miqcqp plan, region-aware or not (issue 23).
+"""Built-in scenes walked by the MuJoCo biped with the miqcqp plan, region-aware or not.
 
 Run (one core; a miqcqp plan is solved once per scene and kept in --cache)::
 
@@ -7,8 +7,8 @@ Run (one core; a miqcqp plan is solved once per scene and kept in --cache)::
         --cache out/plans --out out/region_walks.jsonl
 
 Each walk is exactly ``footfall walk --scene S --planner miqcqp --no-video`` (the same
-``plan_for_walk``, whole-body controller and seeded push), with ``--push 20 --seed K`` for a seed
-K (20 N for 0.1 s: 2 N s) and no push for ``none``. One JSON line per walk is appended to --out:
+``plan_for_walk``, whole-body controller and seeded push), with ``--push 2 --seed K`` (2 N s) for
+a seed K and no push for ``none``. One JSON line per walk is appended to --out:
 fell, fall time, goal reached, footsteps landed off every region, correction sizes and region
 changes (:class:`~footfall.sim.biped.metrics.WalkMetrics`).
 """
@@ -24,12 +24,14 @@ from pathlib import Path
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from footfall.sim.biped.options import WalkOptions
-from footfall.sim.biped.plans import plan_for_walk, random_push, robot_model
-from footfall.sim.biped.walk import walk
+from footfall.sim.biped.plans import plan_for_walk, robot_model
+from footfall.sim.biped.trial import MujocoBipedPlant
+from footfall.sim.disturbance import Disturbance
+from footfall.sim.trial import run_trial
 from footfall.terrain import builtin_scene
 
-#: the push of a seeded walk [N] over PUSH_DURATION = 0.1 s: 2 N s
-PUSH_N = 20.0
+#: the impulse of a seeded walk's push [N s]
+PUSH_IMPULSE = 2.0
 KEYS = ("fell", "fall_time_s", "reached_goal", "footsteps_off_regions", "correction_m")
 
 
@@ -46,11 +48,11 @@ def main() -> None:
         scene = builtin_scene(name)
         plan = plan_for_walk(scene, "miqcqp", None, 300.0, args.cache, model=model)
         for seed in args.seeds.split(","):
-            base = WalkOptions(controller="wbc", region_aware=args.region_aware)
-            pushes = () if seed == "none" else (random_push(int(seed), PUSH_N, plan, base),)
-            opts = WalkOptions(controller="wbc", region_aware=args.region_aware, pushes=pushes)
+            opts = WalkOptions(controller="wbc", region_aware=args.region_aware)
+            plant = MujocoBipedPlant(opts, robot=model)
+            push = None if seed == "none" else Disturbance.of_seed(int(seed), impulse=PUSH_IMPULSE)
             t0 = time.perf_counter()
-            m = walk(scene, plan, opts, model_params=model).metrics.to_dict()
+            m = run_trial(plant, scene, plan, push).detail.metrics.to_dict()
             row = {"scene": name, "seed": seed, "region_aware": args.region_aware}
             row |= {k: m[k] for k in KEYS}
             row["region_changes"] = len(m["region_changes"])

@@ -48,9 +48,9 @@ def main() -> None:
     for _ in range(a.repeats):
         for c in controllers:
             res = walk(scene, plan, WalkOptions(controller=c), model_params=model)
-            tm = res.timing
+            tm = res.trace.timing
             loop = tm["total"] - tm["render"]
-            rtf[c].append(res.sim_time / loop)
+            rtf[c].append(res.trace.sim_time / loop)
             last[c] = (res, loop)
     print(f"{a.robot} on {a.scene}, {a.planner} N = {plan.n_steps}, {a.repeats} repeats")
     print("| controller | real-time factor (median, min-max) | fell | shares of the loop |")
@@ -59,11 +59,13 @@ def main() -> None:
         res, loop = last[c]
         shares = ", ".join(
             f"{k} {100 * v / loop:.0f} %"
-            for k, v in res.timing.items()
+            for k, v in res.trace.timing.items()
             if k not in ("total", "render")
         )
         med = statistics.median(rtf[c])
-        print(f"| {c} | {med:.1f}x ({min(rtf[c]):.1f}-{max(rtf[c]):.1f}) | {res.fell} | {shares} |")
+        print(
+            f"| {c} | {med:.1f}x ({min(rtf[c]):.1f}-{max(rtf[c]):.1f}) | {res.trace.fell} | {shares} |"
+        )
     if "servo" in rtf and "wbc" in rtf:
         ratio = statistics.median(w / s for w, s in zip(rtf["wbc"], rtf["servo"], strict=True))
         print(f"\nwbc / servo real-time factor, same run: {ratio:.2f}")
