@@ -1,0 +1,14 @@
+"""``footfall view``: an interactive 3-D page of a scene, a plan, a walk, a quadruped walk or a
+study, served locally with viser and drawn in any browser (or headless, for a picture).
+
+Layers: :mod:`.load` reads footfall's files into plain frozen dataclasses (one loader per kind,
+:func:`load_view` picks it), :mod:`.replay` turns a walk's recorded joint positions into body
+poses and meshes, :mod:`.build` makes the scene's nodes and the camera with pure functions,
+:mod:`.page` is the thin viser layer and :mod:`.browser` the headless Chromium. Needs the
+``view`` extra (``pip install 'footfall[view]'``: viser, trimesh, playwright) and, for a walk's
+robot, MuJoCo (``sim``).
+"""
+
+from footfall.viz.view.load import ViewData, load_view
+
+__all__ = ["ViewData", "load_view"]

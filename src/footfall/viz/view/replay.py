@@ -1,0 +1,256 @@
+"""Read a walk's ``replay.npz`` (:mod:`footfall.sim.replay` writes it) and pose its robot.
+
+The file is read with ``allow_pickle=False``: only numeric and text arrays, never code. The joint
+positions become body poses through MuJoCo's forward kinematics of the recorded MJCF, and the
+model's geoms become triangle meshes (boxes, capsules, spheres, cylinders, ellipsoids through
+``trimesh``; mesh geoms from the compiled model's own vertices), so the page needs neither the
+simulation nor the robot's files.
+"""
+
+from __future__ import annotations
+
+import stat
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from footfall._typing import FloatArray
+from footfall.errors import InputError
+
+#: what this reader understands (``footfall.sim.replay.REPLAY_FORMAT``)
+REPLAY_FORMAT = "footfall-replay-1"
+#: a replay file larger than this [bytes] is refused (a 20 s biped walk is ~0.1 MB)
+MAX_REPLAY_BYTES = 200_000_000
+#: frames a replay may hold (an hour at 30 Hz)
+MAX_FRAMES = 108_000
+#: MuJoCo geom types (``mjtGeom``) drawn from the model
+PLANE, HFIELD, SPHERE, CAPSULE, ELLIPSOID, CYLINDER, BOX, MESH = 0, 1, 2, 3, 4, 5, 6, 7
+#: half extent [m] of an infinite plane geom when drawn
+PLANE_HALF = 4.0
+
+
+@dataclass(frozen=True)
+class Replay:
+    """The arrays of a replay file.
+
+    Attributes:
+        kind: ``biped`` or ``quadruped``.
+        t: frame times, shape (F,) [s].
+        qpos: MuJoCo joint positions per frame, shape (F, nq).
+        model_xml: the MJCF the walk compiled.
+        scene_yaml: the walked scene as a scene file ("" when not recorded).
+        traces: measurements per frame, each with F rows (see :mod:`footfall.sim.replay`).
+    """
+
+    kind: str
+    t: FloatArray
+    qpos: FloatArray
+    model_xml: str
+    scene_yaml: str = ""
+    traces: dict[str, NDArray[Any]] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class GeomMesh:
+    """One geom as a triangle mesh in its body's frame.
+
+    Attributes:
+        body: index into :attr:`RobotMotion.bodies` (-1: the world, a fixed geom).
+        vertices: shape (V, 3) [m] in the body frame; faces: shape (T, 3) vertex indices.
+        rgb: colour, three ints in 0..255; opacity: 0..1.
+    """
+
+    body: int
+    vertices: FloatArray
+    faces: NDArray[np.int32]
+    rgb: tuple[int, int, int]
+    opacity: float = 1.0
+
+
+@dataclass(frozen=True)
+class RobotMotion:
+    """The robot of a replay: its geoms and its bodies' poses at every frame.
+
+    Attributes:
+        t: frame times, shape (F,) [s].
+        bodies: names of the moving bodies that carry geoms, length B.
+        pos: body positions, shape (F, B, 3) [m]; wxyz: body orientations, shape (F, B, 4).
+        geoms: the meshes of the robot's geoms (``body >= 0``) and of the world's (``-1``).
+    """
+
+    t: FloatArray
+    bodies: tuple[str, ...]
+    pos: FloatArray
+    wxyz: FloatArray
+    geoms: tuple[GeomMesh, ...]
+
+
+def _text(data: Any, key: str, path: Path) -> str:
+    arr = data[key]
+    if arr.dtype.kind != "U" or arr.ndim != 0:
+        raise InputError(f"{path}:{key}", str(arr.dtype), "a text entry")
+    return str(arr)
+
+
+def read_replay(path: Path) -> Replay:
+    """The replay in ``path``; a file that is not one (or of another format) is an
+    :class:`InputError` naming it."""
+    try:
+        info = path.stat()
+    except OSError as e:
+        raise InputError("replay file", str(path), f"a readable file ({e.strerror})") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise InputError("replay file", str(path), "a regular file")
+    if info.st_size > MAX_REPLAY_BYTES:
+        raise InputError("replay file", f"{path} ({info.st_size} bytes)", "a smaller replay")
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            keys = set(data.files)
+            missing = {"format", "kind", "t", "qpos", "model_xml"} - keys
+            if missing:
+                raise InputError(
+                    "replay file", str(path), f"a footfall replay (no {sorted(missing)})"
+                )
+            fmt = _text(data, "format", path)
+            if fmt != REPLAY_FORMAT:
+                raise InputError(f"{path}:format", fmt, REPLAY_FORMAT)
+            t = np.asarray(data["t"], dtype=float)
+            qpos = np.asarray(data["qpos"], dtype=float)
+            traces = {k.removeprefix("trace/"): data[k] for k in keys if k.startswith("trace/")}
+            replay = Replay(
+                kind=_text(data, "kind", path),
+                t=t,
+                qpos=qpos,
+                model_xml=_text(data, "model_xml", path),
+                scene_yaml=_text(data, "scene_yaml", path) if "scene_yaml" in keys else "",
+                traces=traces,
+            )
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError) as e:
+        if isinstance(e, InputError):
+            raise
+        raise InputError("replay file", str(path), f"a readable .npz replay ({e})") from None
+    _check_shapes(replay, path)
+    return replay
+
+
+def _check_shapes(r: Replay, path: Path) -> None:
+    n = r.t.shape[0] if r.t.ndim == 1 else -1
+    if n < 1 or n > MAX_FRAMES or not np.all(np.isfinite(r.t)) or np.any(np.diff(r.t) < 0):
+        raise InputError(f"{path}:t", r.t.shape, f"1 to {MAX_FRAMES} ascending finite times")
+    if r.qpos.ndim != 2 or r.qpos.shape[0] != n or not np.all(np.isfinite(r.qpos)):
+        raise InputError(f"{path}:qpos", r.qpos.shape, f"({n}, nq) finite joint positions")
+    for name, arr in r.traces.items():
+        if arr.shape[:1] != (n,) or arr.dtype.kind not in "fiub":
+            raise InputError(f"{path}:trace/{name}", arr.shape, f"{n} numeric rows")
+
+
+def _mujoco() -> Any:
+    try:
+        import mujoco
+    except ImportError:
+        raise InputError(
+            "mujoco", "not installed", "pip install 'footfall[sim]' to show a walk's robot"
+        ) from None
+    return mujoco
+
+
+def robot_motion(replay: Replay) -> RobotMotion:
+    """Body poses at every frame (MuJoCo forward kinematics of the recorded model) and the
+    model's geoms as meshes."""
+    mujoco = _mujoco()
+    try:
+        model = mujoco.MjModel.from_xml_string(replay.model_xml)
+    except ValueError as e:
+        raise InputError(
+            "replay model_xml", str(e)[:200], "an MJCF model MuJoCo compiles"
+        ) from None
+    if replay.qpos.shape[1] != model.nq:
+        raise InputError("replay qpos", replay.qpos.shape, f"{model.nq} columns (the model's nq)")
+    data = mujoco.MjData(model)
+    bodies = sorted({int(b) for b in model.geom_bodyid if b > 0})
+    index = {b: i for i, b in enumerate(bodies)}
+    n = replay.t.shape[0]
+    pos = np.empty((n, len(bodies), 3))
+    wxyz = np.empty((n, len(bodies), 4))
+    for f in range(n):
+        data.qpos[:] = replay.qpos[f]
+        mujoco.mj_kinematics(model, data)
+        pos[f] = data.xpos[bodies]
+        wxyz[f] = data.xquat[bodies]
+    geoms = tuple(
+        g
+        for i in range(model.ngeom)
+        if (g := geom_mesh(model, i, index.get(int(model.geom_bodyid[i]), -1))) is not None
+    )
+    names = tuple(
+        mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) or f"body{b}" for b in bodies
+    )
+    return RobotMotion(replay.t, names, pos, wxyz, geoms)
+
+
+def _primitive(gtype: int, size: FloatArray) -> Any:
+    """A trimesh primitive of a MuJoCo geom's half sizes, centred at its origin."""
+    import trimesh
+
+    if gtype == BOX:
+        return trimesh.creation.box(extents=2.0 * size)
+    if gtype == SPHERE:
+        return trimesh.creation.icosphere(subdivisions=2, radius=size[0])
+    if gtype == ELLIPSOID:
+        sphere = trimesh.creation.icosphere(subdivisions=2, radius=1.0)
+        sphere.apply_scale(size)
+        return sphere
+    if gtype == CAPSULE:
+        return trimesh.creation.capsule(height=2.0 * size[1], radius=size[0], count=[12, 12])
+    if gtype == CYLINDER:
+        return trimesh.creation.cylinder(radius=size[0], height=2.0 * size[1], sections=16)
+    if gtype == PLANE:
+        hx, hy = (s if s > 0 else PLANE_HALF for s in size[:2])
+        return trimesh.creation.box(extents=(2.0 * hx, 2.0 * hy, 1e-3))
+    return None
+
+
+def _trimesh() -> Any:
+    try:
+        import trimesh
+    except ImportError:
+        raise InputError("trimesh", "not installed", "pip install 'footfall[view]'") from None
+    return trimesh
+
+
+def geom_mesh(model: Any, i: int, body: int) -> GeomMesh | None:
+    """Geom ``i`` of a compiled MuJoCo model as a mesh in its body's frame (None: not drawn,
+    e.g. a height field or an invisible geom)."""
+    trimesh = _trimesh()
+    gtype = int(model.geom_type[i])
+    rgba = np.array(model.geom_rgba[i], dtype=float)
+    if model.geom_matid[i] >= 0:
+        rgba = np.array(model.mat_rgba[model.geom_matid[i]], dtype=float)
+    if rgba[3] <= 0.0:
+        return None
+    if gtype == MESH:
+        m = int(model.geom_dataid[i])
+        v0, nv = int(model.mesh_vertadr[m]), int(model.mesh_vertnum[m])
+        f0, nf = int(model.mesh_faceadr[m]), int(model.mesh_facenum[m])
+        mesh = trimesh.Trimesh(
+            model.mesh_vert[v0 : v0 + nv], model.mesh_face[f0 : f0 + nf], process=False
+        )
+    else:
+        mesh = _primitive(gtype, np.array(model.geom_size[i], dtype=float))
+        if mesh is None:
+            return None
+    pose = trimesh.transformations.quaternion_matrix(np.array(model.geom_quat[i], dtype=float))
+    pose[:3, 3] = model.geom_pos[i]
+    mesh.apply_transform(pose)
+    rgb = tuple(round(255 * float(c)) for c in np.clip(rgba[:3], 0.0, 1.0))
+    return GeomMesh(
+        body,
+        np.asarray(mesh.vertices, dtype=float),
+        np.asarray(mesh.faces, dtype=np.int32),
+        (rgb[0], rgb[1], rgb[2]),
+        float(rgba[3]),
+    )
