@@ -31,6 +31,12 @@ LIFT = 0.004
 LEFT_RGB, RIGHT_RGB, LANDED_RGB = (52, 120, 219), (231, 76, 60), (40, 40, 40)
 COM_RGB, COP_RGB, ZMP_RGB, PUSH_RGB = (142, 68, 173), (241, 196, 15), (39, 174, 96), (230, 126, 34)
 START_RGB, GOAL_RGB = (46, 204, 113), (155, 89, 182)
+#: viridis from 0.15 to 0.85 of its range (matplotlib's values, RGB 0..255)
+VIRIDIS = np.array(
+    [[71, 45, 123], [59, 82, 139], [44, 114, 142], [33, 145, 140], [40, 174, 128],
+     [94, 201, 98], [173, 220, 48]],
+    dtype=float,
+)  # fmt: skip
 #: how far the camera looks down [rad] and the share of the picture kept free at the edges
 CAMERA_ELEVATION, CAMERA_MARGIN = math.radians(30.0), 0.06
 #: terrain farther than this from the plan and the robot is left out of the framing [m]
@@ -67,14 +73,13 @@ class Label:
 
 
 def height_colours(heights: FloatArray) -> list[tuple[int, int, int]]:
-    """A colour per height (viridis from the lowest to the highest; mid-scale when all equal)."""
-    from matplotlib import colormaps
-
+    """A colour per height, dark blue (lowest) to yellow-green (highest) along viridis (mid-scale
+    when all are equal)."""
     h = np.asarray(heights, dtype=float)
     span = float(np.ptp(h)) if h.size else 0.0
     s = (h - h.min()) / span if span > 1e-9 else np.full(h.shape, 0.5)
-    cmap = colormaps["viridis"]
-    return [(int(255 * r), int(255 * g), int(255 * b)) for r, g, b, _ in cmap(0.15 + 0.7 * s)]
+    rgb = [np.interp(s, np.linspace(0.0, 1.0, len(VIRIDIS)), VIRIDIS[:, c]) for c in range(3)]
+    return [(int(r), int(g), int(b)) for r, g, b in zip(*rgb, strict=True)]
 
 
 def _prism(top: FloatArray, depth: float) -> tuple[FloatArray, NDArray[np.int32]]:
@@ -169,14 +174,42 @@ def polyline(points: FloatArray) -> FloatArray:
     return np.stack([points[:-1], points[1:]], axis=1)
 
 
-def landed_soles(plan: FootstepPlan, landed: FloatArray) -> list[Mesh]:
-    """Where footsteps 1..N landed, as dark translucent soles at the planned headings."""
+def landed_soles(plan: FootstepPlan, landed: FloatArray) -> Mesh | None:
+    """Where the plan's footsteps 1..N landed, as dark translucent soles at the planned
+    headings, in one mesh (None: none landed)."""
+    soles = [
+        _sole(f"{LANDED}/{i:03d}", p, float(plan.headings[i]), plan, LANDED_RGB, 0.55)
+        for i, p in enumerate(landed, start=1)
+        if i < len(plan.headings) and np.all(np.isfinite(p))
+    ]
+    return merge(LANDED, soles) if soles else None
+
+
+def merge(name: str, meshes: list[Mesh]) -> Mesh:
+    """One mesh of ``meshes`` (the first one's colour and opacity): a page draws one node
+    faster than many."""
+    offsets = np.cumsum([0] + [m.vertices.shape[0] for m in meshes[:-1]])
+    return Mesh(
+        name,
+        np.vstack([m.vertices for m in meshes]),
+        np.vstack([m.faces + k for m, k in zip(meshes, offsets, strict=True)]).astype(np.int32),
+        meshes[0].rgb,
+        meshes[0].opacity,
+    )
+
+
+def robot_meshes(motion: RobotMotion, world: bool) -> list[tuple[int, Mesh]]:
+    """The robot's geoms merged per body and colour, as ``(body, mesh)`` in the body's frame
+    (body -1: the model's fixed geoms, the quadruped's ground, included with ``world``)."""
+    groups: dict[tuple[int, tuple[int, int, int], float], list[Mesh]] = {}
+    for g in motion.geoms:
+        if g.body >= 0 or world:
+            mesh = Mesh("", g.vertices, g.faces, g.rgb, g.opacity)
+            groups.setdefault((g.body, g.rgb, g.opacity), []).append(mesh)
     out = []
-    for i, p in enumerate(landed, start=1):
-        if i < len(plan.headings) and np.all(np.isfinite(p)):
-            out.append(
-                _sole(f"{LANDED}/{i:03d}", p, float(plan.headings[i]), plan, LANDED_RGB, 0.55)
-            )
+    for k, ((body, _, _), meshes) in enumerate(groups.items()):
+        parent = f"/robot/{motion.bodies[body]}" if body >= 0 else "/world_geoms"
+        out.append((body, merge(f"{parent}/m{k}", meshes)))
     return out
 
 

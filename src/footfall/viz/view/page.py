@@ -148,9 +148,9 @@ class ViewPage:
             self._draw_plan(data)
         if data.walk is not None:
             w = data.walk
-            if data.plan is not None:
-                for m in build.landed_soles(data.plan, w.landed):
-                    self._mesh(m)
+            landed = build.landed_soles(data.plan, w.landed) if data.plan is not None else None
+            if landed is not None:
+                self._mesh(landed)
             self._robot(w.motion, world=data.scene is None)
             self._trail("/walk/cop_trail", w.cop, build.COP_RGB)
             self._trail("/walk/zmp_trail", w.zmp, build.ZMP_RGB)
@@ -230,21 +230,20 @@ class ViewPage:
             )
             for i, b in enumerate(motion.bodies)
         ]
-        for k, g in enumerate(motion.geoms):
-            if g.body < 0 and not world:
-                continue
-            parent = f"/robot/{motion.bodies[g.body]}" if g.body >= 0 else "/world_geoms"
-            mesh = build.Mesh(f"{parent}/g{k}", g.vertices, g.faces, g.rgb, g.opacity)
+        for body, mesh in build.robot_meshes(motion, world):
             scene.add_mesh_simple(
                 mesh.name,
                 mesh.vertices,
                 mesh.faces,
                 color=mesh.rgb,
+                opacity=None if mesh.opacity >= 1.0 else mesh.opacity,
+                side="double",
                 cast_shadow=False,
                 receive_shadow=False,
             )
+            if body < 0:
+                self._terrain.append(mesh.vertices)
         self._points.append(build.body_extents(motion))
-        self._terrain.extend(g.vertices for g in motion.geoms if g.body < 0 and world)
 
     # ---------------------------------------------------------------------- controls
     def _controls(self, data: ViewData) -> None:

@@ -192,25 +192,58 @@ def robot_motion(replay: Replay) -> RobotMotion:
     return RobotMotion(replay.t, names, pos, wxyz, geoms)
 
 
-def _primitive(gtype: int, size: FloatArray) -> Any:
-    """A trimesh primitive of a MuJoCo geom's half sizes, centred at its origin."""
-    import trimesh
+def revolve(profile: FloatArray, sections: int = 16) -> tuple[FloatArray, NDArray[np.int32]]:
+    """The surface of revolution about z of ``profile`` (P, 2) rows ``(radius, z)`` from bottom
+    to top: P rings of ``sections`` vertices, triangles facing outward."""
+    theta = np.linspace(0.0, 2.0 * np.pi, sections, endpoint=False)
+    r, z = profile[:, :1], profile[:, 1:]
+    verts = np.stack(
+        [r * np.cos(theta), r * np.sin(theta), np.broadcast_to(z, (len(profile), sections))],
+        axis=-1,
+    ).reshape(-1, 3)
+    k, i = np.meshgrid(np.arange(len(profile) - 1), np.arange(sections), indexing="ij")
+    a = k * sections + i
+    b = k * sections + (i + 1) % sections
+    faces = np.concatenate(
+        [np.stack([a, b, a + sections], -1), np.stack([b, b + sections, a + sections], -1)]
+    )
+    return verts, faces.reshape(-1, 3).astype(np.int32)
 
+
+def _arc(lo: float, hi: float, n: int = 5) -> FloatArray:
+    """(cos, sin) of ``n`` latitudes from ``lo`` to ``hi`` [rad]."""
+    phi = np.linspace(lo, hi, n)
+    return np.column_stack([np.cos(phi), np.sin(phi)])
+
+
+def box(half: FloatArray) -> tuple[FloatArray, NDArray[np.int32]]:
+    """A box of half extents ``half`` (3,) [m] centred at the origin, faces outward."""
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    faces = [(a, b, c) for a, b, c, _ in quads] + [(a, c, d) for a, _, c, d in quads]
+    return corners * half, np.array(faces, dtype=np.int32)
+
+
+def primitive(gtype: int, size: FloatArray) -> tuple[FloatArray, NDArray[np.int32]] | None:
+    """A MuJoCo primitive geom of half sizes ``size`` (3,) as a mesh centred at its origin, its
+    axis along z (None for a height field or a mesh)."""
+    half_pi = np.pi / 2
     if gtype == BOX:
-        return trimesh.creation.box(extents=2.0 * size)
-    if gtype == SPHERE:
-        return trimesh.creation.icosphere(subdivisions=2, radius=size[0])
-    if gtype == ELLIPSOID:
-        sphere = trimesh.creation.icosphere(subdivisions=2, radius=1.0)
-        sphere.apply_scale(size)
-        return sphere
-    if gtype == CAPSULE:
-        return trimesh.creation.capsule(height=2.0 * size[1], radius=size[0], count=[12, 12])
-    if gtype == CYLINDER:
-        return trimesh.creation.cylinder(radius=size[0], height=2.0 * size[1], sections=16)
-    if gtype == PLANE:
+        return box(size)
+    if gtype == PLANE:  # infinite sides (size 0) are drawn PLANE_HALF wide
         hx, hy = (s if s > 0 else PLANE_HALF for s in size[:2])
-        return trimesh.creation.box(extents=(2.0 * hx, 2.0 * hy, 1e-3))
+        return box(np.array([hx, hy, 5e-4]))
+    if gtype in (SPHERE, ELLIPSOID):
+        verts, faces = revolve(_arc(-half_pi, half_pi, 9))
+        return verts * (size if gtype == ELLIPSOID else size[0]), faces
+    if gtype == CAPSULE:
+        r, h = size[0], size[1]
+        lower = _arc(-half_pi, 0.0) * r - [0.0, h]
+        upper = _arc(0.0, half_pi) * r + [0.0, h]
+        return revolve(np.vstack([lower, upper]))
+    if gtype == CYLINDER:
+        r, h = size[0], size[1]
+        return revolve(np.array([[0.0, -h], [r, -h], [r, h], [0.0, h]]))
     return None
 
 
@@ -222,10 +255,20 @@ def _trimesh() -> Any:
     return trimesh
 
 
+def _model_mesh(model: Any, i: int) -> tuple[FloatArray, NDArray[np.int32]]:
+    """Mesh geom ``i``'s compiled vertices and faces, through ``trimesh`` (which merges the
+    duplicate vertices MuJoCo keeps per face and drops degenerate faces)."""
+    trimesh = _trimesh()
+    m = int(model.geom_dataid[i])
+    v0, nv = int(model.mesh_vertadr[m]), int(model.mesh_vertnum[m])
+    f0, nf = int(model.mesh_faceadr[m]), int(model.mesh_facenum[m])
+    mesh = trimesh.Trimesh(model.mesh_vert[v0 : v0 + nv], model.mesh_face[f0 : f0 + nf])
+    return np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int32)
+
+
 def geom_mesh(model: Any, i: int, body: int) -> GeomMesh | None:
     """Geom ``i`` of a compiled MuJoCo model as a mesh in its body's frame (None: not drawn,
     e.g. a height field or an invisible geom)."""
-    trimesh = _trimesh()
     gtype = int(model.geom_type[i])
     rgba = np.array(model.geom_rgba[i], dtype=float)
     if model.geom_matid[i] >= 0:
@@ -233,24 +276,20 @@ def geom_mesh(model: Any, i: int, body: int) -> GeomMesh | None:
     if rgba[3] <= 0.0:
         return None
     if gtype == MESH:
-        m = int(model.geom_dataid[i])
-        v0, nv = int(model.mesh_vertadr[m]), int(model.mesh_vertnum[m])
-        f0, nf = int(model.mesh_faceadr[m]), int(model.mesh_facenum[m])
-        mesh = trimesh.Trimesh(
-            model.mesh_vert[v0 : v0 + nv], model.mesh_face[f0 : f0 + nf], process=False
-        )
+        verts, faces = _model_mesh(model, i)
     else:
-        mesh = _primitive(gtype, np.array(model.geom_size[i], dtype=float))
-        if mesh is None:
+        shape = primitive(gtype, np.array(model.geom_size[i], dtype=float))
+        if shape is None:
             return None
-    pose = trimesh.transformations.quaternion_matrix(np.array(model.geom_quat[i], dtype=float))
-    pose[:3, 3] = model.geom_pos[i]
-    mesh.apply_transform(pose)
+        verts, faces = shape
+    rot = np.zeros(9)
+    _mujoco().mju_quat2Mat(rot, np.array(model.geom_quat[i], dtype=float))
+    verts = verts @ rot.reshape(3, 3).T + np.asarray(model.geom_pos[i], dtype=float)
     rgb = tuple(round(255 * float(c)) for c in np.clip(rgba[:3], 0.0, 1.0))
     return GeomMesh(
         body,
-        np.asarray(mesh.vertices, dtype=float),
-        np.asarray(mesh.faces, dtype=np.int32),
+        verts,
+        faces,
         (rgb[0], rgb[1], rgb[2]),
         float(rgba[3]),
     )
