@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 import time
 from pathlib import Path
@@ -36,6 +37,9 @@ def view_command(
         None, help="Render the page headless into this PNG and exit (needs Chromium)."
     ),
     size: str = typer.Option("1280x720", help="Picture size of --screenshot, WIDTHxHEIGHT [px]."),
+    at: float = typer.Option(
+        0.0, "--time", help="Show the recorded motion at this time [s] (the slider's start)."
+    ),
 ) -> None:
     """Serve an interactive 3-D page of a scene, plan, walk, quadruped walk or study (viser):
     terrain coloured by height, footsteps with index and side, the CoM path, the robot replayed
@@ -45,6 +49,8 @@ def view_command(
     from footfall.viz.view.page import ViewPage
 
     width_height = _size(size)
+    if not (math.isfinite(at) and at >= 0.0):
+        raise InputError("time", at, "a finite time >= 0 [s]")
     if screenshot is not None and (screenshot.is_dir() or screenshot.suffix.lower() != ".png"):
         raise InputError("screenshot", str(screenshot), "a .png file path")
     if screenshot is not None and not screenshot.parent.is_dir():
@@ -52,7 +58,7 @@ def view_command(
     data = load_view(path, scene)
     for note in data.notes:
         console.print(f"note: {note}")
-    page = ViewPage(data, host, 0 if screenshot is not None else port)
+    page = ViewPage(data, host, 0 if screenshot is not None else port, start=at)
     try:
         if screenshot is not None:
             from footfall.viz.view.browser import screenshot as take

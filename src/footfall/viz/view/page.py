@@ -53,9 +53,12 @@ def check_port(host: str, port: int) -> None:
 
 
 class ViewPage:
-    """A running page of ``data`` at ``http://host:port`` (port 0: any free port)."""
+    """A running page of ``data`` at ``http://host:port`` (port 0: any free port), showing the
+    recorded motion at ``start`` [s]."""
 
-    def __init__(self, data: ViewData, host: str = "127.0.0.1", port: int = 8080) -> None:
+    def __init__(
+        self, data: ViewData, host: str = "127.0.0.1", port: int = 8080, start: float = 0.0
+    ) -> None:
         viser = _viser()
         check_port(host, port)
         self.data = data
@@ -88,6 +91,11 @@ class ViewPage:
         with server.atomic():
             self._draw(data)
             self._controls(data)
+            if len(self.t) > 1 and start > 0.0:
+                self.set_frame(self.frame_at(start))
+                self._from_player = True  # the slider follows; no second update
+                self.slider.value = round(float(self.t[self.frame]), 3)
+                self._from_player = False
         self.camera = build.fit_camera(
             build.framed_points(_stack(self._terrain), _stack(self._points))
         )
@@ -369,7 +377,7 @@ class ViewPage:
             self.set_frame(f)
             self._from_player = True
             try:
-                self.slider.value = float(self.t[f])
+                self.slider.value = round(float(self.t[f]), 3)
             finally:
                 self._from_player = False
             next_tick += period
