@@ -55,11 +55,15 @@ def view_command(
         raise InputError("screenshot", str(screenshot), "a .png file path")
     if screenshot is not None and not screenshot.parent.is_dir():
         raise InputError("screenshot", str(screenshot), "a path in an existing folder")
-    data = load_view(path, scene)
-    for note in data.notes:
-        console.print(f"note: {note}")
-    page = ViewPage(data, host, 0 if screenshot is not None else port, start=at)
+    if not path.exists():  # before anything starts
+        raise InputError("path", str(path), "an existing file or folder that footfall wrote")
+    # serve first: a browser loads the page while the files are read and drawn into it
+    page = ViewPage(None, host, 0 if screenshot is not None else port)
     try:
+        data = load_view(path, scene)
+        for note in data.notes:
+            console.print(f"note: {note}")
+        page.show(data, start=at)
         if screenshot is not None:
             from footfall.viz.view.browser import screenshot as take
 

@@ -3,6 +3,7 @@ biped and one gait cycle of the quadruped (both through the command line, as a u
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import replace
 from pathlib import Path
@@ -47,6 +48,28 @@ def quadruped_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     res = CliRunner().invoke(app, ["quadruped", "--cycles", "1", "--no-video", "--out", str(out)])
     assert res.exit_code == 0, res.output
     return out
+
+
+@pytest.fixture
+def study_dir(walk_dir: Path, tmp_path: Path) -> Path:
+    """A study folder as ``footfall study`` leaves it: two trials of ``flat`` in trials.parquet
+    (written by the study's own store), the first one's plan in the plans/ cache."""
+    pytest.importorskip("pyarrow")
+    from footfall.experiments.study.store import write_rows
+    from footfall.experiments.study.trials import COLUMNS
+    from footfall.planning import load_plan
+    from footfall.planning.cache import PlanCache
+
+    PlanCache(tmp_path / "plans").save("a" * 64, load_plan(walk_dir / "plan.json"), "flat")
+    rows = []
+    for planner, n in (("kinematic", 4), ("miqcqp", 9)):
+        row: dict[str, object] = {name: None for name, _ in COLUMNS}
+        row.update(key=f"flat|{planner}|N={n}|J=10|seed=0", scene="flat", planner=planner,
+                   n_steps=n, push_impulse=10.0, push_time=2.0, push_direction=math.pi / 2,
+                   seed=0, success=True, fell=False, goal_error=0.01)  # fmt: skip
+        rows.append(row)
+    write_rows(tmp_path / "trials.parquet", rows)
+    return tmp_path
 
 
 def browser_or_skip() -> None:

@@ -105,26 +105,15 @@ def test_a_quadruped_folder_holds_feet_contacts_cop_and_zmp(quadruped_dir: Path)
     assert np.all(np.isfinite(q.zmp))
 
 
-def test_a_study_folder_lists_its_trials_with_their_plans(walk_dir: Path, tmp_path: Path) -> None:
-    pytest.importorskip("pyarrow")
-    from footfall.experiments.study.store import write_rows
-    from footfall.experiments.study.trials import COLUMNS
-    from footfall.planning.cache import PlanCache
-
-    plan = load_plan(walk_dir / "plan.json")
-    PlanCache(tmp_path / "plans").save("a" * 64, plan, "flat")
-    row = {name: None for name, _ in COLUMNS}
-    row.update(key="flat|kinematic|N=4|J=10|seed=0", scene="flat", planner="kinematic", n_steps=4,
-               push_impulse=10.0, push_time=2.0, push_direction=math.pi / 2, seed=0,
-               success=True, fell=False, goal_error=0.01)  # fmt: skip
-    write_rows(tmp_path / "trials.parquet", [row])
-    data = load_view(tmp_path)
-    (trial,) = data.trials
-    assert data.kind == "study" and trial.plan is not None and trial.plan.n_steps == 4
-    assert trial.push is not None
+def test_a_study_folder_lists_its_trials_with_their_plans(study_dir: Path) -> None:
+    data = load_view(study_dir)
+    first, second = data.trials
+    assert data.kind == "study" and first.plan is not None and first.plan.n_steps == 4
+    assert second.plan is None and any("no plan" in n for n in data.notes)
+    assert first.push is not None
     # 10 N s over the pulse, along +y (pi / 2)
-    assert trial.push.force[1] * trial.push.duration == pytest.approx(10.0)
-    assert abs(trial.push.force[0]) < 1e-9
+    assert first.push.force[1] * first.push.duration == pytest.approx(10.0)
+    assert abs(first.push.force[0]) < 1e-9
     assert [s.name for s in data.scenes] == ["flat"]
 
 

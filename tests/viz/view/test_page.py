@@ -137,6 +137,25 @@ def test_a_quadruped_page_shows_its_support_polygon(quadruped_dir: Path, browser
         served.close()
 
 
+def test_a_study_page_shows_the_picked_trial(study_dir: Path, browser: Any) -> None:
+    served = ViewPage(load_view(study_dir), port=0)
+    try:
+        page = open_page(browser, served.url)
+        first, second = served.data.trials
+        assert first.plan is not None
+        assert len(_names(page, build.FOOTSTEPS)) == first.plan.n_steps + 1
+        served.show_trial(second.key)  # what the trial picker does; this trial has no plan
+        page.wait_for_function(  # the soles are gone (their parent groups may stay, empty)
+            "() => !Object.keys(window.__viserSceneTree.getState())"
+            ".some(n => /^\\/plan\\/footsteps\\/\\d+$/.test(n))"
+        )
+        assert len(_names(page, build.REGIONS)) == 1  # the scene stays
+        assert "no plan in the cache" in page.inner_text("body")
+        page.close()
+    finally:
+        served.close()
+
+
 def _cli(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], *args: str
 ) -> tuple[int, str]:

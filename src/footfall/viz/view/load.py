@@ -395,6 +395,7 @@ def _load_replay_folder(folder: Path, given: Scene | None) -> ViewData:
 
 def _load_study(folder: Path, given: Scene | None) -> ViewData:
     rows = _study_rows(folder)
+    duration = _push_duration(folder)
     notes: list[str] = []
     plans = _cached_plans(folder / "plans")
     scenes: dict[str, Scene] = {}
@@ -409,7 +410,6 @@ def _load_study(folder: Path, given: Scene | None) -> ViewData:
         push = None
         if row.get("push_time") is not None and row.get("push_impulse"):
             direction = float(row.get("push_direction") or 0.0)  # [rad] (Disturbance)
-            duration = 0.1  # the studies' pulse (footfall.sim.biped.plans.PUSH_DURATION)
             f = float(row["push_impulse"]) / duration
             push = PushMark(
                 float(row["push_time"]),
@@ -438,6 +438,18 @@ def _load_study(folder: Path, given: Scene | None) -> ViewData:
         scenes=tuple(scenes.values()),
         notes=tuple(dict.fromkeys(notes)),
     )
+
+
+def _push_duration(folder: Path) -> float:
+    """The study's push pulse [s] from its ``study.json`` (the design's fingerprint); the
+    designs' default, 0.1 s, when the file does not say."""
+    path = folder / STUDY_FILE
+    data = _report(path, "study file") if path.is_file() else {}
+    fp = data.get("fingerprint")
+    value = fp.get("push_duration") if isinstance(fp, dict) else None
+    if isinstance(value, int | float) and math.isfinite(value) and value > 0:
+        return float(value)
+    return 0.1
 
 
 def _study_rows(folder: Path) -> list[dict[str, Any]]:

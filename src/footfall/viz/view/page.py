@@ -53,15 +53,19 @@ def check_port(host: str, port: int) -> None:
 
 
 class ViewPage:
-    """A running page of ``data`` at ``http://host:port`` (port 0: any free port), showing the
-    recorded motion at ``start`` [s]."""
+    """A page served at ``http://host:port`` (port 0: any free port). The server starts at
+    once, so a browser can load the page while :meth:`show` puts ``data`` into it (given here,
+    it is shown at once, the recorded motion at ``start`` [s])."""
 
     def __init__(
-        self, data: ViewData, host: str = "127.0.0.1", port: int = 8080, start: float = 0.0
+        self,
+        data: ViewData | None = None,
+        host: str = "127.0.0.1",
+        port: int = 8080,
+        start: float = 0.0,
     ) -> None:
         viser = _viser()
         check_port(host, port)
-        self.data = data
         with contextlib.redirect_stdout(io.StringIO()):  # viser prints a banner regardless
             server = viser.ViserServer(host=host, port=port, label="footfall", verbose=False)
         self.server = server
@@ -76,9 +80,11 @@ class ViewPage:
         server.scene.configure_environment_map(None)
         server.scene.configure_default_lights(True, cast_shadow=False)
         server.scene.set_up_direction("+z")
+        self.data = ViewData("none", "")
         self.motion: RobotMotion | None = None
-        self.t: FloatArray = np.zeros(1)
+        self.t: FloatArray = np.zeros(0)
         self.frame = 0
+        self.camera = build.fit_camera(np.zeros((1, 3)))
         self._bodies: list[Any] = []
         self._markers: dict[str, Any] = {}
         self._pushes: list[tuple[PushMark, Any]] = []
@@ -88,6 +94,18 @@ class ViewPage:
         self._points: list[FloatArray] = []
         self._terrain: list[FloatArray] = []
         self._handles: list[Any] = []
+        self._player = threading.Thread(target=self._play_loop, daemon=True)
+        self._player.start()
+        if data is not None:
+            self.show(data, start)
+
+    def show(self, data: ViewData, start: float = 0.0) -> None:
+        """Put ``data`` into the page (once), the motion at ``start`` [s], the camera fitted to
+        it; the page holds everything when it holds :data:`READY_NODE`."""
+        if self.data.kind != "none":
+            raise InputError("show", data.title, "one call per page")
+        self.data = data
+        server = self.server
         with server.atomic():
             self._draw(data)
             self._controls(data)
@@ -99,14 +117,17 @@ class ViewPage:
         self.camera = build.fit_camera(
             build.framed_points(_stack(self._terrain), _stack(self._points))
         )
-        server.initial_camera.position = tuple(self.camera.position)
-        server.initial_camera.look_at = tuple(self.camera.look_at)
+        position, look_at = tuple(self.camera.position), tuple(self.camera.look_at)
+        server.initial_camera.position = position
+        server.initial_camera.look_at = look_at
         server.initial_camera.up = (0.0, 0.0, 1.0)
         server.initial_camera.fov = self.camera.fov
+        for client in server.get_clients().values():  # pages that opened before the data came
+            client.camera.fov = self.camera.fov
+            client.camera.position = position
+            client.camera.look_at = look_at
         # the last node: a page that has it has everything before it (messages arrive in order)
         server.scene.add_frame(READY_NODE, show_axes=False, visible=False)
-        self._player = threading.Thread(target=self._play_loop, daemon=True)
-        self._player.start()
 
     # ------------------------------------------------------------------ static scene
     def _mesh(self, m: build.Mesh, terrain: bool = False) -> Any:
