@@ -1,13 +1,16 @@
-"""File output shared by the CLI and the demo."""
+"""File input and output shared by the CLI, the demo and the viewer."""
 
 from __future__ import annotations
 
 import json
 import math
+import stat
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from footfall.errors import InputError
 
 
 def json_ready(value: Any) -> Any:
@@ -33,3 +36,18 @@ def write_json(path: Path, payload: dict[str, Any]) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(json_ready(payload), indent=2, allow_nan=False) + "\n")
     return path
+
+
+def regular_file(path: Path, what: str, max_bytes: int) -> int:
+    """The size of ``path`` [bytes] after checking that it is a regular file (not a folder,
+    device or pipe) of at most ``max_bytes``; anything else is an :class:`InputError` naming
+    ``what`` and the file."""
+    try:
+        info = path.stat()
+    except OSError as e:
+        raise InputError(what, str(path), f"a readable file ({e.strerror})") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise InputError(what, str(path), "a regular file (not a folder, device or pipe)")
+    if info.st_size > max_bytes:
+        raise InputError(what, f"{path} ({info.st_size} bytes)", f"at most {max_bytes} bytes")
+    return int(info.st_size)

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import stat
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from footfall._io import regular_file
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, ReachTrapezoid
 from footfall.planning.plan import FootstepPlan
@@ -31,14 +31,7 @@ def read_json_file(path: Path, what: str, max_bytes: int = MAX_PLAN_BYTES) -> An
     """The JSON data of ``path``: a regular file (not a folder, device or pipe) of at most
     ``max_bytes`` bytes of UTF-8 JSON; anything else raises :class:`InputError` naming ``what``
     and the file."""
-    try:
-        info = path.stat()
-    except OSError as e:
-        raise InputError(what, str(path), f"a readable JSON file ({e.strerror})") from None
-    if not stat.S_ISREG(info.st_mode):
-        raise InputError(what, str(path), "a regular file (not a folder, device or pipe)")
-    if info.st_size > max_bytes:
-        raise InputError(what, f"{path} ({info.st_size} bytes)", f"at most {max_bytes} bytes")
+    regular_file(path, what, max_bytes)
     try:
         with path.open("rb") as fh:
             raw = fh.read(max_bytes + 1)

@@ -105,7 +105,7 @@ def test_robot_motion_meshes_every_moving_body(walk_dir: Path) -> None:
     assert carried == set(range(len(motion.bodies)))
     assert "pelvis" in motion.bodies and "torso" in motion.bodies
     for g in motion.geoms:
-        assert g.faces.max() < g.vertices.shape[0]
+        assert g.mesh.faces.max() < g.mesh.vertices.shape[0]
     # unit quaternions, finite positions
     assert np.allclose(np.linalg.norm(motion.wxyz, axis=2), 1.0, atol=1e-9)
     assert np.all(np.isfinite(motion.pos))

@@ -19,7 +19,7 @@ from footfall.models.biped import Side
 from footfall.planning.plan import FootstepPlan
 from footfall.terrain.region import Region
 from footfall.terrain.scene import Scene
-from footfall.viz.view.replay import RobotMotion
+from footfall.viz.view.replay import Mesh, RobotMotion
 
 #: node name prefixes (the tests count children of these)
 REGIONS, FOOTSTEPS, LANDED = "/scene/regions", "/plan/footsteps", "/walk/landed"
@@ -41,17 +41,6 @@ VIRIDIS = np.array(
 CAMERA_ELEVATION, CAMERA_MARGIN = math.radians(30.0), 0.06
 #: terrain farther than this from the plan and the robot is left out of the framing [m]
 FRAME_PAD = 0.6
-
-
-@dataclass(frozen=True)
-class Mesh:
-    """A triangle mesh: vertices (V, 3) [m] in its own frame, faces (T, 3), colour, opacity."""
-
-    name: str
-    vertices: FloatArray
-    faces: NDArray[np.int32]
-    rgb: tuple[int, int, int]
-    opacity: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -204,8 +193,7 @@ def robot_meshes(motion: RobotMotion, world: bool) -> list[tuple[int, Mesh]]:
     groups: dict[tuple[int, tuple[int, int, int], float], list[Mesh]] = {}
     for g in motion.geoms:
         if g.body >= 0 or world:
-            mesh = Mesh("", g.vertices, g.faces, g.rgb, g.opacity)
-            groups.setdefault((g.body, g.rgb, g.opacity), []).append(mesh)
+            groups.setdefault((g.body, g.mesh.rgb, g.mesh.opacity), []).append(g.mesh)
     out = []
     for k, ((body, _, _), meshes) in enumerate(groups.items()):
         parent = f"/robot/{motion.bodies[body]}" if body >= 0 else "/world_geoms"
@@ -249,8 +237,8 @@ def body_extents(motion: RobotMotion, every: int = 10) -> FloatArray:
     the reach of its geoms along the world axes, every ``every`` frames and at the last."""
     reach = np.zeros(len(motion.bodies))
     for g in motion.geoms:
-        if g.body >= 0 and g.vertices.size:
-            reach[g.body] = max(reach[g.body], float(np.linalg.norm(g.vertices, axis=1).max()))
+        if g.body >= 0 and g.mesh.vertices.size:
+            reach[g.body] = max(reach[g.body], float(np.linalg.norm(g.mesh.vertices, axis=1).max()))
     frames = np.unique(np.r_[np.arange(0, motion.pos.shape[0], every), motion.pos.shape[0] - 1])
     pos = motion.pos[frames].reshape(-1, 1, 3)
     r = np.tile(reach, len(frames)).reshape(-1, 1, 1)

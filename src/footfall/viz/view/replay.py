@@ -9,7 +9,6 @@ simulation nor the robot's files.
 
 from __future__ import annotations
 
-import stat
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,6 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from footfall._io import regular_file
 from footfall._typing import FloatArray
 from footfall.errors import InputError
 
@@ -55,20 +55,24 @@ class Replay:
 
 
 @dataclass(frozen=True)
-class GeomMesh:
-    """One geom as a triangle mesh in its body's frame.
+class Mesh:
+    """A triangle mesh: vertices (V, 3) [m] in its own frame, faces (T, 3), colour (three ints
+    in 0..255), opacity (0..1); ``name`` is its node in the page."""
 
-    Attributes:
-        body: index into :attr:`RobotMotion.bodies` (-1: the world, a fixed geom).
-        vertices: shape (V, 3) [m] in the body frame; faces: shape (T, 3) vertex indices.
-        rgb: colour, three ints in 0..255; opacity: 0..1.
-    """
-
-    body: int
+    name: str
     vertices: FloatArray
     faces: NDArray[np.int32]
     rgb: tuple[int, int, int]
     opacity: float = 1.0
+
+
+@dataclass(frozen=True)
+class GeomMesh:
+    """One geom of the model: ``mesh`` in the frame of body ``body`` (an index into
+    :attr:`RobotMotion.bodies`; -1: the world, a fixed geom)."""
+
+    body: int
+    mesh: Mesh
 
 
 @dataclass(frozen=True)
@@ -99,14 +103,7 @@ def _text(data: Any, key: str, path: Path) -> str:
 def read_replay(path: Path) -> Replay:
     """The replay in ``path``; a file that is not one (or of another format) is an
     :class:`InputError` naming it."""
-    try:
-        info = path.stat()
-    except OSError as e:
-        raise InputError("replay file", str(path), f"a readable file ({e.strerror})") from None
-    if not stat.S_ISREG(info.st_mode):
-        raise InputError("replay file", str(path), "a regular file")
-    if info.st_size > MAX_REPLAY_BYTES:
-        raise InputError("replay file", f"{path} ({info.st_size} bytes)", "a smaller replay")
+    regular_file(path, "replay file", MAX_REPLAY_BYTES)
     try:
         with np.load(path, allow_pickle=False) as data:
             keys = set(data.files)
@@ -286,10 +283,4 @@ def geom_mesh(model: Any, i: int, body: int) -> GeomMesh | None:
     _mujoco().mju_quat2Mat(rot, np.array(model.geom_quat[i], dtype=float))
     verts = verts @ rot.reshape(3, 3).T + np.asarray(model.geom_pos[i], dtype=float)
     rgb = tuple(round(255 * float(c)) for c in np.clip(rgba[:3], 0.0, 1.0))
-    return GeomMesh(
-        body,
-        verts,
-        faces,
-        (rgb[0], rgb[1], rgb[2]),
-        float(rgba[3]),
-    )
+    return GeomMesh(body, Mesh(f"geom{i}", verts, faces, (rgb[0], rgb[1], rgb[2]), float(rgba[3])))
