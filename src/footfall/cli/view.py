@@ -45,8 +45,7 @@ def view_command(
     terrain coloured by height, footsteps with index and side, the CoM path, the robot replayed
     with a time slider, measured CoP against planned ZMP, pushes. With --screenshot, render it
     headless into a PNG and exit."""
-    from footfall.viz.view import load_view
-    from footfall.viz.view.page import ViewPage
+    from footfall.viz.view.serve import start_server, stop_server
 
     width_height = _size(size)
     if not (math.isfinite(at) and at >= 0.0):
@@ -57,8 +56,17 @@ def view_command(
         raise InputError("screenshot", str(screenshot), "a path in an existing folder")
     if not path.exists():  # before anything starts
         raise InputError("path", str(path), "an existing file or folder that footfall wrote")
-    # serve first: a browser loads the page while the files are read and drawn into it
-    page = ViewPage(None, host, 0 if screenshot is not None else port)
+    # serve first: a browser loads the page while the planner's modules are imported and the
+    # files read and drawn into it
+    server = start_server(host, 0 if screenshot is not None else port)
+    try:
+        from footfall.viz.view import load_view
+        from footfall.viz.view.page import ViewPage
+
+        page = ViewPage(None, host, server=server)
+    except BaseException:
+        stop_server(server)
+        raise
     try:
         data = load_view(path, scene)
         for note in data.notes:

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from footfall.errors import InputError
-from footfall.viz.view.page import READY_NODE
+from footfall.viz.view.serve import READY_NODE
 
 #: a browser the environment names, then the usual names of a system Chromium
 BROWSER_ENV = "FOOTFALL_CHROMIUM"

@@ -7,10 +7,7 @@ per-frame markers when the time changes. The camera starts fitted to everything 
 
 from __future__ import annotations
 
-import contextlib
-import io
 import math
-import socket
 import threading
 import time
 from typing import Any
@@ -22,34 +19,12 @@ from footfall.errors import InputError
 from footfall.viz.view import build
 from footfall.viz.view.load import PushMark, StudyTrial, ViewData
 from footfall.viz.view.replay import RobotMotion
+from footfall.viz.view.serve import READY_NODE, start_server, stop_server
 
 #: frames a second of the replay's playback (the rate walks record at)
 PLAY_FPS = 30.0
 #: a push arrow shows this long [s] before and after the push
 PUSH_SHOWN = 0.4
-#: the node added last (see :func:`footfall.viz.view.browser.wait_loaded`)
-READY_NODE = "/footfall_ready"
-
-
-def _viser() -> Any:
-    try:
-        import viser
-    except ImportError:
-        raise InputError("viser", "not installed", "pip install 'footfall[view]'") from None
-    return viser
-
-
-def check_port(host: str, port: int) -> None:
-    """Refuse a port another program listens on (viser would silently take the next one)."""
-    if port == 0:
-        return
-    if not 0 < port < 65536:
-        raise InputError("port", port, "a TCP port in 1..65535, or 0 for any free port")
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        try:
-            s.bind((host, port))
-        except OSError as e:
-            raise InputError("port", port, f"a free port ({e.strerror}); try --port 0") from None
 
 
 class ViewPage:
@@ -63,23 +38,12 @@ class ViewPage:
         host: str = "127.0.0.1",
         port: int = 8080,
         start: float = 0.0,
+        server: Any = None,
     ) -> None:
-        viser = _viser()
-        check_port(host, port)
-        with contextlib.redirect_stdout(io.StringIO()):  # viser prints a banner regardless
-            server = viser.ViserServer(host=host, port=port, label="footfall", verbose=False)
-        self.server = server
-        if port and server.get_port() != port:  # taken between the check and the bind
-            with contextlib.redirect_stdout(io.StringIO()):
-                server.stop()
-            raise InputError("port", port, "a free port; try --port 0")
+        # a server already started (:func:`~footfall.viz.view.serve.start_server`) is adopted
+        self.server = server = server if server is not None else start_server(host, port)
         self.port = int(server.get_port())
         self.url = f"http://{host}:{self.port}/"
-        # software WebGL: no environment map (its prefiltering stalls the first frame for
-        # seconds) and no shadows
-        server.scene.configure_environment_map(None)
-        server.scene.configure_default_lights(True, cast_shadow=False)
-        server.scene.set_up_direction("+z")
         self.data = ViewData("none", "")
         self.motion: RobotMotion | None = None
         self.t: FloatArray = np.zeros(0)
@@ -409,8 +373,7 @@ class ViewPage:
         self._stop.set()
         self._playing.clear()
         self._player.join(timeout=1.0)
-        with contextlib.redirect_stdout(io.StringIO()):  # "(viser) Server stopped"
-            self.server.stop()
+        stop_server(self.server)
 
 
 def _com_at(plan: Any, t: float) -> FloatArray:
