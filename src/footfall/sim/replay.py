@@ -5,7 +5,7 @@ tick: a viewer draws at most a few tens of frames a second), the MJCF text of th
 belong to, and a few measured traces resampled to the same instants (the centre of pressure, the
 planned ZMP, ...). Everything is a plain numeric or text array written by
 :func:`numpy.savez_compressed`; the viewer reads it with ``allow_pickle=False``, so a replay file
-is data, never code. A 20 s walk of the biped is a few tens of kB.
+is data, never code. A walk of the biped takes about 4 kB a second (a 20 s walk: 73 kB).
 
 Keys (F display frames, ``nq`` the model's position coordinates):
 
