@@ -1,4 +1,4 @@
-"""File output shared by the CLI and the demo."""
+"""File input and output shared by the CLI, the demo and the viewer."""
 
 from __future__ import annotations
 
@@ -38,22 +38,34 @@ def write_json(path: Path, payload: dict[str, Any]) -> Path:
     return path
 
 
-def read_bounded(
-    path: Path, what: str, max_bytes: int, kind: str, error: type[InputError] = InputError
-) -> str:
-    """The UTF-8 text of ``path``: a regular file (not a folder, device or pipe) of at most
-    ``max_bytes`` bytes, read no further than that even if it grows meanwhile. Anything else
-    raises ``error`` naming ``what``, the file and what was expected (``kind``, e.g. "a YAML
-    file")."""
-    path = Path(path)
+def regular_file(
+    path: Path,
+    what: str,
+    max_bytes: int,
+    kind: str = "file",
+    error: type[InputError] = InputError,
+) -> int:
+    """The size of ``path`` [bytes] after checking that it is a regular file (not a folder,
+    device or pipe) of at most ``max_bytes``; anything else raises ``error`` naming ``what``,
+    the file and what was expected (``kind``, e.g. "YAML file")."""
     try:
-        info = path.stat()
+        info = Path(path).stat()
     except OSError as e:
         raise error(what, str(path), f"a readable {kind} ({e.strerror})") from None
     if not stat.S_ISREG(info.st_mode):
         raise error(what, str(path), "a regular file (not a folder, device or pipe)")
     if info.st_size > max_bytes:
         raise error(what, f"{path} ({info.st_size} bytes)", f"at most {max_bytes} bytes")
+    return int(info.st_size)
+
+
+def read_bounded(
+    path: Path, what: str, max_bytes: int, kind: str, error: type[InputError] = InputError
+) -> str:
+    """The UTF-8 text of ``path``: a :func:`regular_file` of at most ``max_bytes`` bytes, read
+    no further than that even if it grows meanwhile."""
+    path = Path(path)
+    regular_file(path, what, max_bytes, kind, error)
     try:
         with path.open("rb") as fh:
             raw = fh.read(max_bytes + 1)

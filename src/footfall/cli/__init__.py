@@ -1,7 +1,7 @@
 """The ``footfall`` command line.
 
 Every command that computes something writes JSON and a figure into ``--out``. The commands live
-by subject in :mod:`.planning`, :mod:`.simulation`, :mod:`.bench` and :mod:`.terrain`;
+by subject in :mod:`.planning`, :mod:`.simulation`, :mod:`.bench`, :mod:`.terrain` and :mod:`.view`;
 :func:`main` turns errors into one line and an exit code (:func:`main` lists them) and ends worker
 processes on SIGINT / SIGTERM.
 """
@@ -70,6 +70,6 @@ def main() -> None:
 
 
 # the command modules register their commands on ``app`` when imported
-from footfall.cli import bench, planning, simulation, study, terrain  # noqa: E402
+from footfall.cli import bench, planning, simulation, study, terrain, view  # noqa: E402
 
-__all__ = ["app", "bench", "main", "planning", "simulation", "study", "terrain"]
+__all__ = ["app", "bench", "main", "planning", "simulation", "study", "terrain", "view"]

@@ -13,12 +13,14 @@ import math
 import time
 from pathlib import Path
 from types import TracebackType
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
 from footfall.cli._common import console
 from footfall.errors import InputError
-from footfall.planning.plan import FootstepPlan
-from footfall.solvers.base import SolveProgress
+
+if TYPE_CHECKING:  # annotations only: importing the planner costs every command a second
+    from footfall.planning.plan import FootstepPlan
+    from footfall.solvers.base import SolveProgress
 
 #: least time [s] between two progress lines of a running solve (plain and JSON lines)
 LOG_PERIOD = 5.0

@@ -113,6 +113,7 @@ def quadruped_cmd(
     from footfall.sim.quadruped.mjcf import SimSettings
     from footfall.sim.quadruped.sim import simulate
     from footfall.sim.quadruped.slip import SLIP_ACTIONS, SlipGuard
+    from footfall.sim.replay import REPLAY_FILE, ReplayRecorder, quadruped_traces
     from footfall.viz.quadruped_plots import save_walk_figures
 
     if controller not in ("servo", "wbc"):
@@ -157,13 +158,16 @@ def quadruped_cmd(
     plans, infeasible = plan_strategies(QuadrupedRobot(), params, compare)
     plan = plans[params.strategy]
     console.print(f"simulating {params.cycles} cycles on {label} ({plan.duration:.1f} s)...")
+    replay = ReplayRecorder("quadruped")
     res = simulate(
         plan,
         settings,
         video_path=out / "quadruped.mp4" if video else None,
         controller=controller,
         slip_guard=guard,
+        replay=replay,
     )
+    replay.write(out / REPLAY_FILE, quadruped_traces(res.trace, replay.times))
     if video and res.video is None:
         console.print(res.video_note)
     payload = res.metrics.to_dict()
@@ -206,7 +210,7 @@ def quadruped_cmd(
             f"slip guard: {st.leg} slid {100 * st.slip_m:.1f} cm at {st.time_s:.2f} s; "
             f"holding four feet from {st.hold_time_s:.2f} s"
         )
-    console.print(f"wrote {out / 'quadruped.json'}")
+    console.print(f"wrote {out / 'quadruped.json'} and {REPLAY_FILE}")
     if m.fell:
         raise typer.Exit(1)
 
@@ -516,7 +520,9 @@ def walk_cmd(
     from footfall.sim.biped.options import WalkOptions
     from footfall.sim.biped.plans import ROBOT_CONTROLLERS, plan_for_walk, robot_model
     from footfall.sim.biped.trial import MujocoBipedPlant
+    from footfall.sim.replay import REPLAY_FILE, ReplayRecorder, biped_traces
     from footfall.sim.trial import run_trial, trial_pushes
+    from footfall.terrain import scene_to_yaml
     from footfall.viz.walk_plot import plot_walk
 
     check_planner_name(planner)
@@ -550,14 +556,18 @@ def walk_cmd(
     if not plan.has_solution:
         console.print(f"{sc.name}: {planner} found no plan ({plan.status.value}). {plan.message}")
         raise typer.Exit(1)
+    replay = ReplayRecorder("biped")
     plant = MujocoBipedPlant(
         WalkOptions(controller=controller, region_aware=region_aware),
         robot=model,
         video_path=out / "walk.mp4" if video else None,
+        replay=replay,
     )
     pushes = trial_pushes(plant, plan, disturbance)
     with console.status(f"walking {plan.n_steps} steps in MuJoCo ..."):
         res = run_trial(plant, sc, plan, disturbance).detail
+    # what `footfall view` replays: joint positions at 30 Hz, the model, the scene, the CoP
+    replay.write(out / REPLAY_FILE, biped_traces(res.trace, replay.times), scene_to_yaml(sc))
     # walk.json's "controller" (from the result) names the controller and holds its tally
     report = _walk_report(sc.name, planner, robot, plan, disturbance, pushes, res)
     write_json(out / "walk.json", report)
@@ -571,6 +581,8 @@ def walk_cmd(
     )
     if res.video_note:
         console.print(res.video_note)
-    console.print(f"wrote {out / 'walk.json'}, walk.png" + (", walk.mp4" if res.video else ""))
+    console.print(
+        f"wrote {out / 'walk.json'}, walk.png, {REPLAY_FILE}" + (", walk.mp4" if res.video else "")
+    )
     if m.fell or not m.reached_goal:
         raise typer.Exit(1)

@@ -54,6 +54,8 @@ class BipedSim:
         self.mujoco = mujoco
         self.params: WalkerModel = model_params if model_params is not None else BipedModel()
         xml = self.params.mjcf(terrain_xml(scene.terrain), settings)
+        #: the MJCF text compiled into ``model`` (a replay stores it, :mod:`footfall.sim.replay`)
+        self.xml = xml
         self.model = mujoco.MjModel.from_xml_string(xml)
         self.data = mujoco.MjData(self.model)
         m = self.model

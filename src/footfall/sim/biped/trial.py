@@ -14,6 +14,7 @@ from footfall.sim.biped.model import BipedSimSettings, WalkerModel
 from footfall.sim.biped.options import WalkOptions
 from footfall.sim.biped.walk import walk
 from footfall.sim.disturbance import Push, SupportTimeline
+from footfall.sim.replay import ReplayRecorder
 from footfall.sim.trial import check_settings
 from footfall.terrain.scene import Scene
 
@@ -28,12 +29,15 @@ class MujocoBipedPlant:
         robot: the walker model (None: footfall's 30 kg biped).
         settings: physics settings (None: the model's defaults).
         video_path: write an MP4 of the walk here (None: no video).
+        replay: record the joint positions for ``footfall view`` into this recorder (None:
+            none; a command's plant of one walk).
     """
 
     options: WalkOptions = field(default_factory=WalkOptions)
     robot: WalkerModel | None = None
     settings: BipedSimSettings | None = None
     video_path: Path | None = None
+    replay: ReplayRecorder | None = None
 
     name = "mujoco"
 
@@ -60,6 +64,7 @@ class MujocoBipedPlant:
             model_params=self.robot,
             settings=self.settings,
             video_path=self.video_path,
+            replay=self.replay,
         )
         m = res.metrics
         return Outcome(

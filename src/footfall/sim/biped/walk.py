@@ -84,6 +84,7 @@ from footfall.sim.biped.state import (
 from footfall.sim.biped.wbc import BipedWbc, CopTarget
 from footfall.sim.disturbance import push_force
 from footfall.sim.falls import HUMANOID_FALL
+from footfall.sim.replay import ReplayRecorder
 from footfall.terrain.edges import inset_riser_edges
 from footfall.terrain.scene import Scene
 
@@ -135,6 +136,8 @@ class BipedWalk:
         self.t_end_steps = self.t_walk0 + self.n * self.t_step
         self.n_ticks = round((self.t_end_steps + opts.stop_time + opts.hold_time) / self.dt)
         self._init_state()
+        #: records the joint positions for ``footfall view`` when :meth:`run` is given one
+        self.replay: ReplayRecorder | None = None
 
     def _default_adjuster(self, plan: FootstepPlan) -> MPCAdjuster:
         """The MPC of eq. (5.19) on the regions with their riser edges moved in."""
@@ -202,10 +205,15 @@ class BipedWalk:
         video_path: Path | None = None,
         video_size: tuple[int, int] = (640, 480),
         progress: Callable[[float], None] | None = None,
+        replay: ReplayRecorder | None = None,
     ) -> WalkResult:
-        """Walk until the end of the hold (or a fall with ``stop_on_fall``) and measure it."""
+        """Walk until the end of the hold (or a fall with ``stop_on_fall``) and measure it
+        (``replay``: also record the joint positions at its display rate)."""
         sim = self.sim
         self.video = Video(sim.mujoco, sim.model, video_path, video_size, self.dt, nm.TRACK_CAMERA)
+        self.replay = replay
+        if replay is not None:
+            replay.begin(sim.xml)
         wall0 = time.perf_counter()
         k = 0
         for k in range(self.n_ticks):
@@ -222,6 +230,8 @@ class BipedWalk:
         timing = self.log.timing
         t = float(self.log.t[k])
         c0 = time.perf_counter()
+        if self.replay is not None:
+            self.replay.sample(t, self.sim.data)
         if self.wbc is not None:
             # the torque controller needs this instant's model terms and contact forces
             self.sim.mujoco.mj_forward(self.sim.model, self.sim.data)
@@ -650,6 +660,7 @@ def walk(
     video_path: Path | None = None,
     video_size: tuple[int, int] = (640, 480),
     progress: Callable[[float], None] | None = None,
+    replay: ReplayRecorder | None = None,
 ) -> WalkResult:
     """Simulate the biped walking ``plan`` over ``scene`` in MuJoCo and measure it.
 
@@ -668,6 +679,7 @@ def walk(
         video_path: write an MP4 here (offscreen GL); None = no video.
         video_size: (width, height) [px].
         progress: optional callback receiving the fraction done.
+        replay: records the joint positions for ``footfall view`` (:mod:`footfall.sim.replay`).
 
     Returns:
         A :class:`WalkResult`.
@@ -679,4 +691,4 @@ def walk(
     opts = options if options is not None else WalkOptions()
     check_walk_inputs(scene, plan, opts, model_params)
     walker = BipedWalk(scene, plan, opts, adjuster, model_params, settings)
-    return walker.run(video_path, video_size, progress)
+    return walker.run(video_path, video_size, progress, replay)

@@ -45,6 +45,7 @@ from footfall.sim.quadruped.slip import (
     downhill,
     stance_slips,
 )
+from footfall.sim.replay import ReplayRecorder
 
 #: a foot counts as in contact when it carries more than this fraction of the robot's weight
 CONTACT_FORCE_FRACTION = 0.01
@@ -81,6 +82,8 @@ class QuadrupedSim:
         #: the ground (a number is the document's slope [rad])
         self.ground = slope if not isinstance(slope, int | float) else PlaneGround(float(slope))
         xml = ground_scene(robot, self.ground, self.settings, x_range)
+        #: the MJCF text compiled into ``model`` (a replay stores it, :mod:`footfall.sim.replay`)
+        self.xml = xml
         self.model = mujoco.MjModel.from_xml_string(xml)
         self.data = mujoco.MjData(self.model)
         m = self.model
@@ -228,6 +231,7 @@ def _track(
     progress: Callable[[float], None] | None,
     pushes: tuple[Push, ...] = (),
     guard: SlipMonitor | None = None,
+    replay: ReplayRecorder | None = None,
 ) -> None:
     """Track the planned joint angles sample by sample, measuring after each control period
     (``guard``: the slip guard, which may hold the reference, ``rec.trace.planned``, still)."""
@@ -248,6 +252,8 @@ def _track(
                 )
             mj.mj_step(m, d)
         rec.measure(k)
+        if replay is not None:
+            replay.sample(float(tr.t[k]), d)
         if guard is not None and guard.update(k, tr.slip_vel[k]):
             tr.planned = guard.reference
         video.frame(k, d)
@@ -265,6 +271,7 @@ def _track_wbc(
     settle_time: float,
     pushes: tuple[Push, ...] = (),
     guard: SlipMonitor | None = None,
+    replay: ReplayRecorder | None = None,
 ) -> None:
     """Drive every joint by torque from the whole-body QP (:mod:`.wbc`) at every physics step,
     measuring after each control period; it also holds the first reference while the robot
@@ -293,6 +300,8 @@ def _track_wbc(
                 d.xfrc_applied[sim.trunk, :3] = push_force(pushes, t_start + i * m.opt.timestep)
             mj.mj_step2(m, d)
         rec.measure(k)
+        if replay is not None:
+            replay.sample(float(tr.t[k]), d)
         if guard is not None and guard.update(k, tr.slip_vel[k]):
             tr.planned = guard.reference
             wbc.retarget(tr.planned)
@@ -314,6 +323,7 @@ def simulate(
     wbc_gains: Any = None,
     pushes: tuple[Push, ...] = (),
     slip_guard: SlipGuard | None = None,
+    replay: ReplayRecorder | None = None,
 ) -> QuadrupedResult:
     """Simulate ``plan`` in MuJoCo and measure it.
 
@@ -323,7 +333,8 @@ def simulate(
     :class:`~footfall.sim.quadruped.wbc.QuadrupedWbcGains` (None: the defaults). ``pushes``:
     forces on the trunk (:class:`~footfall.sim.disturbance.Push`, times since the gait started).
     ``slip_guard``: stop the gait when a foot slips (:class:`~footfall.sim.quadruped.slip.SlipGuard`;
-    None: off); the run keeps its planned length, holding still after a stop.
+    None: off); the run keeps its planned length, holding still after a stop. ``replay``: also
+    record the joint positions for ``footfall view`` (:mod:`footfall.sim.replay`).
 
     Args:
         plan: the gait plan (its slope defines the scene).
@@ -357,15 +368,19 @@ def simulate(
     video = Video(sim.mujoco, sim.model, video_path, video_size, control_dt, nm.TRACK_CAMERA)
     rec = _Recorder(sim, plan, ref)
     guard = SlipMonitor(slip_guard, plan, ref) if slip_guard is not None else None
+    if replay is not None:
+        replay.begin(sim.xml)
 
     wall0 = time.perf_counter()
     if controller == "wbc":
-        _track_wbc(sim, rec, video, control_dt, progress, wbc_gains, settle_time, pushes, guard)
+        _track_wbc(
+            sim, rec, video, control_dt, progress, wbc_gains, settle_time, pushes, guard, replay
+        )
     else:
         # settle in the initial pose so the legs take the weight before the gait starts
         for _ in range(round(settle_time / sim.model.opt.timestep)):
             sim.mujoco.mj_step(sim.model, sim.data)
-        _track(sim, rec, video, control_dt, progress, pushes, guard)
+        _track(sim, rec, video, control_dt, progress, pushes, guard, replay)
     tr = rec.trace
     tr.wall_time = time.perf_counter() - wall0 - video.render_time
     tr.sim_time = settle_time + float(ref.t[-1])
