@@ -26,11 +26,12 @@ except importlib.metadata.PackageNotFoundError:
         allow_module_level=True,
     )
 
+from footfall.sim.biped.g1 import G1Model, g1_urdf_path, urdf_joint  # noqa: E402
+
 from footfall.errors import FootfallError, InputError  # noqa: E402
 from footfall.models.biped import Side  # noqa: E402
+from footfall.robots import names as nm  # noqa: E402
 from footfall.sim.biped import g1 as g1_model  # noqa: E402
-from footfall.sim.biped import names as nm  # noqa: E402
-from footfall.sim.biped.g1 import G1Model, g1_urdf_path, urdf_joint  # noqa: E402
 from footfall.sim.biped.model import measure_model, planner_params  # noqa: E402
 from footfall.sim.biped.plans import robot_model  # noqa: E402
 from footfall.sim.biped.plant import BipedSim, ankle_joint_torque  # noqa: E402
