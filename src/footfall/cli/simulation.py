@@ -371,6 +371,7 @@ def compare_command(
     controller: str = typer.Option(
         DEFAULT_CONTROLLER, help="--sim mujoco: the walker's controller, " + _CONTROLLER_HELP
     ),
+    robot: str = typer.Option("biped", help="--sim mujoco: " + ROBOT_HELP),
     noise_pos: float | None = typer.Option(
         None, help="--sim reduced: CoM position estimate noise (std) [m]. [default: 0.002]"
     ),
@@ -415,6 +416,7 @@ def compare_command(
         initial_impulse=0.0,
         time_limit=time_limit,
         region_aware=region_aware,
+        robot=robot,
         **noise,  # type: ignore[arg-type]
     )
     from footfall.cli.study import run_design
