@@ -20,7 +20,7 @@ import numpy as np
 from footfall.errors import InputError
 from footfall.models.biped import Side
 from footfall.robots.file import MODEL_FORMATS, RobotFile, load_robot_file
-from footfall.robots.model import RobotModel, straight_leg_height
+from footfall.robots.model import RobotModel, _kinematics, straight_leg_height
 
 
 @dataclass(frozen=True)
@@ -113,9 +113,10 @@ def inspect_robot(model: Path, config: Path | None = None, name: str | None = No
         step_height_max=reach.step_height_max,
     )
     from footfall.robots import names as nm
-    from footfall.sim.biped.model import measure_model  # the walker's own measurement
 
-    info = measure_model(RobotModel(complete))
+    kin = _kinematics(rf)
+    kin.pose(walker.nominal_joints(), np.array([0.0, 0.0, walker.pelvis_height]))
+    com_height = float(kin.com()[2] - kin.soles()[0][0][2])
     mj, m = _compiled(RobotModel(complete))
     limits = []
     for joint in nm.LEG_JOINTS:
@@ -125,8 +126,8 @@ def inspect_robot(model: Path, config: Path | None = None, name: str | None = No
         limits.append((joint, float(m.jnt_range[j, 0]), float(m.jnt_range[j, 1]), torque))
     return Inspection(
         robot=complete,
-        mass=info.mass,
-        com_height=info.com_height,
+        mass=float(np.sum(m.body_mass)),
+        com_height=com_height,
         leg_length=straight_leg_height(rf),
         foot=dict(zip(Side, lay.feet, strict=True)),
         joint_limits=limits,
