@@ -90,9 +90,15 @@ def _urdf_root(rf: RobotFile) -> ET.Element:
         raise InputError("model", str(rf.model), f"a valid URDF (XML: {e})") from None
     if root.tag != "robot":
         raise InputError("model", str(rf.model), "a URDF (a <robot> element)")
-    # a <mujoco> extension of another setup: ours are set on the spec
+    # a <mujoco> extension of another setup is replaced by ours: visual geometry kept (MuJoCo's
+    # URDF reader decides that while parsing; the walker model removes it itself), fixed links
+    # kept as bodies, and inertias that break the triangle inequality balanced (MuJoCo refuses
+    # them otherwise; some published URDFs have them)
     for ext in root.findall("mujoco"):
         root.remove(ext)
+    ET.SubElement(ET.SubElement(root, "mujoco"), "compiler").attrib.update(
+        {"discardvisual": "false", "fusestatic": "false", "balanceinertia": "true"}
+    )
     return root
 
 
@@ -107,7 +113,6 @@ def _spec_from(rf: RobotFile, root: ET.Element | None) -> Any:
     except Exception as e:  # MuJoCo's parser errors: a file the user handed in
         raise InputError("model", str(rf.model), f"a model MuJoCo can read ({e})") from None
     spec.compiler.fusestatic = False  # fixed links stay bodies: the torso, the sole links
-    spec.compiler.discardvisual = True
     return spec
 
 
@@ -132,30 +137,66 @@ class RawModel:
         model: the compiled MuJoCo model.
         data: its data after forward kinematics.
         base: the base body's name.
+        dropped: mesh files left out (MuJoCo cannot read them).
     """
 
     model: Any
     data: Any
     base: str
+    dropped: tuple[str, ...] = ()
+
+
+#: mesh files MuJoCo reads; geometry in other files (Collada, ...) is left out of the raw model
+MESH_SUFFIXES = (".stl", ".obj", ".msh")
+#: meshes MuJoCo refuses to decode are left out one by one, at most this many
+MAX_DROPPED_MESHES = 64
+
+
+def _drop_meshes(root: ET.Element, keep: Any) -> list[str]:
+    """Remove the ``<visual>`` and ``<collision>`` elements whose mesh file ``keep(file)``
+    refuses; the files left out."""
+    dropped = []
+    for link in root.findall("./link"):
+        for tag in ("visual", "collision"):
+            for e in link.findall(tag):
+                mesh = e.find("geometry/mesh")
+                if mesh is not None and not keep(mesh.get("filename", "")):
+                    link.remove(e)
+                    dropped.append(mesh.get("filename", ""))
+    return dropped
 
 
 def raw_model(rf: RobotFile) -> RawModel:
-    """The model as its file has it (collision geometry and every joint kept), with a free base,
-    at zero joint angles: what :func:`find_legs`, :func:`sole_from_geometry` and
-    :func:`body_box` read."""
+    """The model as its file has it (visual and collision geometry and every joint kept), with a
+    free base, at zero joint angles: what :func:`find_legs`, :func:`sole_from_geometry` and
+    :func:`body_box` read. Meshes MuJoCo cannot read (another format, or a file its decoder
+    refuses) are left out of it (``RawModel.dropped``); what they would have given must then come
+    from the robot file (a sole, say)."""
     mujoco = require_mujoco()
-    spec = _spec_from(rf, _urdf_root(rf) if rf.format == "urdf" else None)
-    base = _base_name(rf, spec)
-    body = spec.body(base)
-    if not any(j.type == mujoco.mjtJoint.mjJNT_FREE for j in body.joints):
-        body.add_freejoint()
-    try:
-        model = spec.compile()
-    except Exception as e:
-        raise InputError("model", str(rf.model), f"a model MuJoCo compiles ({e})") from None
+    root = _urdf_root(rf) if rf.format == "urdf" else None
+    dropped: list[str] = []
+    if root is not None:
+        dropped += _drop_meshes(root, lambda f: f.lower().endswith(MESH_SUFFIXES))
+    for _ in range(MAX_DROPPED_MESHES):
+        spec = _spec_from(rf, root)
+        base = _base_name(rf, spec)
+        body = spec.body(base)
+        if not any(j.type == mujoco.mjtJoint.mjJNT_FREE for j in body.joints):
+            body.add_freejoint()
+        try:
+            model = spec.compile()
+            break
+        except Exception as e:
+            bad = re.search(r"mesh file '([^']+)'|in STL file '([^']+)'", str(e))
+            if root is None or bad is None:
+                raise InputError("model", str(rf.model), f"a model MuJoCo compiles ({e})") from None
+            name = Path(bad.group(1) or bad.group(2)).name
+            dropped += _drop_meshes(root, lambda f, name=name: Path(f).name != name)
+    else:
+        raise InputError("model", str(rf.model), "a model with fewer unreadable meshes")
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
-    return RawModel(model, data, base)
+    return RawModel(model, data, base, tuple(dropped))
 
 
 def _body_chain(m: Any, body: int, base: int) -> list[int]:
@@ -256,21 +297,19 @@ def _roles(m: Any, d: Any, joints: list[int], side: Side) -> tuple[str, ...]:
 
 # ------------------------------------------------------------------------------- geometry -> sole
 def _geom_points(raw: RawModel, body: int, frame: int | None = None) -> FloatArray:
-    """Points (n, 3) of the collision geometry of ``body`` and of the bodies fixed to it, in the
-    world (or in body ``frame``'s frame) [m]: mesh vertices, box corners, points around spheres,
-    capsules and cylinders."""
+    """Points (n, 3) of the collision geometry (the visual geometry without any) of ``body`` and
+    of the bodies fixed to it, in the world (or in body ``frame``'s frame) [m]: mesh vertices,
+    box corners, points around spheres, capsules and cylinders."""
     mujoco = require_mujoco()
     m, d = raw.model, raw.data
     bodies = [body] + [b for b in range(1, m.nbody) if _fixed_to(m, b, body)]
     pts: list[FloatArray] = []
     g = mujoco.mjtGeom
     ring = np.array([[math.cos(a), math.sin(a)] for a in np.linspace(0, 2 * math.pi, 16, False)])
-    for gi in range(m.ngeom):
-        if (
-            int(m.geom_bodyid[gi]) not in bodies
-            or (m.geom_contype[gi] | m.geom_conaffinity[gi]) == 0
-        ):
-            continue
+    mine = [gi for gi in range(m.ngeom) if int(m.geom_bodyid[gi]) in bodies]
+    colliding = [gi for gi in mine if (m.geom_contype[gi] | m.geom_conaffinity[gi]) != 0]
+    # the collision geometry; a body without any is drawn by its visual geometry
+    for gi in colliding or mine:
         t, size = m.geom_type[gi], m.geom_size[gi]
         if t == g.mjGEOM_MESH:
             k = int(m.geom_dataid[gi])
@@ -347,8 +386,8 @@ def _extent(hull: FloatArray, x: float) -> tuple[float, float]:
 
 def sole_from_geometry(raw: RawModel, foot: str, radius: float = 0.005) -> Sole:
     """The sole of the ``foot`` link: the largest axis-aligned rectangle (foot frame) inside the
-    footprint of its collision geometry's lowest points (within ``SOLE_BAND``), on the plane
-    through the lowest point.
+    footprint of its collision geometry's lowest points (within ``SOLE_BAND``; its visual
+    geometry's when it has no collision geometry), on the plane through the lowest point.
 
     Raises:
         InputError: the foot has no collision geometry (give ``sole:`` in the robot file).
@@ -358,7 +397,7 @@ def sole_from_geometry(raw: RawModel, foot: str, radius: float = 0.005) -> Sole:
     pts = _geom_points(raw, b, frame=b)
     if pts.shape[0] == 0:
         raise InputError(
-            "sole", foot, "a foot with collision geometry, or the sole: rectangle in the robot file"
+            "sole", foot, "a foot with geometry, or the sole: rectangle in the robot file"
         )
     z = float(pts[:, 2].min())
     band = pts[pts[:, 2] <= z + SOLE_BAND, :2]
