@@ -70,6 +70,6 @@ def main() -> None:
 
 
 # the command modules register their commands on ``app`` when imported
-from footfall.cli import bench, planning, simulation, study, terrain, view  # noqa: E402
+from footfall.cli import bench, planning, robot, simulation, study, terrain, view  # noqa: E402
 
-__all__ = ["app", "bench", "main", "planning", "simulation", "study", "terrain", "view"]
+__all__ = ["app", "bench", "main", "planning", "robot", "simulation", "study", "terrain", "view"]

@@ -106,6 +106,15 @@ def _positive_int(field: str, value: int) -> int:
     return value
 
 
+#: help of ``--robot``
+ROBOT_HELP = (
+    "The robot: biped (footfall's 30 kg biped), g1 or talos (robot files of models in "
+    "example-robot-data: pip install 'footfall[robots]'), or your robot file (.yaml, see "
+    "footfall robot inspect). The plan is made for its measured mass, CoM height and feet and "
+    "the reach, step height and timing derived from its legs."
+)
+
+
 # --- pushes: one disturbance type for every command (footfall.sim.disturbance) ---
 #: ``--push`` [N s]
 PushOption = Annotated[

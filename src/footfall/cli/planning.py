@@ -12,6 +12,7 @@ from rich.console import Console
 from footfall._io import write_json
 from footfall.cli._common import (
     _THREADS_HELP,
+    ROBOT_HELP,
     _threads,
     app,
     console,
@@ -163,9 +164,7 @@ def plan(
         "(no trailing foot beside or across the new stance foot when headings differ).",
     ),
     robot: str | None = typer.Option(
-        None,
-        help="Plan for a MuJoCo walker model: biped or g1 (mass, CoM height, stance width and "
-        "foot size measured on the model, the rest from the scene); omitted: the scene's robot.",
+        None, help=ROBOT_HELP + " Omitted: the scene's robot (the document's parameters)."
     ),
     swing_max: float | None = typer.Option(
         None,

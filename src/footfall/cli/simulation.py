@@ -14,6 +14,7 @@ import typer
 from footfall._io import write_json
 from footfall.cli._common import (
     _THREADS_HELP,
+    ROBOT_HELP,
     PushDirectionOption,
     PushDurationOption,
     PushDvOption,
@@ -374,6 +375,7 @@ def compare_command(
     controller: str = typer.Option(
         DEFAULT_CONTROLLER, help="--sim mujoco: the walker's controller, " + _CONTROLLER_HELP
     ),
+    robot: str = typer.Option("biped", help="--sim mujoco: " + ROBOT_HELP),
     noise_pos: float | None = typer.Option(
         None, help="--sim reduced: CoM position estimate noise (std) [m]. [default: 0.002]"
     ),
@@ -418,6 +420,7 @@ def compare_command(
         initial_impulse=0.0,
         time_limit=time_limit,
         region_aware=region_aware,
+        robot=robot,
         **noise,  # type: ignore[arg-type]
     )
     from footfall.cli.study import run_design
@@ -471,11 +474,7 @@ def walk_cmd(
     push_duration: PushDurationOption = 0.1,
     out: Path = typer.Option(Path("out/walk"), help="Output folder."),
     video: bool = typer.Option(True, "--video/--no-video", help="Write walk.mp4 (offscreen GL)."),
-    robot: str = typer.Option(
-        "biped",
-        help="biped (ours) or g1 (Unitree G1 from example-robot-data: pip install "
-        "'footfall[robots]'); the plan is made for its measured mass, CoM height and feet.",
-    ),
+    robot: str = typer.Option("biped", help=ROBOT_HELP),
     robot_aware: bool = typer.Option(
         True,
         "--robot-aware/--document-reach",
@@ -483,9 +482,7 @@ def walk_cmd(
         "frames, swing bound); --document-reach: eq. (5.12f) in the stance foot's frame only.",
     ),
     heading_segments: int | None = typer.Option(None, help=_WALK_SEGMENTS_HELP),
-    controller: str | None = typer.Option(
-        None, help=_CONTROLLER_HELP + " Default: the robot's (biped: wbc, g1: servo)."
-    ),
+    controller: str = typer.Option(DEFAULT_CONTROLLER, help=_CONTROLLER_HELP),
     region_aware: str = typer.Option(
         "planned",
         "--region-aware",
@@ -518,7 +515,7 @@ def walk_cmd(
     from footfall.control.adjusters import REGION_MODES
     from footfall.planning.plan import check_planner_name
     from footfall.sim.biped.options import WalkOptions
-    from footfall.sim.biped.plans import ROBOT_CONTROLLERS, plan_for_walk, robot_model
+    from footfall.sim.biped.plans import plan_for_walk, robot_model
     from footfall.sim.biped.trial import MujocoBipedPlant
     from footfall.sim.replay import REPLAY_FILE, ReplayRecorder, biped_traces
     from footfall.sim.trial import run_trial, trial_pushes
@@ -526,8 +523,6 @@ def walk_cmd(
     from footfall.viz.walk_plot import plot_walk
 
     check_planner_name(planner)
-    if controller is None:
-        controller = ROBOT_CONTROLLERS.get(robot, DEFAULT_CONTROLLER)
     _check_controller(controller)
     if region_aware not in REGION_MODES:
         raise InputError("region_aware", region_aware, f"one of {', '.join(REGION_MODES)}")

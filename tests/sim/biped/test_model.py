@@ -12,7 +12,7 @@ mujoco = pytest.importorskip("mujoco")
 from footfall.control.adjusters import U_MAX_FOOT_SHARE  # noqa: E402
 from footfall.errors import InputError  # noqa: E402
 from footfall.models.biped import BipedParams, Side  # noqa: E402
-from footfall.sim.biped import names as nm  # noqa: E402
+from footfall.robots import names as nm  # noqa: E402
 from footfall.sim.biped.model import (  # noqa: E402
     BipedModel,
     biped_mjcf,

@@ -14,7 +14,7 @@ import pytest
 mujoco = pytest.importorskip("mujoco")
 
 from footfall.models.biped import Side  # noqa: E402
-from footfall.sim.biped import names as nm  # noqa: E402
+from footfall.robots import names as nm  # noqa: E402
 from footfall.sim.biped.plant import BipedSim  # noqa: E402
 from footfall.sim.biped.state import Command  # noqa: E402
 from footfall.sim.biped.wbc import BipedWbc, CopTarget  # noqa: E402

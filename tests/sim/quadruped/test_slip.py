@@ -177,7 +177,7 @@ class Steep(NamedTuple):
 @pytest.fixture(scope="module")
 def steep() -> Steep:
     pytest.importorskip("mujoco")
-    from footfall.sim._mjcf import SimSettings
+    from footfall._mjcf import SimSettings
     from footfall.sim.quadruped.sim import simulate
 
     plan = _plan(30.0)
@@ -254,7 +254,7 @@ def test_the_guard_stops_the_whole_body_controller_on_a_slippery_climb() -> None
     slides past the limit in the second cycle; the gait lands the swinging foot and holds, and
     the robot stays put (the trunk within 3 cm over the five seconds held)."""
     pytest.importorskip("mujoco")
-    from footfall.sim._mjcf import SimSettings
+    from footfall._mjcf import SimSettings
     from footfall.sim.quadruped.sim import simulate
 
     plan = _plan(30.0, cycles=2)

@@ -76,6 +76,8 @@ class StudyDesign:
             (``WalkOptions.region_aware`` / ``SimOptions.region_aware``): ``off`` (document 000's
             free footstep, the default), ``planned`` (in the planned region inset by the sole) or
             ``nearby`` (or the best region within reach).
+        robot: the walker (``mujoco``): ``biped`` (footfall's), a built-in robot file's name
+            (``g1``, ``talos``) or a robot file (a ``.yaml`` path, relative to the study file).
     """
 
     name: str
@@ -97,6 +99,7 @@ class StudyDesign:
     noise_vel: float = 0.0
     placement_error: float = 0.0
     region_aware: str = "off"
+    robot: str = "biped"
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
@@ -147,6 +150,18 @@ class StudyDesign:
 
         if not isinstance(self.region_aware, str) or self.region_aware not in REGION_MODES:
             raise InputError("region_aware", self.region_aware, f"one of {', '.join(REGION_MODES)}")
+        from footfall.robots.registry import ROBOT_FILE_SUFFIXES, builtin_robot_names
+
+        names = builtin_robot_names()
+        if not isinstance(self.robot, str) or not (
+            self.robot in names
+            or (self.robot.endswith(ROBOT_FILE_SUFFIXES) and Path(self.robot).is_file())
+        ):
+            raise InputError(
+                "robot", self.robot, f"one of {', '.join(names)} or a robot file (.yaml)"
+            )
+        if self.robot != "biped" and self.simulator != "mujoco":
+            raise InputError("robot", self.robot, "biped with simulator reduced (its plans' robot)")
         n = self.max_trials()
         if n > MAX_TRIALS:
             raise InputError("seeds", self.seeds, f"a study of at most {MAX_TRIALS} walks ({n})")
@@ -193,6 +208,8 @@ class StudyDesign:
         out = {k: getattr(self, k) for k in keys}
         if self.region_aware != "off":  # absent when off: folders from before the field stay valid
             out["region_aware"] = self.region_aware
+        if self.robot != "biped":  # likewise
+            out["robot"] = self.robot
         return out
 
     def to_dict(self) -> dict[str, Any]:
@@ -262,6 +279,9 @@ def study_from_dict(data: object, source: str = "study", base: Path | None = Non
                 str(base / v) if isinstance(v, str) and v not in builtin else v for v in scenes
             ],
         }
+    robot = data.get("robot")
+    if base is not None and isinstance(robot, str) and robot.endswith((".yaml", ".yml")):
+        data = {**data, "robot": str(base / robot)}
     return StudyDesign(**{str(k): v for k, v in data.items()})
 
 

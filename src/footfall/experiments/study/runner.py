@@ -79,7 +79,9 @@ Planner = Callable[[Scene, str, "int | None", "SearchMonitor | None"], FootstepP
 def _planner(design: StudyDesign, folder: Path) -> Planner:
     """``plan(scene, planner, n_steps, monitor)`` for the study's simulator, cached in ``folder``."""
     if design.simulator == "mujoco":
-        from footfall.sim.biped.plans import plan_for_walk
+        from footfall.sim.biped.plans import plan_for_walk, robot_model
+
+        model = robot_model(design.robot)
 
         def plan_mujoco(
             scene: Scene, planner: str, n: int | None, monitor: SearchMonitor | None
@@ -87,7 +89,7 @@ def _planner(design: StudyDesign, folder: Path) -> Planner:
             # one worker: the plans shipped with the section 5.5 study were made so, and the
             # worker count is part of the plan cache key
             return plan_for_walk(
-                scene, planner, n, design.time_limit, folder, monitor=monitor, threads=1
+                scene, planner, n, design.time_limit, folder, model, monitor=monitor, threads=1
             )
 
         return plan_mujoco

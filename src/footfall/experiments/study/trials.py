@@ -105,9 +105,11 @@ def study_plant(design: StudyDesign) -> Plant:
     """The plant of the study's simulator (:data:`footfall.sim.trial.PLANTS`) with its settings."""
     if design.simulator == "mujoco":
         from footfall.sim.biped.options import WalkOptions
+        from footfall.sim.biped.plans import robot_model
 
         options = WalkOptions(controller=str(design.controller), region_aware=design.region_aware)
-        return make_plant("mujoco", options=options)
+        robot = None if design.robot == "biped" else robot_model(design.robot)
+        return make_plant("mujoco", options=options, robot=robot)
     from footfall.sim.reduced.closed_loop import SimOptions
 
     sim = SimOptions(

@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 
 from footfall._typing import FloatArray
 from footfall.models.biped import Side
-from footfall.sim.biped import names as nm
+from footfall.robots import names as nm
 from footfall.sim.biped.plant import BipedSim
 
 #: sole-pose and CoM costs of the inverse kinematics: the feet must be where they are (the stance

@@ -2,7 +2,7 @@
 
 A ~30 kg humanoid lower body for document 000's validation (section 5.5): a pelvis carrying a torso
 box, two 6-DoF legs (hip yaw / roll / pitch, knee, ankle pitch / roll, axes as in
-:data:`footfall.sim.biped.names.LEG_JOINT_AXES`) and flat rectangular feet. The ankle axes sit
+:data:`footfall.robots.names.LEG_JOINT_AXES`) and flat rectangular feet. The ankle axes sit
 straight above the sole centre, which is the footstep point of the planner and the ALIP contact
 point. Each foot touches the ground through four small spheres at the sole corners; the foot box is
 visual only. Joints are driven by position actuators (PD servos).
@@ -12,7 +12,7 @@ The planner's :class:`~footfall.models.biped.BipedParams` are *derived* from thi
 
 MuJoCo notes (as for the quadruped): angles in radians need ``<compiler angle="radian"/>``; robot
 geoms collide only with terrain through the contype/conaffinity bits of
-:mod:`footfall.sim.biped.names`; ``cone="elliptic"`` with a high ``impratio`` keeps the feet from
+:mod:`footfall.robots.names`; ``cone="elliptic"`` with a high ``impratio`` keeps the feet from
 creeping on the slope.
 """
 
@@ -24,12 +24,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from footfall._typing import FloatArray
-from footfall._validate import check_fields, non_negative, positive
-from footfall.control.adjusters import U_MAX_FOOT_SHARE
-from footfall.errors import FootfallError, InputError
-from footfall.models.biped import BipedParams, Side
-from footfall.sim._mjcf import (
+from footfall._mjcf import (
     TERRAIN_MATERIAL,
     SimSettings,
     box_inertia,
@@ -39,7 +34,12 @@ from footfall.sim._mjcf import (
     position_actuator,
     rod_inertia,
 )
-from footfall.sim.biped import names as nm
+from footfall._typing import FloatArray
+from footfall._validate import check_fields, non_negative, positive
+from footfall.control.adjusters import U_MAX_FOOT_SHARE
+from footfall.errors import FootfallError, InputError
+from footfall.models.biped import BipedParams, ReachTrapezoid, Side
+from footfall.robots import names as nm
 
 #: the planner's swing bound L_swing for this biped [m] (``PlannerOptions.swing_max``, beyond the
 #: document; :func:`footfall.sim.biped.plans.plan_for_walk` uses it): the longest swing this biped
@@ -75,9 +75,9 @@ class BipedSimSettings(SimSettings):
 class WalkerModel(Protocol):
     """What the walker (:mod:`footfall.sim.biped.walk`) and :func:`planner_params` need of a robot.
 
-    :class:`BipedModel` (our biped) and :class:`footfall.sim.biped.g1.G1Model` (the Unitree G1 of
+    (our biped) and :class:`footfall.robots.model.RobotModel` (a robot file's humanoid, e.g. the G1 of
     ``example-robot-data``) implement it. The MJCF must name its elements as
-    :mod:`footfall.sim.biped.names` does (pelvis, torso, 12 leg joints and their position
+    :mod:`footfall.robots.names` does (pelvis, torso, 12 leg joints and their position
     actuators, sole sites, four corner contact geoms per foot, pelvis and torso geoms).
     """
 
@@ -456,20 +456,88 @@ def measure_model(params: WalkerModel | None = None) -> ModelInfo:
     )
 
 
+#: the swing of the longest step (``SWING_MAX``) may ask the hip pitch for at most this share of its
+#: torque limit: on the G1 (88 N m) T_ss = 0.4 s needs 54 % and saturated the swing hip in 15-18 %
+#: of the physics steps, 0.45 s: 6 %, 0.5 s: 1 % (benchmarks/RESULTS.md, "Robots from their
+#: files"); footfall's biped at 0.4 s: 10 %
+SWING_TORQUE_SHARE = 0.4
+#: ... and its moment on the body at most this times the moment the stance sole holds,
+#: ``m g foot_length / 2``: our biped walks at 1.09 (T_ss = 0.4 s), the G1 fell at 1.73 (0.4 s)
+#: and walked at 1.11 (0.5 s)
+SWING_MOMENT_RATIO = 1.1
+
+
+def swing_time(
+    inertia: float,
+    hip_height: float,
+    hip_torque: float,
+    mass: float,
+    foot_length: float,
+    swing_length: float = SWING_MAX,
+    g: float = 9.81,
+) -> float:
+    """The shortest single support T_ss [s] in which the walker's swing of ``swing_length`` D
+    [m] (a quintic over the ``SWING_MOVE`` share of T_ss, peak acceleration ``5.77 D / T^2``)
+    asks the hip pitch (``hip_torque`` [N m], inf: no limit) for at most ``SWING_TORQUE_SHARE``
+    of its limit and moves the body with at most ``SWING_MOMENT_RATIO`` times the sole's moment
+    ``m g foot_length / 2``.
+
+    The swing's hip torque is ``inertia * a / hip_height``: the leg (``inertia`` [kg m^2] about
+    its hip) swung by its foot's acceleration ``a`` ``hip_height`` [m] below the hip; the same
+    moment acts back on the body, where the stance sole and the ALIP's CoM motion take it.
+    """
+    from footfall.sim.biped.references import QUINTIC_PEAK_ACC, SWING_MOVE
+
+    cap = SWING_MOMENT_RATIO * mass * g * foot_length / 2.0
+    if math.isfinite(hip_torque):
+        cap = min(cap, SWING_TORQUE_SHARE * hip_torque)
+    t_move = math.sqrt(QUINTIC_PEAK_ACC * swing_length * inertia / (hip_height * cap))
+    return t_move / (SWING_MOVE[1] - SWING_MOVE[0])
+
+
 def planner_params(
     params: WalkerModel | None = None, base: BipedParams | None = None
 ) -> BipedParams:
-    """The planner's robot parameters derived from the MuJoCo model (ours or e.g. the G1).
+    """The planner's robot parameters derived from the MuJoCo model (ours or a robot file's).
 
     Mass and CoM height are measured (:func:`measure_model`); stance width and foot size are the
     model's; the ankle-torque bound is ``U_MAX_FOOT_SHARE * m g * foot_width / 2`` (or the base's,
-    if smaller) so that a planned ZMP always lies inside the sole. Everything else (timing, reach,
-    heading limits) comes from ``base`` (default :class:`BipedParams`).
+    if smaller) so that a planned ZMP always lies inside the sole.
+
+    A robot file's model (``robot_limits``) also sets what its legs allow: the reach trapezoid
+    and step height derived by inverse kinematics (:func:`footfall.robots.derive.derive_reach`),
+    T_ss no shorter than :func:`swing_time` of its swing leg (rounded up to 10 ms), and U_max no
+    larger than the ankle joints can give beyond the moment of the weight on the sole centre's
+    offset from the ankle axes. Footfall's own biped keeps the base's (the document's) timing
+    and reach. Everything else (T_ds, heading limits) comes from ``base`` (default
+    :class:`BipedParams`).
     """
     p: WalkerModel = params if params is not None else BipedModel()
     b = base if base is not None else BipedParams()
     info = measure_model(p)
-    u_foot = U_MAX_FOOT_SHARE * info.mass * b.g * p.foot_width / 2.0
+    u_max = min(b.u_max, U_MAX_FOOT_SHARE * info.mass * b.g * p.foot_width / 2.0)
+    derived: dict[str, Any] = {}
+    limits = getattr(p, "robot_limits", None)
+    if limits is not None:
+        reach, leg = limits()
+        weight = info.mass * b.g
+        dx, dy = p.ankle_offset
+        pitch, roll = leg.ankle_torque
+        u_max = min(u_max, pitch - abs(dx) * weight, roll - abs(dy) * weight)
+        if u_max <= 0.0:
+            raise InputError(
+                "robot.ankle_torque",
+                leg.ankle_torque,
+                f"ankle torque limits above the weight's moment ({abs(dx) * weight:.3g} N m)",
+            )
+        t_need = swing_time(
+            leg.inertia, leg.hip_height, leg.hip_torque, info.mass, p.foot_length, SWING_MAX, b.g
+        )
+        derived = {
+            "t_ss": max(b.t_ss, math.ceil(t_need * 100.0 - 1e-9) / 100.0),
+            "reach": ReachTrapezoid(np.array(reach.vertices, dtype=float)),
+            "step_height_max": reach.step_height_max,
+        }
     return replace(
         b,
         mass=info.mass,
@@ -477,5 +545,6 @@ def planner_params(
         stance_width=p.stance_width,
         foot_length=p.foot_length,
         foot_width=p.foot_width,
-        u_max=min(b.u_max, u_foot),
+        u_max=u_max,
+        **derived,
     )

@@ -11,7 +11,6 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from footfall.errors import InputError
 from footfall.planning.cache import PlanCache, cached_plan
 from footfall.planning.plan import (
     FootstepPlan,
@@ -31,33 +30,23 @@ from footfall.sim.biped.options import RISER_LANDING_TOLERANCE
 from footfall.terrain.edges import inset_riser_edges
 from footfall.terrain.scene import Scene
 
-#: robots the walker can walk (``footfall walk --robot``): our biped and the Unitree G1 of
-#: example-robot-data (``footfall[robots]``)
-ROBOTS = ("biped", "g1")
 
-
-#: the controller each walker model walks best with (``footfall walk --controller``'s default):
-#: measured (benchmarks/RESULTS.md, "Whole-body control"), our biped walks 4 N s pushes far more
-#: often with the whole-body QP; the G1 reaches flat_long's goal only with its servos (with the
-#: QP it falls in the final stop) and falls on the steps with either
-ROBOT_CONTROLLERS = {"biped": "wbc", "g1": "servo"}
-
-
-def robot_model(name: str) -> WalkerModel:
-    """The walker model called ``name`` (one of :data:`ROBOTS`), with its default settings.
+def robot_model(source: str | Path) -> WalkerModel:
+    """The walker model named ``source``: footfall's own ``biped``, a built-in robot file's
+    (``footfall.robots.registry.builtin_robot_names``) or a robot file's (a ``.yaml`` path).
 
     Raises:
-        InputError: for an unknown name.
-        FootfallError: for ``g1`` without ``example-robot-data`` installed.
+        InputError: an unknown name or a bad robot file (naming the field).
+        MissingExtraError: the model's package is not installed (naming the extra).
     """
-    if name == "biped":
-        return BipedModel()
-    if name == "g1":
-        from footfall.sim.biped.g1 import G1Model, g1_urdf_path
+    from footfall.robots.registry import resolve_robot_file
 
-        g1_urdf_path()  # fail here, with the extra to install, rather than at the first use
-        return G1Model()
-    raise InputError("robot", name, f"one of {', '.join(ROBOTS)}")
+    rf = resolve_robot_file(source)
+    if rf is None:
+        return BipedModel()
+    from footfall.robots.model import RobotModel
+
+    return RobotModel(rf)
 
 
 def plan_for_walk(

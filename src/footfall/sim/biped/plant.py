@@ -19,7 +19,7 @@ from footfall._typing import FloatArray
 from footfall.control.adjusters import SOLE_TORQUE_SHARE
 from footfall.errors import FootfallError
 from footfall.models.biped import Side
-from footfall.sim.biped import names as nm
+from footfall.robots import names as nm
 from footfall.sim.biped.model import (
     BipedModel,
     BipedSimSettings,
@@ -39,8 +39,8 @@ class BipedSim:
     """MuJoCo model + data of a biped on a scene's terrain, with handles resolved by name.
 
     ``model_params`` is any :class:`~footfall.sim.biped.model.WalkerModel`: our biped
-    (:class:`BipedModel`, the default) or e.g. :class:`footfall.sim.biped.g1.G1Model`; its MJCF
-    names its elements as :mod:`footfall.sim.biped.names` does. ``settings`` go to its ``mjcf``
+    (:class:`BipedModel`, the default) or a robot file's :class:`footfall.robots.model.RobotModel`; its MJCF
+    names its elements as :mod:`footfall.robots.names` does. ``settings`` go to its ``mjcf``
     (None: the model's defaults).
     """
 

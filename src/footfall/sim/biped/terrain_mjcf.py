@@ -15,9 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from footfall._mjcf import fmt as _fmt
 from footfall._typing import FloatArray
-from footfall.sim._mjcf import fmt as _fmt
-from footfall.sim.biped import names as nm
+from footfall.robots import names as nm
 from footfall.terrain.region import Region
 from footfall.terrain.terrain import Terrain
 

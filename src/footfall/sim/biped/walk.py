@@ -54,8 +54,8 @@ from footfall.errors import InputError, SolverError
 from footfall.models.biped import Side
 from footfall.planning.plan import FootstepPlan
 from footfall.results.walk import WalkResult, WalkTrace
+from footfall.robots import names as nm
 from footfall.sim._video import Video
-from footfall.sim.biped import names as nm
 from footfall.sim.biped.ik import WholeBodyIK
 from footfall.sim.biped.metrics import summarise
 from footfall.sim.biped.model import BipedSimSettings, WalkerModel

@@ -43,7 +43,7 @@ from footfall.control.wbc import (
 )
 from footfall.errors import InputError, SolverError
 from footfall.models.biped import Side
-from footfall.sim.biped import names as nm
+from footfall.robots import names as nm
 from footfall.sim.biped.plant import BipedSim
 from footfall.sim.biped.state import Command
 from footfall.sim.wbc_model import MujocoWbcModel

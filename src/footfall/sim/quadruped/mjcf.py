@@ -23,11 +23,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from footfall._validate import positive
-from footfall.errors import InputError
-from footfall.quadruped.ground import PlaneGround, QuadrupedGround, VaryingSlope
-from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
-from footfall.sim._mjcf import (
+from footfall._mjcf import (
     SimSettings,
     box_inertia,
     fmt,
@@ -36,6 +32,10 @@ from footfall.sim._mjcf import (
     position_actuator,
     rod_inertia,
 )
+from footfall._validate import positive
+from footfall.errors import InputError
+from footfall.quadruped.ground import PlaneGround, QuadrupedGround, VaryingSlope
+from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
 from footfall.sim.quadruped import names as nm
 
 #: joint axes in the parent body frame, in ``JOINT_NAMES`` order (ab/ad about x, pitch/knee about y)

@@ -1,4 +1,5 @@
-"""Names of the MuJoCo elements of the footfall biped and of the terrain geoms, defined once."""
+"""Names of the MuJoCo elements of a walker model (footfall's biped or a robot file's) and of the
+terrain geoms, defined once: the contract between the robot models and the walker."""
 
 from __future__ import annotations
 
