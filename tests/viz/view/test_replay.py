@@ -13,7 +13,7 @@ pytest.importorskip("trimesh")
 from footfall.errors import InputError  # noqa: E402
 from footfall.models.biped import Side  # noqa: E402
 from footfall.planning import load_plan  # noqa: E402
-from footfall.sim.biped import names as nm  # noqa: E402
+from footfall.robots import names as nm  # noqa: E402
 from footfall.sim.replay import DISPLAY_RATE, REPLAY_FILE, ReplayRecorder, at_frames  # noqa: E402
 from footfall.viz.view.replay import read_replay, robot_motion  # noqa: E402
 

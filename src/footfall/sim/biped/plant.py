@@ -1,7 +1,7 @@
 """The MuJoCo biped on a scene's terrain: handles by name, measurements, ankle torque mode.
 
 :class:`BipedSim` holds the MuJoCo model and data of a walker model (:mod:`footfall.sim.biped.model`
-or :mod:`footfall.sim.biped.g1`) standing on a scene's terrain and reads what the walk measures:
+or a robot file (:mod:`footfall.robots`)) standing on a scene's terrain and reads what the walk measures:
 sole poses, the CoM state, and each foot's contact points and forces, from which
 :func:`sole_cop` gives the centre of pressure (the measured ZMP). :func:`ankle_joint_torque`
 turns the ALIP torque (eq. 5.3) into ankle joint torques.

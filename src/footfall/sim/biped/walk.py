@@ -673,7 +673,7 @@ def walk(
             the plan was made on).
         model_params: the robot (default: our biped, :class:`BipedModel`); any
             :class:`~footfall.sim.biped.model.WalkerModel`, e.g. the G1 of
-            :mod:`footfall.sim.biped.g1`. The plan should be made for it
+            a robot file (:mod:`footfall.robots`). The plan should be made for it
             (:func:`~footfall.sim.biped.model.planner_params`).
         settings: physics settings (None: the model's defaults).
         video_path: write an MP4 here (offscreen GL); None = no video.
