@@ -293,3 +293,18 @@ def test_a_model_without_legs_says_which_names_to_give(tmp_path: Path) -> None:
     rf = parse_robot_file(f"name: arm\nmodel: {urdf.name}\n", "t.yaml", tmp_path)
     with pytest.raises(InputError, match="leg"):
         layout(rf)
+
+
+def test_a_model_inside_an_installed_package_is_named_by_package_and_path() -> None:
+    """A robot file written for a model of example-robot-data names the distribution and the
+    file in it (found anywhere), not this machine's site-packages path; a file outside any
+    distribution keeps its path."""
+    from footfall.robots.file import package_file, package_of
+
+    rel = "cmeel.prefix/share/example-robot-data/robots/talos_data/robots/talos_reduced.urdf"
+    found = package_file("example-robot-data", rel)
+    # the RECORD of the distribution, read here by a different route than package_of's
+    dist = importlib.metadata.distribution("example-robot-data")
+    assert rel in {str(f) for f in dist.files or ()}
+    assert package_of(found) == ("example-robot-data", rel)
+    assert package_of(Path(__file__)) is None

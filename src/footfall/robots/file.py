@@ -289,6 +289,22 @@ def package_file(package: str, path: str) -> Path:
     return found
 
 
+def package_of(path: Path) -> tuple[str, str] | None:
+    """``(distribution, path)`` of the installed distribution that ships the file ``path``
+    (its RECORD lists it), or None: a robot file then names the model the way
+    :func:`package_file` finds it on any machine, not by this machine's install path."""
+    target = path.resolve()
+    for dist in importlib.metadata.distributions():
+        root = Path(str(dist.locate_file(""))).resolve()
+        if not target.is_relative_to(root):
+            continue
+        rel = target.relative_to(root).as_posix()
+        # the RECORD's lines are "path,hash,size": a text search, not thousands of path objects
+        if f"\n{rel}," in "\n" + (dist.read_text("RECORD") or ""):
+            return dist.metadata["Name"], rel
+    return None
+
+
 def parse_robot_file(text: str | Path, source: str, base: Path | None) -> RobotFile:
     """A :class:`RobotFile` from YAML text or a file path (``base``: the folder of relative model
     paths)."""

@@ -19,7 +19,7 @@ import numpy as np
 
 from footfall.errors import InputError
 from footfall.models.biped import Side
-from footfall.robots.file import MODEL_FORMATS, RobotFile, load_robot_file
+from footfall.robots.file import MODEL_FORMATS, RobotFile, load_robot_file, package_of
 from footfall.robots.model import RobotModel, _kinematics, straight_leg_height
 
 
@@ -90,9 +90,11 @@ def _robot_of(model: Path, config: Path | None, name: str | None) -> RobotFile:
         if not model.is_file():
             raise InputError("MODEL", str(model), "an existing file")
         if config is not None:
-            rf = replace(load_robot_file(config), model=model.resolve())
+            rf = replace(load_robot_file(config), model=model.resolve(), package=package_of(model))
         else:
-            rf = RobotFile(name=name or model.stem[:64], model=model.resolve())
+            rf = RobotFile(
+                name=name or model.stem[:64], model=model.resolve(), package=package_of(model)
+            )
     return replace(rf, name=name) if name else rf
 
 
