@@ -554,7 +554,9 @@ class BipedWalk:
 
         The feet in contact are the stance foot in single support and both otherwise. A QP
         without a solution (a robot already falling) keeps the last torques and is counted in
-        the controller's tally (``WalkTrace.controller``).
+        the controller's tally (``WalkTrace.controller``). Each step is ``mj_step1`` (positions
+        and velocities: the model terms the QP reads; the tick's ``mj_forward`` did it for the
+        first) and ``mj_step2`` with the torques: ``mj_step`` in two halves.
         """
         sim, timing = self.sim, self.log.timing
         mj, m, d = sim.mujoco, sim.model, sim.data
@@ -565,7 +567,7 @@ class BipedWalk:
         for j in range(self.substeps):
             c0 = time.perf_counter()
             if j > 0:
-                mj.mj_forward(m, d)
+                mj.mj_step1(m, d)
                 com, vel, l_g = sim.com_state()
             cop = self._cop_target(cmd, j * step)
             try:
@@ -577,7 +579,7 @@ class BipedWalk:
             timing["ik"] += c1 - c0
             d.xfrc_applied[sim.torso, :3] = push_force(self.opts.pushes, t + j * step)
             d.ctrl[sim.actuators] = tau
-            mj.mj_step(m, d)
+            mj.mj_step2(m, d)
             timing["physics"] += time.perf_counter() - c1
 
     def _actuator_commands(
