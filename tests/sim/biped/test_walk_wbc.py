@@ -111,9 +111,11 @@ def test_cli_walk_rejects_an_unknown_controller(tmp_path) -> None:  # type: igno
     assert not (tmp_path / "plan.json").exists()
 
 
-def test_every_robot_has_a_default_controller() -> None:
-    from footfall.sim.biped.options import CONTROLLERS
-    from footfall.sim.biped.plans import ROBOT_CONTROLLERS, ROBOTS
+def test_every_robot_walks_with_the_same_default_controller() -> None:
+    """One default for every robot (a robot file has no controller of its own): the command's
+    --controller default is the walker's."""
+    from footfall.cli.simulation import DEFAULT_CONTROLLER
+    from footfall.sim.biped.options import CONTROLLERS, WalkOptions
 
-    assert set(ROBOT_CONTROLLERS) == set(ROBOTS)
-    assert set(ROBOT_CONTROLLERS.values()) <= set(CONTROLLERS)
+    assert DEFAULT_CONTROLLER == WalkOptions().controller == "wbc"
+    assert DEFAULT_CONTROLLER in CONTROLLERS
