@@ -83,6 +83,28 @@ def convexity_defect(vertices: FloatArray) -> str | None:
     return None
 
 
+def drop_collinear(vertices: FloatArray, tol: float) -> FloatArray:
+    """The polygon (V, 2) without the vertices that lie within ``tol`` [m] of the line through
+    their two neighbours (collinear or repeated vertices), removed one at a time, the nearest to
+    its line first, until none is left or three vertices remain.
+
+    Removing a vertex of a convex polygon leaves a polygon inside it; the region rows built from
+    the result (eq. 5.18) then have no zero-length or duplicate edge."""
+    v = np.asarray(vertices, dtype=float)
+    while v.shape[0] > 3:
+        prev, nxt = np.roll(v, 1, axis=0), np.roll(v, -1, axis=0)
+        chord = nxt - prev
+        cross = chord[:, 0] * (v[:, 1] - prev[:, 1]) - chord[:, 1] * (v[:, 0] - prev[:, 0])
+        length = np.linalg.norm(chord, axis=1)
+        # distance to the chord's line; a vertex whose neighbours coincide is a spike: drop it
+        dist = np.where(length > 0.0, np.abs(cross) / np.where(length > 0.0, length, 1.0), 0.0)
+        j = int(np.argmin(dist))
+        if dist[j] > tol:
+            break
+        v = np.delete(v, j, axis=0)
+    return v
+
+
 def outward_halfspaces(vertices: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Half-spaces ``A q <= b`` of a convex CCW polygon (V, 2) (eq. 5.18).
 

@@ -188,7 +188,8 @@ def plan(
         "and while a solve runs, at most one every 5 s), with or without a terminal.",
     ),
 ) -> None:
-    """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists.
+    """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists or
+    the independent checker rejects the plan.
 
     Progress: a status line in a terminal; without one, a plain line on stderr per N tried and at
     most every 5 s while a solve runs."""
@@ -237,7 +238,9 @@ def plan(
     )
     console.print(f"wrote {out / 'plan.json'}" + (" and plan.png" if result.has_solution else ""))
     if not checked:
+        # a plan the independent checker rejects is not a plan to walk: a failed run
         console.print("the plan violates the checker's constraints (see plan.json 'check')")
+        raise typer.Exit(1)
     if not result.reaches_goal:
         raise typer.Exit(1)
 

@@ -1,10 +1,11 @@
 """Independent checker of footstep plans.
 
 It shares no code path with the planners: regions are tested with cross products on the region
-corners (not the planner's half-space rows), the plane height with a normal recomputed from three
-corners, reachability by rotating the step into the stance frame with the true sin/cos and testing
-the trapezoid corners, and the ALIP states are re-simulated by integrating the CoM dynamics about
-the centre of pressure with scipy's ``solve_ivp`` (not the ZOH / reset matrices).
+corners (not the planner's half-space rows), the plane height with a normal recomputed from the
+3-D corners (Newell's formula over every edge), reachability by rotating the step into the stance
+frame with the true sin/cos and testing the trapezoid corners, and the ALIP states are
+re-simulated by integrating the CoM dynamics about the centre of pressure with scipy's
+``solve_ivp`` (not the ZOH / reset matrices).
 """
 
 from __future__ import annotations
@@ -101,9 +102,19 @@ def _inside_polygon(xy: FloatArray, corners: FloatArray, tol: float) -> float:
 
 
 def _plane_height(corners3d: FloatArray, xy: FloatArray) -> float:
-    a, b, c = corners3d[0], corners3d[1], corners3d[2]
-    normal = np.cross(b - a, c - a)
-    return float(a[2] - (normal[0] * (xy[0] - a[0]) + normal[1] * (xy[1] - a[1])) / normal[2])
+    """Height [m] at ``xy`` of the plane through a planar polygon's 3-D corners (V, 3).
+
+    The normal is Newell's: the sum over every edge of the cross products of consecutive corners
+    (twice the vector area of the polygon), which collinear corners (a height map's outlines keep
+    some) do not degenerate; three corners alone give a zero or noise-sized normal when they lie
+    on a line. Its vertical component is twice the polygon's horizontal area, never 0 for a
+    region."""
+    p = np.asarray(corners3d, dtype=float)
+    q = np.roll(p, -1, axis=0)
+    normal = np.sum(np.cross(p, q), axis=0)
+    centre = p.mean(axis=0)
+    dx, dy = xy[0] - centre[0], xy[1] - centre[1]
+    return float(centre[2] - (normal[0] * dx + normal[1] * dy) / normal[2])
 
 
 def _simulate_single_support(

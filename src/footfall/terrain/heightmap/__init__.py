@@ -279,7 +279,8 @@ def _convex_regions(
                 normal, offset = _piece_plane(cxy[near], cz[near])
                 if normal[2] < math.cos(math.radians(opts.max_slope_deg)):
                     continue
-                regions.append(Region(f"s{k}", normal, offset, polygons.ccw_vertices(piece)))
+                vertices = polygons.ccw_vertices(piece, res)
+                regions.append(Region(f"s{k}", normal, offset, vertices))
                 owner.append(k)
     return regions, owner
 
