@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+import pytest
 
 from footfall.planning import PlannerOptions, check_plan, make_plan
 from footfall.planning.cache import PlanCache, cached_plan, plan_key
+from footfall.planning.plan import FootstepPlan
 from tests.planning.scenes import SHORT_FLAT, scene
 
 #: how far a tampered footstep is moved [m]: far off the 3 m x 2 m ground
@@ -38,6 +42,48 @@ def test_a_tampered_cached_plan_is_not_returned(tmp_path: Path) -> None:
     # the file was overwritten with the new plan: the next call is a clean hit
     third = cached_plan(sc, "miqcqp", 3, cache=cache)
     assert "loaded from cache" in third.message and "discarded" not in third.message
+
+
+def _sideways(data: dict[str, Any]) -> str:
+    data["footsteps"][2]["position"][1] += 0.5  # still on the ground, out of reach
+    return "reach"
+
+
+def _turned(data: dict[str, Any]) -> str:
+    data["footsteps"][2]["heading"] += 3.0
+    return "heading_rate"
+
+
+def _alip(data: dict[str, Any]) -> str:
+    data["alip"]["states"][1][1][2] *= 1.5
+    return "dynamics"
+
+
+@pytest.mark.parametrize("tamper", [_sideways, _turned, _alip])
+def test_a_cached_plan_is_checked_in_full(tmp_path: Path, tamper) -> None:  # type: ignore[no-untyped-def]
+    """Footsteps moved within their region, headings or ALIP states edited: the independent
+    checker finds it, so the cache does too (before, only start, alternation and region)."""
+    sc, cache = scene(SHORT_FLAT), PlanCache(tmp_path)
+    made = cached_plan(sc, "miqcqp", 3, cache=cache)
+    (path,) = tmp_path.glob("plan-*.json")
+    data = json.loads(path.read_text())
+    kind = tamper(data)
+    path.write_text(json.dumps(data))
+    stored = FootstepPlan.from_dict(json.loads(path.read_text()), sc.robot)
+    assert kind in check_plan(stored, sc).kinds()  # what `footfall check` says of the file
+    again = cached_plan(sc, "miqcqp", 3, cache=cache)
+    assert "loaded from cache" not in again.message and "discarded" in again.message
+    np.testing.assert_allclose(again.footsteps, made.footsteps, atol=1e-6)
+
+
+def test_a_kinematic_plan_over_the_torque_limit_is_served(tmp_path: Path) -> None:
+    """The kinematic planner has no torque bound: its cached plans keep being served."""
+    sc, cache = scene(SHORT_FLAT), PlanCache(tmp_path)
+    robot = replace(sc.robot, u_max=1.0)
+    made = cached_plan(sc, "kinematic", 3, cache=cache, robot=robot)
+    assert check_plan(made, sc, robot).kinds() == {"torque"}
+    again = cached_plan(sc, "kinematic", 3, cache=cache, robot=robot)
+    assert "loaded from cache" in again.message
 
 
 def test_a_cached_plan_with_another_n_is_not_used(tmp_path: Path) -> None:
