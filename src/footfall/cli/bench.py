@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from footfall._io import write_json
+from footfall._io import remove_outputs, write_json, write_text
 from footfall.cli._common import (
     _threads,
     app,
@@ -68,8 +68,9 @@ def bench_plan_cmd(
         ),
     )
     table = format_table(rows)
+    remove_outputs(out, "bench_plan.json", "bench_plan.md")  # no file of another run beside ours
     write_json(out / "bench_plan.json", {"runs": rows_to_dict(rows)})
-    (out / "bench_plan.md").write_text(table + "\n")
+    write_text(out / "bench_plan.md", table + "\n")
     print(table)
 
 
@@ -120,11 +121,12 @@ def bench_sim_cmd(
         raise InfeasibleError(f"{planner} found no plan for {sc.name}: {plan.message}")
     rows = bench_sim(plan, k_list, runs=runs, options=bench_sim_options(rate))
     table = format_sim_table(rows)
+    remove_outputs(out, "bench_sim.json", "bench_sim.md")  # no file of another run beside ours
     write_json(
         out / "bench_sim.json",
         {"scene": sc.name, "planner": planner, "rows": sim_speed_to_dict(rows)},
     )
-    (out / "bench_sim.md").write_text(table + "\n")
+    write_text(out / "bench_sim.md", table + "\n")
     print(table)
 
 

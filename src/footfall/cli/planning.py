@@ -9,7 +9,7 @@ from typing import Any
 import typer
 from rich.console import Console
 
-from footfall._io import write_json
+from footfall._io import remove_outputs, write_json, write_text
 from footfall.cli._common import (
     _THREADS_HELP,
     _threads,
@@ -83,6 +83,7 @@ def lip(
     params = lip_params(example, **{k: v for k, v in given.items() if v is not None})
     title = "LIP walk" if example is None else f"LIP walk: {example} (document 004)"
     walk = lip_walk(params)
+    remove_outputs(out, "lip_walk.json", "lip_walk.png")  # no file of another run beside ours
     write_json(out / "lip_walk.json", lip_walk_to_dict(walk, dt))
     plot_lip_walk(walk, out / "lip_walk.png", title=title)
     speed = math.hypot(*walk.final_vel)
@@ -125,7 +126,8 @@ def scenes_command(
 
     scene = resolve_scene(show)
     output_folder(out)
-    (out / "scene.yaml").write_text(scene_to_yaml(scene))
+    remove_outputs(out, "scene.yaml", "scene.png")  # no file of another run beside ours
+    write_text(out / "scene.yaml", scene_to_yaml(scene))
     plot_scene(scene, out / "scene.png")
     console.print(f"wrote {out / 'scene.png'} and {out / 'scene.yaml'}")
 
@@ -227,11 +229,10 @@ def plan(
         report = check_plan(result, sc)
         checked = report.ok
         payload["check"] = {"ok": report.ok, "violations": report.summary().splitlines()}
+    remove_outputs(out, "plan.json", "plan.png")  # no file of an earlier run beside ours
     write_json(out / "plan.json", payload)
     if result.has_solution:
         plot_plan(result, sc, out / "plan.png")
-    else:  # no figure of an earlier run beside this run's plan.json
-        (out / "plan.png").unlink(missing_ok=True)
     console.print(
         f"{sc.name}: {planner} -> {result.status.value}, {result.n_steps} steps, "
         f"objective {result.objective:.4g}, {result.solve_time:.2f} s. {result.message}"

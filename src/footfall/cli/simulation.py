@@ -11,7 +11,7 @@ from typing import Any
 
 import typer
 
-from footfall._io import write_json
+from footfall._io import remove_outputs, write_json
 from footfall._validate import names_in, non_negative
 from footfall.cli._common import (
     _THREADS_HELP,
@@ -103,7 +103,7 @@ def quadruped_cmd(
     from footfall.sim.quadruped.mjcf import SimSettings
     from footfall.sim.quadruped.sim import simulate
     from footfall.sim.quadruped.slip import SLIP_ACTIONS, SlipGuard
-    from footfall.viz.quadruped_plots import save_walk_figures
+    from footfall.viz.quadruped_plots import WALK_FIGURES, save_walk_figures
 
     if controller not in ("servo", "wbc"):
         raise InputError("--controller", controller, "servo or wbc")
@@ -144,6 +144,8 @@ def quadruped_cmd(
         )
         label = f"{math.degrees(params.slope):g}°/{math.degrees(params.body_pitch):g}°"
     output_folder(out)
+    # this run's files replace the last run's as a set: none of theirs is left beside ours
+    remove_outputs(out, "quadruped.json", "quadruped.mp4", *WALK_FIGURES)
     plans, infeasible = plan_strategies(QuadrupedRobot(), params, compare)
     plan = plans[params.strategy]
     console.print(f"simulating {params.cycles} cycles on {label} ({plan.duration:.1f} s)...")
@@ -592,6 +594,7 @@ def walk_cmd(
     model = robot_model(robot)
     sc = resolve_scene_arguments(scene_file, scene)
     output_folder(out)
+    remove_outputs(out, "plan.json", "walk.json", "walk.png", "walk.mp4")  # no mixed runs
     with ProgressLog(f"{sc.name} with {planner} for the {robot}", quiet, log_json) as log:
         plan = plan_for_walk(
             sc,

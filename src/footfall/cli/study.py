@@ -12,6 +12,7 @@ from typing import Any
 
 import typer
 
+from footfall._io import write_text
 from footfall.cli._common import app, console, output_folder
 from footfall.errors import FootfallError, InputError
 
@@ -125,7 +126,8 @@ def study_command(
     summary, paths = write_report(out, design, run.rows, run.plans, header)
     for line in summary.verdict:
         console.print(line)
-    (out / "run.json").write_text(
+    write_text(
+        out / "run.json",
         json.dumps(
             {
                 "executor": executor,
@@ -137,7 +139,7 @@ def study_command(
                 "rows": len(run.rows),
             },
             indent=1,
-        )
+        ),
     )
     console.print(f"wrote {out / 'trials.parquet'}, " + ", ".join(str(p) for p in paths))
     missing = [p for p in run.plans if not p.plan.has_solution]

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import typer
 
+from footfall._io import remove_outputs, write_text
 from footfall.cli._common import app, console, output_folder, parse_floats
 from footfall.errors import InputError
 
@@ -111,7 +112,8 @@ def from_heightmap(
     elapsed = time.perf_counter() - t0
     text = scene_to_yaml(scene)
     load_scene(text)  # the file must pass the scene loader's own validation
-    out.write_text(text)
+    remove_outputs(out.parent, out.name, out.with_suffix(".png").name)  # no mixed runs
+    write_text(out, text)
     figure = plot_heightmap_regions(result, out.with_suffix(".png"), scene)
     h, w = hm.shape
     spikes = int(result.spikes.sum())

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from footfall._io import atomic_open, write_text
 from footfall._validate import check_fields, non_negative, positive
 from footfall.control.adjusters import REGION_MODES
 from footfall.errors import InputError
@@ -212,7 +213,7 @@ def write_outputs(
     out.mkdir(parents=True, exist_ok=True)
     csv_path = out / "compare.csv"
     fields = ["scene", "planner", "trial", "push_impulse", *TRIAL_FIELDS]
-    with csv_path.open("w", newline="") as fh:
+    with atomic_open(csv_path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=fields)
         w.writeheader()
         for r in sorted(rows, key=lambda r: (r["scene"], r["planner"], r["trial"])):
@@ -241,7 +242,7 @@ def write_outputs(
         md += [f"- {r['scene']} / {r['planner']}: {r['message']}" for r in notes]
         md.append("")
     md_path = out / "compare.md"
-    md_path.write_text("\n".join(md))
+    write_text(md_path, "\n".join(md))
     from footfall.viz.compare_plots import plot_compare
 
     figs = plot_compare(rows, out)

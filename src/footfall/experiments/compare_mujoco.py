@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from footfall._io import atomic_open, write_text
 from footfall.errors import InputError
 from footfall.planning.run import SearchMonitor
 from footfall.sim.biped.options import WalkOptions
@@ -162,7 +163,7 @@ def write_mujoco_outputs(
     out.mkdir(parents=True, exist_ok=True)
     csv_path = out / "compare_mujoco.csv"
     fields = list(dict.fromkeys(k for r in rows for k in r))
-    with csv_path.open("w", newline="") as fh:
+    with atomic_open(csv_path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=fields)
         w.writeheader()
         w.writerows(rows)
@@ -202,7 +203,7 @@ def write_mujoco_outputs(
             md.append(f"- {scene}: the claim {verdict}: miqcqp {1000 * ours:.1f} mm vs {txt}.")
     md.append("")
     md_path = out / "compare_mujoco.md"
-    md_path.write_text("\n".join(md))
+    write_text(md_path, "\n".join(md))
     fig_path = plot_mujoco_table(table, out / "compare_mujoco.png")
     return [csv_path, md_path, fig_path]
 

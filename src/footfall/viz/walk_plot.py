@@ -13,6 +13,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from footfall._io import save_figure
 from footfall._typing import FloatArray
 from footfall.terrain.scene import Scene
 
@@ -141,7 +142,4 @@ def plot_walk(
     ax.set_ylabel("height [m]")
     ax.legend(fontsize=7)
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=110)

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from footfall._io import PendingFile
 from footfall._typing import FloatArray
 from footfall.models.biped import Side
 from footfall.planning.plan import FootstepPlan
@@ -198,6 +199,7 @@ class Video:
     ) -> None:
         self.renderer: Any = None
         self.writer: Any = None
+        self.file: PendingFile | None = None
         self.note = ""
         self.frame_every = max(1, round(1.0 / (VIDEO_FPS * dt)))
         if path is None:
@@ -209,8 +211,9 @@ class Video:
             return
         import imageio.v2 as imageio
 
-        path.parent.mkdir(parents=True, exist_ok=True)
-        self.writer = imageio.get_writer(str(path), fps=VIDEO_FPS, macro_block_size=8)
+        # written beside the destination and renamed over it when complete (close)
+        self.file = PendingFile(path)
+        self.writer = imageio.get_writer(str(self.file.tmp), fps=VIDEO_FPS, macro_block_size=8)
 
     def frame(self, k: int, data: Any) -> bool:
         """Render tick ``k`` if a frame is due; whether one was."""
@@ -220,9 +223,15 @@ class Video:
         self.writer.append_data(self.renderer.render())
         return True
 
-    def close(self) -> None:
-        """Finish the file and free the renderer."""
+    def close(self, complete: bool = True) -> None:
+        """Finish the file (put in place when ``complete``; removed, the previous video left,
+        when the walk was interrupted) and free the renderer."""
         if self.writer is not None:
             self.writer.close()
+            assert self.file is not None
+            if complete:
+                self.file.commit()
+            else:
+                self.file.abort()
         if self.renderer is not None:
             self.renderer.close()

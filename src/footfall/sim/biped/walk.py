@@ -210,11 +210,15 @@ class BipedWalk:
         self.video = Video(sim.mujoco, sim.model, video_path, video_size, self.dt)
         wall0 = time.perf_counter()
         k = 0
-        for k in range(self.n_ticks):
-            if not self.step(k):
-                break
-            if progress is not None and k % 100 == 0:
-                progress(k / self.n_ticks)
+        try:
+            for k in range(self.n_ticks):
+                if not self.step(k):
+                    break
+                if progress is not None and k % 100 == 0:
+                    progress(k / self.n_ticks)
+        except BaseException:  # an error or a signal: no half-written video in place
+            self.video.close(complete=False)
+            raise
         wall = time.perf_counter() - wall0
         self.video.close()
         return self._result(k + 1, wall, video_path)

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from footfall._geometry import cross3
+from footfall._io import PendingFile
 from footfall._typing import FloatArray
 from footfall._validate import positive
 from footfall.errors import FootfallError, InputError
@@ -361,6 +362,7 @@ class _Video:
     def __init__(self, sim: QuadrupedSim, path: Path | None, size: tuple[int, int]) -> None:
         self.renderer: Any = None
         self.writer: Any = None
+        self.file: PendingFile | None = None
         self.note = ""
         self.path = path
         #: wall time spent rendering, subtracted from the loop's wall time [s]
@@ -371,8 +373,9 @@ class _Video:
         if self.renderer is not None:
             import imageio.v2 as imageio
 
-            path.parent.mkdir(parents=True, exist_ok=True)
-            self.writer = imageio.get_writer(str(path), fps=VIDEO_FPS, macro_block_size=8)
+            # written beside the destination and renamed over it when complete (close)
+            self.file = PendingFile(path)
+            self.writer = imageio.get_writer(str(self.file.tmp), fps=VIDEO_FPS, macro_block_size=8)
 
     def frame(self, data: Any) -> None:
         """Append the current scene as a frame."""
@@ -383,13 +386,19 @@ class _Video:
         self.writer.append_data(self.renderer.render())
         self.render_time += time.perf_counter() - r0
 
-    def close(self) -> Path | None:
-        """Finish the file; its path, or None when none was written."""
+    def close(self, complete: bool = True) -> Path | None:
+        """Finish the file (put in place when ``complete``; removed, the previous video left,
+        when the walk was interrupted); its path, or None when none was written."""
         if self.writer is not None:
             self.writer.close()
+            assert self.file is not None
+            if complete:
+                self.file.commit()
+            else:
+                self.file.abort()
         if self.renderer is not None:
             self.renderer.close()
-        return self.path if self.writer is not None else None
+        return self.path if self.writer is not None and complete else None
 
 
 class _Recorder:
@@ -605,13 +614,17 @@ def simulate(
     guard = SlipMonitor(slip_guard, plan, ref) if slip_guard is not None else None
 
     wall0 = time.perf_counter()
-    if controller == "wbc":
-        _track_wbc(sim, rec, video, control_dt, progress, wbc_gains, settle_time, pushes, guard)
-    else:
-        # settle in the initial pose so the legs take the weight before the gait starts
-        for _ in range(round(settle_time / sim.model.opt.timestep)):
-            sim.mujoco.mj_step(sim.model, sim.data)
-        _track(sim, rec, video, control_dt, progress, pushes, guard)
+    try:
+        if controller == "wbc":
+            _track_wbc(sim, rec, video, control_dt, progress, wbc_gains, settle_time, pushes, guard)
+        else:
+            # settle in the initial pose so the legs take the weight before the gait starts
+            for _ in range(round(settle_time / sim.model.opt.timestep)):
+                sim.mujoco.mj_step(sim.model, sim.data)
+            _track(sim, rec, video, control_dt, progress, pushes, guard)
+    except BaseException:  # an error or a signal: no half-written video in place
+        video.close(complete=False)
+        raise
     rec.wall_time = time.perf_counter() - wall0 - video.render_time
     rec.video = video.close()
     rec.video_note = video.note

@@ -1,0 +1,83 @@
+"""What the commands write: every file whole or not at all (an interrupted write leaves the
+previous file, never a truncated one), no file of an earlier run beside a new one, and never an
+output over one of the command's inputs."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+from matplotlib.figure import Figure
+from typer.testing import CliRunner
+
+from footfall.cli import app
+from tests.planning.scenes import SHORT_FLAT
+
+#: what an interrupted figure write leaves when written in place (the issue's walk.png)
+TRUNCATED = 124
+
+
+class Interrupted(BaseException):
+    """Stands for SIGTERM arriving inside a write (footfall's handler raises a BaseException)."""
+
+
+def _savefig_interrupted(self: Figure, target: Any, *args: Any, **kwargs: Any) -> None:
+    """Write the first bytes of a PNG to ``target``, then be interrupted."""
+    with open(target, "wb") as fh:
+        fh.write(b"\x89PNG" + b"\0" * (TRUNCATED - 4))
+    raise Interrupted
+
+
+def _leftovers(folder: Path) -> list[str]:
+    return sorted(p.name for p in folder.iterdir() if ".tmp" in p.name)
+
+
+def test_an_interrupted_figure_leaves_the_previous_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from footfall.planning import make_plan
+    from footfall.terrain import load_scene
+    from footfall.viz.plan_plot import plot_plan
+
+    sc = load_scene(SHORT_FLAT)
+    plan = make_plan(sc, "kinematic", 3)
+    path = plot_plan(plan, sc, tmp_path / "plan.png")
+    good = path.read_bytes()
+    monkeypatch.setattr(Figure, "savefig", _savefig_interrupted)
+    with pytest.raises(Interrupted):
+        plot_plan(plan, sc, path)
+    assert path.read_bytes() == good
+    assert _leftovers(tmp_path) == []
+
+
+def test_a_writer_interrupted_in_atomic_path_leaves_the_previous_file(tmp_path: Path) -> None:
+    from footfall._io import atomic_path, write_json
+
+    path = write_json(tmp_path / "plan.json", {"status": "optimal"})
+    with pytest.raises(Interrupted), atomic_path(path) as tmp:
+        assert tmp.parent == path.parent and tmp.suffix == ".json" and tmp != path
+        tmp.write_text('{"status": "ti')
+        raise Interrupted
+    assert json.loads(path.read_text()) == {"status": "optimal"}
+    assert _leftovers(tmp_path) == []
+
+
+def test_a_run_stopped_while_writing_leaves_no_file_of_the_earlier_run(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`plan` interrupted between plan.json and plan.png: the new plan.json is there, the old
+    plan.png is gone (not left beside it, not truncated)."""
+    scene_file = tmp_path / "flat.yaml"
+    scene_file.write_text(SHORT_FLAT)
+    out = tmp_path / "out"
+    args = ["plan", str(scene_file), "--planner", "kinematic", "--steps", "3", "--out", str(out)]
+    assert CliRunner().invoke(app, args).exit_code == 0
+    assert (out / "plan.png").stat().st_size > 10_000
+    monkeypatch.setattr(Figure, "savefig", _savefig_interrupted)
+    with pytest.raises(Interrupted):
+        CliRunner().invoke(app, [*args[:4], "--steps", "4", "--out", str(out)])
+    assert len(json.loads((out / "plan.json").read_text())["footsteps"]) == 5  # this run's
+    assert not (out / "plan.png").exists()
+    assert _leftovers(out) == []
