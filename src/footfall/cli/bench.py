@@ -13,6 +13,7 @@ from footfall.cli._common import (
     console,
     output_folder,
     parse_floats,
+    refuse_inputs_as_outputs,
 )
 from footfall.errors import InputError
 
@@ -113,6 +114,7 @@ def bench_sim_cmd(
                 "nodes", nodes, "comma-separated integers >= 2 or 'plan', e.g. plan,10"
             )
     sc = resolve_scene(scene)
+    refuse_inputs_as_outputs([scene], {"out": [out / "bench_sim.json", out / "bench_sim.md"]})
     output_folder(out)
     plan = make_plan(sc, planner, None, PlannerOptions(threads=_threads(None)))
     if not plan.has_solution:

@@ -17,6 +17,7 @@ from footfall.cli._common import (
     console,
     output_folder,
     parse_floats,
+    refuse_inputs_as_outputs,
 )
 from footfall.cli._progress import ProgressLog
 from footfall.errors import InputError
@@ -125,6 +126,7 @@ def scenes_command(
     from footfall.viz.terrain_plot import plot_scene
 
     scene = resolve_scene(show)
+    refuse_inputs_as_outputs([show], {"out": [out / "scene.yaml", out / "scene.png"]})
     output_folder(out)
     remove_outputs(out, "scene.yaml", "scene.png")  # no file of another run beside ours
     write_text(out / "scene.yaml", scene_to_yaml(scene))
@@ -202,6 +204,11 @@ def plan(
 
     check_planner_name(planner)
     sc = resolve_scene_arguments(scene_file, scene)
+    outputs = {
+        "out": [out / "plan.json", out / "plan.png"],
+        "log_json": [log_json] if log_json else [],
+    }
+    refuse_inputs_as_outputs([scene_file, scene], outputs)
     output_folder(out)
     if steps is not None and min_steps:
         raise InputError("steps", steps, "no --steps with --min-steps (which searches N)")
@@ -263,6 +270,7 @@ def check_command(
 
     sc = resolve_scene_arguments(scene_file, scene)
     if out is not None:
+        refuse_inputs_as_outputs([plan_file, scene_file, scene], {"out": [out / "check.json"]})
         output_folder(out)
     result = load_plan(plan_file, sc)
     report = check_plan(result, sc)

@@ -22,6 +22,7 @@ from footfall.cli._common import (
     app,
     console,
     output_folder,
+    refuse_inputs_as_outputs,
 )
 from footfall.cli._progress import ProgressLog
 from footfall.errors import InputError
@@ -143,9 +144,11 @@ def quadruped_cmd(
             "osp" if strategy is None else strategy,
         )
         label = f"{math.degrees(params.slope):g}°/{math.degrees(params.body_pitch):g}°"
+    outputs = ["quadruped.json", "quadruped.mp4", *WALK_FIGURES]
+    refuse_inputs_as_outputs([scene], {"out": [out / name for name in outputs]})
     output_folder(out)
     # this run's files replace the last run's as a set: none of theirs is left beside ours
-    remove_outputs(out, "quadruped.json", "quadruped.mp4", *WALK_FIGURES)
+    remove_outputs(out, *outputs)
     plans, infeasible = plan_strategies(QuadrupedRobot(), params, compare)
     plan = plans[params.strategy]
     console.print(f"simulating {params.cycles} cycles on {label} ({plan.duration:.1f} s)...")
@@ -593,8 +596,13 @@ def walk_cmd(
     push = non_negative("push", push)
     model = robot_model(robot)
     sc = resolve_scene_arguments(scene_file, scene)
+    files = ("plan.json", "walk.json", "walk.png", "walk.mp4")
+    logs = [log_json] if log_json else []
+    refuse_inputs_as_outputs(
+        [scene_file, scene], {"out": [out / f for f in files], "log_json": logs}
+    )
     output_folder(out)
-    remove_outputs(out, "plan.json", "walk.json", "walk.png", "walk.mp4")  # no mixed runs
+    remove_outputs(out, *files)  # no file of an earlier run beside this run's
     with ProgressLog(f"{sc.name} with {planner} for the {robot}", quiet, log_json) as log:
         plan = plan_for_walk(
             sc,

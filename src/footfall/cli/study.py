@@ -13,7 +13,7 @@ from typing import Any
 import typer
 
 from footfall._io import write_text
-from footfall.cli._common import app, console, output_folder
+from footfall.cli._common import app, console, output_folder, refuse_inputs_as_outputs
 from footfall.errors import FootfallError, InputError
 
 #: least time between two progress lines without a terminal [s]
@@ -67,6 +67,11 @@ def study_command(
         workers = available_cores()
     if limit is not None and limit < 0:
         raise InputError("--limit", limit, "an integer >= 0")
+    from footfall.experiments.study.report import report_names
+    from footfall.experiments.study.store import META, TABLE
+
+    names = [TABLE, META, "run.json", *report_names(design)]
+    refuse_inputs_as_outputs([study_file], {"out": [out / name for name in names]})
     output_folder(out)
     # small matrices run fastest single-threaded; spawned workers and Ray workers read this
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")

@@ -9,7 +9,13 @@ from pathlib import Path
 import typer
 
 from footfall._io import remove_outputs, write_text
-from footfall.cli._common import app, console, output_folder, parse_floats
+from footfall.cli._common import (
+    app,
+    console,
+    output_folder,
+    parse_floats,
+    refuse_inputs_as_outputs,
+)
 from footfall.errors import InputError
 
 terrain_app = typer.Typer(
@@ -86,6 +92,9 @@ def from_heightmap(
         raise InputError(
             "out", str(out), "a file path for the scene YAML (a folder of that name exists)"
         )
+    if out.suffix.lower() == ".png":
+        raise InputError("out", str(out), "a .yaml path (the figure goes beside it as .png)")
+    refuse_inputs_as_outputs([map_file], {"out": [out, out.with_suffix(".png")]})
     output_folder(out.parent if str(out.parent) else Path("."))
     options = HeightmapOptions(
         max_slope_deg=max_slope,

@@ -136,6 +136,12 @@ def markdown(
     return "\n".join(md)
 
 
+def report_names(design: StudyDesign) -> list[str]:
+    """The files :func:`write_report` may write into the study folder."""
+    zmp = [f"zmp_{mode}_n.png" for mode in design.steps]
+    return ["summary.md", "summary.json", "cells.csv", "fragility.png", *zmp, "paired.png"]
+
+
 def write_report(
     out: Path,
     design: StudyDesign,
