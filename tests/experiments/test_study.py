@@ -604,3 +604,13 @@ def test_store_refuses_a_damaged_table_or_meta(tmp_path: Path) -> None:
     with pytest.raises(InputError) as e:
         TrialStore(tmp_path, d)
     assert e.value.field == "study folder"
+
+
+@pytest.mark.parametrize("meta", ['{"fingerprint": 3}', '{"fingerprint": ["seeds"]}', "[1, 2]"])
+def test_store_refuses_an_edited_meta_with_one_line(tmp_path: Path, meta: str) -> None:
+    """A study.json that is JSON but not the store's (a fingerprint that is not a mapping) is an
+    InputError naming it, not a TypeError from comparing the fingerprints."""
+    (tmp_path / "study.json").write_text(meta)
+    with pytest.raises(InputError) as e:
+        TrialStore(tmp_path, _design())
+    assert e.value.field == "study folder"

@@ -177,3 +177,33 @@ def test_search_switches_leave_the_key_alone_other_settings_change_it() -> None:
         assert plan_key(sc, "miqcqp", None, dataclasses.replace(opts, bnb=flipped)) == key
     other = dataclasses.replace(opts, bnb=BnbSettings(probe_rounds=0))
     assert plan_key(sc, "miqcqp", None, other) != key
+
+
+def test_a_cache_file_path_that_is_a_folder_is_refused_before_planning(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from footfall.errors import InputError
+    from footfall.planning import cache as cache_mod
+
+    sc, cache = scene(SHORT_FLAT), PlanCache(tmp_path)
+    cache.path(plan_key(sc, "miqcqp", 3, PlannerOptions(), sc.robot)).mkdir()
+    planned: list[int] = []
+    monkeypatch.setattr(cache_mod, "make_plan", lambda *a, **k: planned.append(1))
+    with pytest.raises(InputError) as e:
+        cached_plan(sc, "miqcqp", 3, cache=cache)
+    assert e.value.field == "plan cache file" and planned == []
+
+
+def test_a_plan_that_cannot_be_cached_is_still_returned(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A full disk when the plan is stored: the plan (minutes of planning) is returned, its
+    message says it was not cached."""
+    import errno
+
+    def full(*args: object, **kwargs: object) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(PlanCache, "save", full)
+    plan = cached_plan(scene(SHORT_FLAT), "miqcqp", 3, cache=PlanCache(tmp_path))
+    assert plan.has_solution and "not cached" in plan.message and "No space" in plan.message

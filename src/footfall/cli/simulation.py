@@ -40,6 +40,7 @@ def demo(out: Path = typer.Option(Path("out/demo"), help="Output folder.")) -> N
     """Run the main demo on built-in defaults and write figures and JSON into OUT."""
     from footfall.experiments.demo import run_demo
 
+    output_folder(out)
     labels = {
         "lip": "LIP walks (document 004)",
         "plans": "footstep plans (document 000)",

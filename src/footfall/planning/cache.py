@@ -140,8 +140,19 @@ class PlanCache:
         plan = FootstepPlan.from_dict(data, robot, source=str(path))
         return dataclasses.replace(plan, message=plan.message + " (loaded from cache)")
 
+    def check_writable(self, key: str) -> None:
+        """Refuse, before any planning, a cache whose file of ``key`` could not be written: the
+        folder is a file, or the file's path is a folder (or another non-file)."""
+        folder, path = Path(self.folder), self.path(key)
+        if folder.exists() and not folder.is_dir():
+            raise InputError(
+                "plan cache folder", str(folder), "a folder (a file of that name exists)"
+            )
+        if path.exists() and not path.is_file():
+            raise InputError("plan cache file", str(path), "a regular file or nothing (remove it)")
+
     def save(self, key: str, plan: FootstepPlan, scene_name: str = "") -> Path:
-        """Write ``plan`` under ``key``; returns the path."""
+        """Write ``plan`` under ``key`` (atomically); returns the path."""
         payload = plan.to_dict(scene_name)
         payload["cache_key"] = key
         return write_json(self.path(key), payload)
@@ -170,6 +181,7 @@ def cached_plan(
     key = plan_key(scene, planner, n_steps, options, robot)
     discarded = ""
     if cache is not None:
+        cache.check_writable(key)  # before the planning, whose plan would be lost
         try:
             hit = cache.load(key, robot)
         except InputError as exc:  # a damaged file is a miss: plan again and overwrite it
@@ -183,10 +195,13 @@ def cached_plan(
     if cache is not None and plan.has_solution:
         # a plan its own re-check would refuse is not stored: it would be discarded every time
         problem = cache_mismatch(plan, scene, n_steps)
+        if not problem:
+            try:
+                cache.save(key, plan, scene.name)
+            except OSError as e:  # a full disk: the plan is still returned, uncached
+                problem = f"{cache.path(key)}: {e.strerror}"
         if problem:
             discarded += f" (not cached: {problem})"
-        else:
-            cache.save(key, plan, scene.name)
     if discarded:
         plan = dataclasses.replace(plan, message=plan.message + discarded)
     return plan

@@ -249,6 +249,8 @@ class FootstepPlan:
         if feet.ndim != 2 or feet.shape[1] != 3:
             raise InputError("plan.footsteps", f"shape {feet.shape}", "shape (N + 1, 3)")
         rows = feet.shape[0]
+        if rows > MAX_STEPS + 1:  # no planner makes more; the checker's work grows with them
+            raise InputError("plan.footsteps", f"{rows} footsteps", f"at most {MAX_STEPS + 1}")
         headings = np.asarray(self.headings, dtype=float)
         if headings.shape != (rows,):
             raise InputError("plan.headings", f"shape {headings.shape}", f"shape ({rows},)")
@@ -523,6 +525,8 @@ def _plan_from_dict(data: object, robot: BipedParams, source: str) -> FootstepPl
     n = len(steps) - 1
     if n < 0:
         return _empty_from_dict(data, status, robot)
+    if n > MAX_STEPS:  # refused before any work per footstep
+        raise bad("footsteps", f"{n + 1} footsteps", f"at most {MAX_STEPS + 1} (N <= {MAX_STEPS})")
     k = robot.n_nodes
     sides = r.sides(steps)
     alip = get(data, "alip", "alip")

@@ -21,6 +21,7 @@ from footfall.planning.diagnose import min_steps_lower_bound
 from footfall.planning.plan import (
     FootstepPlan,
     PlannerOptions,
+    check_n_steps,
     check_planner_name,
     check_planning_arguments,
     result_meta,
@@ -68,6 +69,8 @@ def make_plan(
     """
     check_planning_arguments(scene, robot, options)
     check_planner_name(planner)
+    if n_steps is not None:
+        check_n_steps(n_steps)
     options = options or PlannerOptions()
     if members is not None and (planner != "miqcqp" or n_steps is None):
         raise InputError("members", "given", "only with the miqcqp planner and a given N")

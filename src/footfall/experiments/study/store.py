@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from footfall._io import write_text
 from footfall.errors import InputError
 from footfall.experiments.study.design import StudyDesign
 from footfall.experiments.study.trials import COLUMNS, OPTIONAL_COLUMNS
@@ -95,6 +96,8 @@ class TrialStore:
             try:
                 old = json.loads(meta.read_text())["fingerprint"]
             except (OSError, ValueError, KeyError, TypeError):
+                old = None
+            if not isinstance(old, dict):  # unreadable, damaged or edited
                 raise InputError(
                     "study folder", str(meta), "a study.json written by footfall study"
                 ) from None
@@ -106,7 +109,7 @@ class TrialStore:
                     f"a folder of this study or a new one: its trials were run with other "
                     f"{', '.join(diff)} ({', '.join(f'{k}={old.get(k)!r}' for k in diff)})",
                 )
-        meta.write_text(json.dumps({"fingerprint": fp, "design": design.to_dict()}, indent=1))
+        write_text(meta, json.dumps({"fingerprint": fp, "design": design.to_dict()}, indent=1))
         self.parts = self.folder / PARTS
         self.rows: dict[str, dict[str, Any]] = {}
         table = self.folder / TABLE
