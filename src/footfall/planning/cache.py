@@ -27,10 +27,9 @@ import numpy as np
 from footfall._io import write_json
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
-from footfall.planning.check import check_plan
+from footfall.planning.check import check_plan, unexpected_violations
 from footfall.planning.plan import FootstepPlan, PlannerOptions
 from footfall.planning.run import SearchMonitor, make_plan
-from footfall.solvers.base import SolveStatus
 from footfall.terrain.scene import Scene, robot_to_dict, scene_to_dict
 
 #: version of the key's layout and of the file format; bumping it makes every old entry a miss
@@ -207,34 +206,21 @@ def cached_plan(
     return plan
 
 
-#: the checker's violations a planner's own output has by design: the kinematic planner has no
-#: torque bound, and a reactive walk that stops short (``incomplete``) misses the goal. Any other
-#: violation of a cached plan means the file was altered (or the plan was never valid).
-BY_DESIGN: dict[str, frozenset[str]] = {"kinematic": frozenset({"torque"})}
-
-
-def _by_design(plan: FootstepPlan) -> frozenset[str]:
-    kinds = BY_DESIGN.get(plan.planner, frozenset())
-    if plan.status is SolveStatus.INCOMPLETE:
-        kinds |= {"goal"}
-    return kinds
-
-
 def cache_mismatch(plan: FootstepPlan, scene: Scene, n_steps: int | None) -> str:
     """Why a cached ``plan`` cannot be the one asked for on ``scene`` ("" when it can).
 
     It must have footsteps (only those are stored), ``n_steps`` of them when N was asked for,
     and pass every check of the independent checker (:func:`footfall.planning.check_plan`:
     start, regions, reach, step height, swing, heading rate, torque, the re-simulated ALIP
-    dynamics, goal) but those its planner breaks by design (:data:`BY_DESIGN`).
+    dynamics, goal) but those its planner makes by design
+    (:func:`~footfall.planning.check.unexpected_violations`): any other violation means the file
+    was altered (or the plan was never valid).
     """
     if not plan.has_solution:
         return "no footsteps"
     if n_steps is not None and plan.n_steps != n_steps:
         return f"{plan.n_steps} footsteps where N = {n_steps} was asked for"
-    report = check_plan(plan, scene)
-    allowed = _by_design(plan)
-    bad = [v for v in report.violations if v.kind not in allowed]
+    bad = unexpected_violations(check_plan(plan, scene), plan)
     if not bad:
         return ""
     more = f" (and {len(bad) - 1} more violation(s))" if len(bad) > 1 else ""
