@@ -135,14 +135,18 @@ def bench_sim_cmd(
 @bench_app.command("quadruped")
 def bench_quadruped_cmd(
     slope_deg: float = typer.Option(15.0, help="Slope angle [deg]."),
-    body_deg: float = typer.Option(10.0, help="Body angle [deg]."),
+    body_deg: float | None = typer.Option(
+        None, help="Body angle [deg]; default: two thirds of the slope (10 on 15)."
+    ),
     out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_quadruped.json."),
 ) -> None:
     """Quadruped slope walk: simulated s per wall s vs bare mj_step, and gait-plan time."""
+    from footfall.cli.simulation import default_body_deg
     from footfall.experiments.bench import benchmark_quadruped
 
     output_folder(out)
-    result = benchmark_quadruped(slope_deg=slope_deg, body_deg=body_deg)
+    body = default_body_deg(slope_deg) if body_deg is None else body_deg
+    result = benchmark_quadruped(slope_deg=slope_deg, body_deg=body)
     write_json(out / "bench_quadruped.json", result)
     for key, value in result.items():
         console.print(f"{key}: {value}")

@@ -62,7 +62,8 @@ def quadruped_cmd(
     ),
     body_deg: float | None = typer.Option(
         None,
-        help="Body angle beta_B to the horizontal [deg], between 0 and the slope. [default: 10]",
+        help="Body angle beta_B to the horizontal [deg], between 0 and the slope. [default: two "
+        "thirds of the slope, the compromise posture: 10 on 15, -10 on -15]",
     ),
     step: float | None = typer.Option(None, help="Step length S along the slope [m]. [0.4]"),
     height: float | None = typer.Option(None, help="Swing height H normal to the slope [m]. [0.1]"),
@@ -100,6 +101,9 @@ def quadruped_cmd(
     if video:
         # must be chosen before MuJoCo is imported; EGL works headless here
         os.environ.setdefault("MUJOCO_GL", "egl")
+    from footfall.sim._mjcf import require_mujoco
+
+    require_mujoco()  # before any work: a missing extra is one line, exit 2
     from footfall.experiments.slope_walk import compare_strategies, plan_strategies
     from footfall.quadruped import QuadrupedRobot
     from footfall.sim.quadruped.mjcf import SimSettings
@@ -138,9 +142,10 @@ def quadruped_cmd(
             settings = SimSettings(friction=sc.friction)
         label = sc.name
     else:
+        slope = 15.0 if slope_deg is None else slope_deg
         params = _slope_params(
-            15.0 if slope_deg is None else slope_deg,
-            10.0 if body_deg is None else body_deg,
+            slope,
+            default_body_deg(slope) if body_deg is None else body_deg,
             (step, height, cycles, swing_period, shift_period),
             "osp" if strategy is None else strategy,
         )
@@ -205,6 +210,14 @@ def quadruped_cmd(
     console.print(f"wrote {out / 'quadruped.json'}")
     if m.fell:
         raise typer.Exit(1)
+
+
+def default_body_deg(slope_deg: float) -> float:
+    """The body angle [deg] that follows a slope of ``slope_deg`` [deg] when none is given: the
+    compromise posture (``BODY_RATIO`` of the slope, so downhill is negative too)."""
+    from footfall.quadruped.gait import BODY_RATIO
+
+    return BODY_RATIO * slope_deg if math.isfinite(slope_deg) else slope_deg
 
 
 def _slope_params(

@@ -40,7 +40,7 @@ import numpy as np
 
 from footfall._typing import FloatArray
 from footfall._validate import check_fields, non_negative, positive
-from footfall.errors import FootfallError, InputError
+from footfall.errors import FootfallError, InputError, MissingExtraError
 from footfall.models.biped import Side
 from footfall.sim.biped import names as nm
 from footfall.sim.biped.model import require_mujoco
@@ -73,17 +73,17 @@ def g1_urdf_path() -> Path:
     """Path of the G1's URDF in the installed ``example-robot-data`` distribution.
 
     Raises:
-        FootfallError: when ``example-robot-data`` is not installed (naming the extra).
+        MissingExtraError: when ``example-robot-data`` is not installed (naming the extra).
     """
     try:
         dist = importlib.metadata.distribution(ERD_DISTRIBUTION)
     except importlib.metadata.PackageNotFoundError:
-        raise FootfallError(
+        raise MissingExtraError(
             f"the Unitree G1 model needs the {ERD_DISTRIBUTION!r} package: {ROBOTS_EXTRA}"
         ) from None
     path = Path(str(dist.locate_file(G1_URDF)))
     if not path.is_file():
-        raise FootfallError(
+        raise MissingExtraError(
             f"{ERD_DISTRIBUTION} {dist.version} has no {G1_URDF}: {ROBOTS_EXTRA} (>= 6.0)"
         )
     return path

@@ -23,11 +23,12 @@ from footfall._geometry import cross3
 from footfall._io import PendingFile
 from footfall._typing import FloatArray
 from footfall._validate import positive
-from footfall.errors import FootfallError, InputError
+from footfall.errors import InputError
 from footfall.quadruped.gait import GaitParams, GaitPlan, GaitTrajectory, PhaseKind, plan_gait
 from footfall.quadruped.ground import PlaneGround, QuadrupedGround
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
 from footfall.quadruped.stability import centre_of_pressure, stability_margin, support_polygon
+from footfall.sim._mjcf import require_mujoco
 from footfall.sim.pushes import Push
 from footfall.sim.quadruped import names as nm
 from footfall.sim.quadruped.mjcf import SimSettings, ground_scene
@@ -245,13 +246,7 @@ class QuadrupedSim:
         settings: SimSettings | None = None,
         x_range: tuple[float, float] = (-3.0, 12.0),
     ) -> None:
-        try:
-            import mujoco  # optional dependency: footfall[sim]
-        except ImportError as exc:
-            raise FootfallError(
-                f"MuJoCo is required: pip install 'footfall[sim]' ({exc})"
-            ) from None
-
+        mujoco = require_mujoco()
         self.mujoco = mujoco
         self.robot = robot
         self.settings = settings if settings is not None else SimSettings()
