@@ -158,10 +158,14 @@ def polygon_distance(p: FloatArray, q: FloatArray) -> float:
         return 0.0
     best = np.inf
     for poly, other in ((p, q), (q, p)):
-        nxt = np.roll(other, -1, axis=0)
-        for v in poly:
-            for a, b in zip(other, nxt, strict=True):
-                best = min(best, point_segment_distance(v, a, b))
+        # every vertex of poly against every edge a -> b of other at once (point_segment_distance)
+        a = np.asarray(other, dtype=float)
+        ab = np.roll(a, -1, axis=0) - a
+        ap = np.asarray(poly, dtype=float)[:, None, :] - a[None, :, :]
+        denom = np.einsum("ej,ej->e", ab, ab)
+        t = np.einsum("vej,ej->ve", ap, ab) / np.where(denom > 0.0, denom, 1.0)
+        t = np.where(denom > 0.0, np.clip(t, 0.0, 1.0), 0.0)
+        best = min(best, float(np.min(np.linalg.norm(ap - t[..., None] * ab, axis=2))))
     return float(best)
 
 

@@ -152,7 +152,11 @@ def plan(
     ),
     min_steps: bool = typer.Option(False, help="Search the smallest feasible N."),
     planner: str = typer.Option("miqcqp", help="miqcqp, kinematic or reactive."),
-    time_limit: float = typer.Option(60.0, help="Solver time limit per solve [s]."),
+    time_limit: float = typer.Option(
+        60.0,
+        help="Time limit of the solve [s]; in the smallest-N search, of each N tried (its checks "
+        "before the solve included).",
+    ),
     gap: float = typer.Option(1e-4, help="Relative optimality gap at which to stop."),
     solver: str = typer.Option(
         "bnb", help="Backend: bnb (fast exact, default), scip (direct model) or gurobi."

@@ -88,7 +88,9 @@ class PlannerOptions:
         solver: backend name: ``bnb`` (default: footfall's exact branch and bound for this
             problem, falls back to SCIP for other structures), ``scip`` (the direct model on
             SCIP), ``gurobi`` (optional).
-        time_limit: solver wall-time limit [s].
+        time_limit: solver wall-time limit [s]; in the smallest-N search
+            (:func:`~footfall.planning.run.plan_min_steps`) each N tried gets this long, its
+            checks before the solve included.
         gap: relative optimality gap at which the solver stops.
         threads: solver threads; for ``bnb``, the forked worker processes that solve node
             relaxations in parallel (1, the default: the serial search in the calling process, so
