@@ -67,31 +67,11 @@ def _signal_once_workers_run_err(
     time.sleep(1.0)  # let the workers get busy
     proc.send_signal(sig)
     try:
-        code = proc.wait(timeout=15)
+        code = proc.wait(timeout=60)
     except subprocess.TimeoutExpired:
         proc.kill()
-        pytest.fail("the command did not stop within 15 s of the signal")
+        pytest.fail("the command did not stop within 60 s of the signal")
     return code, workers, proc.stderr.read()  # type: ignore[union-attr]
-
-
-@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
-def test_compare_ends_its_trial_pool(sig: int, tmp_path: Path) -> None:
-    args = ["compare", "--scenes", "flat", "--planners", "reactive", "--trials", "400",
-            "--workers", "2"]  # fmt: skip
-    code, workers = _signal_once_workers_run(args, sig, tmp_path)
-    assert code == 128 + sig
-    time.sleep(1.0)
-    assert not [w for w in workers if _alive(w)], "worker processes outlived the command"
-
-
-def test_plan_ends_its_solver_workers(tmp_path: Path) -> None:
-    # a long solve on two workers: stepping stones with many footsteps
-    args = ["plan", "--scene", "stairs_slope_gap", "--steps", "20", "--threads", "2",
-            "--time-limit", "300"]  # fmt: skip
-    code, workers = _signal_once_workers_run(args, signal.SIGTERM, tmp_path)
-    assert code == 128 + signal.SIGTERM
-    time.sleep(1.0)
-    assert not [w for w in workers if _alive(w)], "solver workers outlived the command"
 
 
 def _gone_within(pids: list[int], seconds: float) -> list[int]:
@@ -104,6 +84,24 @@ def _gone_within(pids: list[int], seconds: float) -> list[int]:
     return alive
 
 
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_compare_ends_its_trial_pool(sig: int, tmp_path: Path) -> None:
+    args = ["compare", "--scenes", "flat", "--planners", "reactive", "--trials", "400",
+            "--workers", "2"]  # fmt: skip
+    code, workers = _signal_once_workers_run(args, sig, tmp_path)
+    assert code == 128 + sig
+    assert not _gone_within(workers, 30.0), "worker processes outlived the command"
+
+
+def test_plan_ends_its_solver_workers(tmp_path: Path) -> None:
+    # a long solve on two workers: stepping stones with many footsteps
+    args = ["plan", "--scene", "stairs_slope_gap", "--steps", "20", "--threads", "2",
+            "--time-limit", "300"]  # fmt: skip
+    code, workers = _signal_once_workers_run(args, signal.SIGTERM, tmp_path)
+    assert code == 128 + signal.SIGTERM
+    assert not _gone_within(workers, 30.0), "solver workers outlived the command"
+
+
 def test_plan_solver_workers_die_with_a_killed_parent(tmp_path: Path) -> None:
     """kill -9 leaves no clean-up to the command: the kernel ends its workers (they ran on for
     20-40 s, reparented to PID 1)."""
@@ -111,14 +109,14 @@ def test_plan_solver_workers_die_with_a_killed_parent(tmp_path: Path) -> None:
             "--time-limit", "300"]  # fmt: skip
     code, workers = _signal_once_workers_run(args, signal.SIGKILL, tmp_path)
     assert code == -signal.SIGKILL
-    assert not _gone_within(workers, 5.0), "solver workers outlived their killed parent"
+    assert not _gone_within(workers, 30.0), "solver workers outlived their killed parent"
 
 
 def test_study_pool_workers_die_with_a_killed_parent(tmp_path: Path) -> None:
     args = ["study", str(_long_reduced_study(tmp_path)), "--workers", "2", "--quiet"]
     code, workers = _signal_once_workers_run(args, signal.SIGKILL, tmp_path)
     assert code == -signal.SIGKILL
-    assert not _gone_within(workers, 5.0), "pool workers outlived their killed parent"
+    assert not _gone_within(workers, 30.0), "pool workers outlived their killed parent"
 
 
 def _long_reduced_study(tmp_path: Path) -> Path:

@@ -14,6 +14,7 @@ from footfall.sim.reduced.closed_loop import MAX_CONTROL_RATE, SimOptions
 from footfall.terrain import builtin_scene
 from footfall.terrain.region import MAX_VERTICES, Region
 from footfall.terrain.terrain import MAX_REGIONS, Terrain
+from tests.conftest import VirtualClock
 
 
 def test_too_many_footsteps() -> None:
@@ -154,36 +155,20 @@ def test_adjacency_agrees_with_shapely_distances() -> None:
                     assert (a in adj[b]) == (d <= radius)
 
 
-class _Clock:
-    """A clock that moves only when read (1 ms a read) or when told: time.perf_counter for a
-    test, so a time limit depends on the work done, not on the machine."""
-
-    def __init__(self) -> None:
-        self.now = 1000.0
-
-    def __call__(self) -> float:
-        self.now += 1e-3
-        return self.now
-
-
 def test_each_n_of_the_smallest_n_search_keeps_to_the_time_limit(
-    monkeypatch: pytest.MonkeyPatch,
+    monkeypatch: pytest.MonkeyPatch, virtual_clock: VirtualClock
 ) -> None:
     """The reachable sets before each solve made a 0.3 s limit last 2-8 s per N. Here each cut
     of a set into a region costs 50 ms of the test's clock (a large terrain): every N, its sets,
     its kinematic check and its solve together, stays within its limit (plus one cut and the
     clock reads of a few node solves)."""
-    import time
-
     from footfall.planning import bounds
     from footfall.planning.run import plan_min_steps
 
-    clock = _Clock()
-    monkeypatch.setattr(time, "perf_counter", clock)
     cut = bounds._cuts
 
     def costly(*args, **kwargs):  # type: ignore[no-untyped-def]
-        clock.now += 0.05
+        virtual_clock.advance(0.05)
         return cut(*args, **kwargs)
 
     monkeypatch.setattr(bounds, "_cuts", costly)

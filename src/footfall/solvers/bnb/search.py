@@ -409,7 +409,14 @@ class _Search:
             tid, (allowed, full) = mine.pop(0)
             answered = [(tid, self.relax.solve(allowed, full=full)), *pool.wait(0.0)]
         else:
-            answered = pool.wait(self.deadline - time.perf_counter())
+            # an empty wait is the time limit only once the clock says so (a wait may return a
+            # little early, and the clock is the search's, not the wait's timer)
+            answered = []
+            while not answered:
+                left = self.deadline - time.perf_counter()
+                if left <= 0.0:
+                    return []
+                answered = pool.wait(left)
         answered.reverse()
         return answered
 
