@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -16,25 +14,8 @@ import pytest
 from footfall.errors import InputError
 from footfall.models import ALIP
 from footfall.models.lip import LIP
+from tests.cli import error_line, footfall
 from tests.planning.scenes import SHORT_FLAT
-
-
-def _run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "footfall", *args],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=cwd,
-    )
-
-
-def _one_line(r: subprocess.CompletedProcess[str], field: str) -> str:
-    assert r.returncode == 2, r.stdout + r.stderr[-2000:]
-    lines = [line for line in r.stderr.splitlines() if line.strip()]
-    assert len(lines) == 1 and "Traceback" not in r.stderr, r.stderr[-2000:]
-    assert f"{field}" in lines[0], lines[0]
-    return lines[0]
 
 
 def _scene_file(tmp_path: Path, old: str, new: str) -> Path:
@@ -47,19 +28,19 @@ def _scene_file(tmp_path: Path, old: str, new: str) -> Path:
 # --- the command line -----------------------------------------------------------------------------
 def test_demo_into_a_file_is_refused(tmp_path: Path) -> None:
     (tmp_path / "afile").write_text("x")
-    _one_line(_run("demo", "--out", str(tmp_path / "afile")), "out:")
+    error_line(footfall("demo", "--out", str(tmp_path / "afile")), "out:")
 
 
 def test_a_lip_sampling_period_that_would_fill_the_memory_is_refused(tmp_path: Path) -> None:
-    line = _one_line(_run("lip", "--dt", "1e-9", "--out", str(tmp_path)), "dt:")
+    line = error_line(footfall("lip", "--dt", "1e-9", "--out", str(tmp_path)), "dt:")
     assert "samples" in line
 
 
 def test_a_height_map_fit_window_beyond_any_map_is_refused(tmp_path: Path) -> None:
     np.save(tmp_path / "m.npy", np.zeros((30, 30)))
-    r = _run("terrain", "from-heightmap", str(tmp_path / "m.npy"), "--resolution", "0.02",
+    r = footfall("terrain", "from-heightmap", str(tmp_path / "m.npy"), "--resolution", "0.02",
              "--window", "100001", "--out", str(tmp_path / "s.yaml"))  # fmt: skip
-    _one_line(r, "window:")
+    error_line(r, "window:")
 
 
 @pytest.mark.parametrize(
@@ -77,7 +58,7 @@ def test_a_hostile_scene_is_one_line_naming_the_field(
     tmp_path: Path, old: str, new: str, field: str
 ) -> None:
     scene = _scene_file(tmp_path, old, new)
-    line = _one_line(_run("plan", str(scene), "--steps", "3", "--out", str(tmp_path)), field)
+    line = error_line(footfall("plan", str(scene), "--steps", "3", "--out", str(tmp_path)), field)
     assert len(line) < 600  # a 1 MB name is not echoed in full
     assert not (tmp_path / "plan.json").exists()
 
@@ -109,13 +90,13 @@ def test_a_plan_file_longer_than_any_plan_is_refused_before_checking(tmp_path: P
     plan_file = tmp_path / "long.json"
     plan_file.write_text(json.dumps(data))
     scene_file = _scene_file(tmp_path, "name: short_flat", "name: short_flat")
-    line = _one_line(_run("check", str(plan_file), str(scene_file)), "footsteps")
+    line = error_line(footfall("check", str(plan_file), str(scene_file)), "footsteps")
     assert "29001 footsteps" in line and "at most 201" in line
 
 
-def test_a_corrupted_study_json_is_one_line(tmp_path: Path) -> None:
+def test_a_corrupted_study_json_iserror_line(tmp_path: Path) -> None:
     (tmp_path / "study.json").write_text('{"fingerprint": 3}')
-    _one_line(_run("study", "--quick", "--out", str(tmp_path)), "study folder:")
+    error_line(footfall("study", "--quick", "--out", str(tmp_path)), "study folder:")
 
 
 # --- the library --------------------------------------------------------------------------------

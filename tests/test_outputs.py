@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 import subprocess
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +15,7 @@ from matplotlib.figure import Figure
 from typer.testing import CliRunner
 
 from footfall.cli import app
+from tests.cli import error_line, footfall
 from tests.planning.scenes import SHORT_FLAT
 
 #: what an interrupted figure write leaves when written in place (the issue's walk.png)
@@ -67,7 +67,7 @@ def test_a_writer_interrupted_in_atomic_path_leaves_the_previous_file(tmp_path: 
     assert _leftovers(tmp_path) == []
 
 
-def test_a_run_stopped_while_writing_leaves_no_file_of_the_earlier_run(
+def test_a_run_stopped_while_writing_leaves_no_file_of_the_earlierfootfall(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """`plan` interrupted between plan.json and plan.png: the new plan.json is there, the old
@@ -86,17 +86,8 @@ def test_a_run_stopped_while_writing_leaves_no_file_of_the_earlier_run(
     assert _leftovers(out) == []
 
 
-def _run(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "footfall", *args], capture_output=True, text=True, timeout=300
-    )
-
-
 def _refused(r: subprocess.CompletedProcess[str], field: str) -> None:
-    assert r.returncode == 2, r.stdout + r.stderr
-    lines = [line for line in r.stderr.splitlines() if line.strip()]
-    assert len(lines) == 1 and "Traceback" not in r.stderr, r.stderr
-    assert f"{field}:" in lines[0] and "not an input" in lines[0], lines[0]
+    assert "not an input" in error_line(r, f"{field}:")
 
 
 def test_a_figure_never_replaces_the_height_map_it_is_made_from(tmp_path: Path) -> None:
@@ -105,7 +96,7 @@ def test_a_figure_never_replaces_the_height_map_it_is_made_from(tmp_path: Path) 
     counts = np.full((20, 30), 1000, dtype=np.uint16)
     Image.fromarray(counts).save(tmp_path / "m.png")
     before = (tmp_path / "m.png").read_bytes()
-    r = _run("terrain", "from-heightmap", str(tmp_path / "m.png"), "--resolution", "0.02",
+    r = footfall("terrain", "from-heightmap", str(tmp_path / "m.png"), "--resolution", "0.02",
              "--height-scale", "0.001", "--out", str(tmp_path / "m.yaml"))  # fmt: skip
     _refused(r, "out")
     assert (tmp_path / "m.png").read_bytes() == before
@@ -122,7 +113,7 @@ def test_check_never_writes_over_the_plan_it_checks(tmp_path: Path) -> None:
     before = plan_file.read_bytes()
     scene_file = tmp_path / "flat.yaml"
     scene_file.write_text(SHORT_FLAT)
-    _refused(_run("check", str(plan_file), str(scene_file), "--out", str(tmp_path)), "out")
+    _refused(footfall("check", str(plan_file), str(scene_file), "--out", str(tmp_path)), "out")
     assert plan_file.read_bytes() == before
 
 
@@ -134,7 +125,7 @@ def test_the_progress_log_never_replaces_the_scene(tmp_path: Path, target: str) 
     if target == "link":  # another name for the same file
         log = tmp_path / "log.jsonl"
         log.symlink_to(scene_file)
-    r = _run("plan", str(scene_file), "--steps", "3", "--log-json", str(log),
+    r = footfall("plan", str(scene_file), "--steps", "3", "--log-json", str(log),
              "--out", str(tmp_path / "out"))  # fmt: skip
     _refused(r, "log_json")
     assert scene_file.read_text() == SHORT_FLAT
@@ -143,9 +134,7 @@ def test_the_progress_log_never_replaces_the_scene(tmp_path: Path, target: str) 
 def test_a_log_that_cannot_be_written_is_refused_before_planning(tmp_path: Path) -> None:
     if not Path("/dev/full").exists():
         pytest.skip("no /dev/full here")
-    r = _run("plan", "--scene", "flat", "--steps", "8", "--log-json", "/dev/full",
-             "--out", str(tmp_path))  # fmt: skip
-    assert r.returncode == 2, r.stderr
-    lines = [line for line in r.stderr.splitlines() if line.strip()]
-    assert len(lines) == 1 and "log_json:" in lines[0] and "Traceback" not in r.stderr, r.stderr
+    r = footfall("plan", "--scene", "flat", "--steps", "8", "--log-json", "/dev/full",
+                 "--out", str(tmp_path))  # fmt: skip
+    error_line(r, "log_json:")
     assert not (tmp_path / "plan.json").exists()

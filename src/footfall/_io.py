@@ -70,6 +70,13 @@ class PendingFile:
         """Remove the temporary file (``path`` is left as it was)."""
         self.tmp.unlink(missing_ok=True)
 
+    def finish(self, complete: bool) -> None:
+        """:meth:`commit` a complete file, :meth:`abort` an interrupted one."""
+        if complete:
+            self.commit()
+        else:
+            self.abort()
+
 
 @contextmanager
 def atomic_path(path: Path) -> Iterator[Path]:

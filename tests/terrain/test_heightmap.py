@@ -184,6 +184,19 @@ def test_regions_have_no_collinear_vertices_and_the_checker_sees_their_planes() 
             assert _plane_height(r.vertices3d, p) == pytest.approx(r.height_at(p), abs=1e-9)
 
 
+def test_drop_collinear_removes_exactly_the_vertices_on_straight_edges() -> None:
+    from footfall._geometry import drop_collinear
+
+    hexagon = np.array([[np.cos(a), np.sin(a)] for a in np.arange(6) * np.pi / 3])
+    # midpoints on three edges (one a round-off off its edge) and a repeated corner
+    mid = 0.5 * (hexagon + np.roll(hexagon, -1, axis=0))
+    mid[2] += 1e-13
+    noisy = np.vstack([hexagon[0], mid[0], hexagon[1], hexagon[2], mid[2], hexagon[3],
+                       hexagon[3], hexagon[4], mid[4], hexagon[5]])  # fmt: skip
+    np.testing.assert_array_equal(drop_collinear(noisy, 1e-9), hexagon)
+    np.testing.assert_array_equal(drop_collinear(hexagon, 1e-9), hexagon)  # nothing to drop
+
+
 # ============================================================================= decomposition
 L_SHAPE = [(0.0, 0.0), (1.0, 0.0), (1.0, 0.4), (0.4, 0.4), (0.4, 1.0), (0.0, 1.0)]
 

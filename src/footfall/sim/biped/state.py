@@ -229,9 +229,6 @@ class Video:
         if self.writer is not None:
             self.writer.close()
             assert self.file is not None
-            if complete:
-                self.file.commit()
-            else:
-                self.file.abort()
+            self.file.finish(complete)
         if self.renderer is not None:
             self.renderer.close()

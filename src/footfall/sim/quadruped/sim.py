@@ -387,10 +387,7 @@ class _Video:
         if self.writer is not None:
             self.writer.close()
             assert self.file is not None
-            if complete:
-                self.file.commit()
-            else:
-                self.file.abort()
+            self.file.finish(complete)
         if self.renderer is not None:
             self.renderer.close()
         return self.path if self.writer is not None and complete else None
