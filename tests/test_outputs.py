@@ -138,3 +138,87 @@ def test_a_log_that_cannot_be_written_is_refused_before_planning(tmp_path: Path)
                  "--out", str(tmp_path))  # fmt: skip
     error_line(r, "log_json:")
     assert not (tmp_path / "plan.json").exists()
+
+
+def test_an_interrupted_replay_leaves_the_previous_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """replay.npz (what `footfall view` replays) is written whole or not at all, like the rest."""
+    from footfall.sim.replay import REPLAY_FILE, ReplayRecorder
+
+    class _Data:
+        qpos = np.zeros(3)
+
+    rec = ReplayRecorder("biped")
+    rec.begin("<mujoco/>")
+    rec.sample(0.0, _Data())
+    path = rec.write(tmp_path / REPLAY_FILE)
+    good = path.read_bytes()
+
+    def savez_interrupted(fh: Any, **arrays: Any) -> None:
+        fh.write(b"PK\x03\x04" + b"\0" * 60)  # the start of a zip, then the signal
+        raise Interrupted
+
+    monkeypatch.setattr(np, "savez_compressed", savez_interrupted)
+    with pytest.raises(Interrupted):
+        rec.write(path)
+    assert path.read_bytes() == good
+    assert _leftovers(tmp_path) == []
+
+
+def test_an_interrupted_video_leaves_the_previous_one(tmp_path: Path) -> None:
+    """The MuJoCo plants' video (sim/_video.Video) is put in place only when the walk completes."""
+    pytest.importorskip("imageio_ffmpeg")
+    from footfall.sim._video import Video
+
+    class _Renderer:
+        def __init__(self, model: Any, height: int, width: int) -> None:
+            self.shape = (height, width, 3)
+
+        def update_scene(self, data: Any, camera: str) -> None:
+            pass
+
+        def render(self) -> Any:
+            return np.zeros(self.shape, dtype=np.uint8)
+
+        def close(self) -> None:
+            pass
+
+    class _Mujoco:
+        Renderer = _Renderer
+
+    path = tmp_path / "walk.mp4"
+
+    def record(complete: bool) -> Path | None:
+        video = Video(_Mujoco, None, path, (64, 48), 1 / 30, "track")
+        for k in range(3):
+            assert video.frame(k, None)
+        return video.close(complete)
+
+    assert record(True) == path
+    good = path.read_bytes()
+    assert record(False) is None
+    assert path.read_bytes() == good
+    assert _leftovers(tmp_path) == []
+
+
+@pytest.mark.parametrize("given_as", ["MODEL", "--config"])
+def test_robot_inspect_never_writes_over_the_robot_file_it_reads(
+    tmp_path: Path, given_as: str
+) -> None:
+    out = tmp_path / "out"
+    out.mkdir()
+    robot_file = out / "robot.yaml"
+    robot_file.write_text("name: mine\nmodel: mine.urdf\n")
+    before = robot_file.read_bytes()
+    model = robot_file if given_as == "MODEL" else tmp_path / "mine.urdf"
+    config = ["--config", str(robot_file)] if given_as == "--config" else []
+    _refused(footfall("robot", "inspect", str(model), *config, "--out", str(out)), "out")
+    assert robot_file.read_bytes() == before
+
+
+def test_view_never_writes_its_screenshot_over_what_it_shows(tmp_path: Path) -> None:
+    shown = tmp_path / "shot.png"
+    shown.write_bytes(b"\x89PNG earlier picture")
+    _refused(footfall("view", str(shown), "--screenshot", str(shown)), "screenshot")
+    assert shown.read_bytes() == b"\x89PNG earlier picture"
