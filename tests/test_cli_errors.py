@@ -89,7 +89,9 @@ def test_a_missing_optional_package_exits_2_naming_the_extra(
     (blocked / "__init__.py").write_text(f"raise ImportError('{package} blocked for this test')\n")
     np.save(tmp_path / "map.npy", np.random.default_rng(0).normal(0.0, 1e-3, (20, 20)))
     args = [str(tmp_path / "map.npy") if a == "MAP" else a for a in args]
-    env = os.environ | {"PYTHONPATH": str(tmp_path / "blocked")}
+    # the blocked package first, then whatever path the tests run with (a worktree's src)
+    path = os.pathsep.join(p for p in (str(blocked.parent), os.environ.get("PYTHONPATH")) if p)
+    env = os.environ | {"PYTHONPATH": path}
     r = subprocess.run(
         [sys.executable, "-m", "footfall", *args, "--out", str(tmp_path / "out.yaml")],
         capture_output=True, text=True, timeout=120, env=env,
