@@ -15,8 +15,8 @@ import math
 
 import numpy as np
 
-from footfall.quadruped import GaitParams, QuadrupedRobot, plan_gait
 from footfall._mjcf import SimSettings
+from footfall.quadruped import GaitParams, QuadrupedRobot, plan_gait
 from footfall.sim.quadruped.sim import simulate
 from footfall.sim.quadruped.slip import DEFAULT_SLIP_LIMIT, SlipGuard
 

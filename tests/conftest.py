@@ -1,8 +1,11 @@
 """Shared test settings: named tolerances, headless rendering."""
 
 import os
+import time
+from collections.abc import Iterator
 from dataclasses import replace
 
+import pytest
 from hypothesis import settings
 
 from footfall.planning.plan import FootstepPlan
@@ -42,3 +45,30 @@ def first_steps(plan: FootstepPlan, n: int) -> FootstepPlan:
         torques=plan.torques[:n],
         final_state=plan.states[n, 0],
     )
+
+
+class VirtualClock:
+    """``time.perf_counter`` for a test (fixture :func:`virtual_clock`): it moves only when read
+    (``step`` seconds a read) or when told (:meth:`advance`), so a time limit falls after the
+    same work on any machine, loaded or not. Processes forked while it is installed inherit a
+    copy that moves with their own reads."""
+
+    def __init__(self, step: float = 1e-3) -> None:
+        self.step = step
+        self.now = 1000.0
+
+    def __call__(self) -> float:
+        self.now += self.step
+        return self.now
+
+    def advance(self, seconds: float) -> None:
+        """Let ``seconds`` pass (work that takes time without reading the clock)."""
+        self.now += seconds
+
+
+@pytest.fixture
+def virtual_clock(monkeypatch: pytest.MonkeyPatch) -> Iterator[VirtualClock]:
+    """A :class:`VirtualClock` installed as ``time.perf_counter`` for the test."""
+    clock = VirtualClock()
+    monkeypatch.setattr(time, "perf_counter", clock)
+    yield clock

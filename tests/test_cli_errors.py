@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
+
+import pytest
 
 
 def _run(*args: str) -> subprocess.CompletedProcess[str]:
@@ -63,3 +66,37 @@ def test_a_failed_reactive_plan_exits_1_and_leaves_no_stale_figure(tmp_path) -> 
     )
     assert short.returncode == 1, short.stdout + short.stderr
     assert '"status": "incomplete"' in (tmp_path / "plan.json").read_text()
+
+
+@pytest.mark.parametrize(
+    ("package", "args"),
+    [
+        ("mujoco", ["quadruped", "--cycles", "1", "--no-video"]),
+        ("shapely", ["terrain", "from-heightmap", "MAP", "--resolution", "0.02"]),
+    ],
+)
+def test_a_missing_optional_package_exits_2_naming_the_extra(
+    tmp_path: Path, package: str, args: list[str]
+) -> None:
+    """Nothing ran and the message says what to install: like bad input, exit 2 (not 1, a run
+    that failed)."""
+    import os
+
+    import numpy as np
+
+    blocked = tmp_path / "blocked" / package
+    blocked.mkdir(parents=True)
+    (blocked / "__init__.py").write_text(f"raise ImportError('{package} blocked for this test')\n")
+    np.save(tmp_path / "map.npy", np.random.default_rng(0).normal(0.0, 1e-3, (20, 20)))
+    args = [str(tmp_path / "map.npy") if a == "MAP" else a for a in args]
+    # the blocked package first, then whatever path the tests run with (a worktree's src)
+    path = os.pathsep.join(p for p in (str(blocked.parent), os.environ.get("PYTHONPATH")) if p)
+    env = os.environ | {"PYTHONPATH": path}
+    r = subprocess.run(
+        [sys.executable, "-m", "footfall", *args, "--out", str(tmp_path / "out.yaml")],
+        capture_output=True, text=True, timeout=120, env=env,
+    )  # fmt: skip
+    assert r.returncode == 2, r.stdout + r.stderr
+    lines = [line for line in r.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and "Traceback" not in r.stderr, r.stderr
+    assert "pip install" in lines[0] and "footfall[" in lines[0], lines[0]

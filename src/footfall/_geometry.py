@@ -84,6 +84,28 @@ def convexity_defect(vertices: FloatArray) -> str | None:
     return None
 
 
+def drop_collinear(vertices: FloatArray, tol: float) -> FloatArray:
+    """The polygon (V, 2) without the vertices that lie within ``tol`` [m] of the line through
+    their two neighbours (collinear or repeated vertices), removed one at a time, the nearest to
+    its line first, until none is left or three vertices remain.
+
+    Removing a vertex of a convex polygon leaves a polygon inside it; the region rows built from
+    the result (eq. 5.18) then have no zero-length or duplicate edge."""
+    v = np.asarray(vertices, dtype=float)
+    while v.shape[0] > 3:
+        prev, nxt = np.roll(v, 1, axis=0), np.roll(v, -1, axis=0)
+        chord = nxt - prev
+        cross = chord[:, 0] * (v[:, 1] - prev[:, 1]) - chord[:, 1] * (v[:, 0] - prev[:, 0])
+        length = np.linalg.norm(chord, axis=1)
+        # distance to the chord's line; a vertex whose neighbours coincide is a spike: drop it
+        dist = np.where(length > 0.0, np.abs(cross) / np.where(length > 0.0, length, 1.0), 0.0)
+        j = int(np.argmin(dist))
+        if dist[j] > tol:
+            break
+        v = np.delete(v, j, axis=0)
+    return v
+
+
 def outward_halfspaces(vertices: FloatArray) -> tuple[FloatArray, FloatArray]:
     """Half-spaces ``A q <= b`` of a convex CCW polygon (V, 2) (eq. 5.18).
 
@@ -137,10 +159,14 @@ def polygon_distance(p: FloatArray, q: FloatArray) -> float:
         return 0.0
     best = np.inf
     for poly, other in ((p, q), (q, p)):
-        nxt = np.roll(other, -1, axis=0)
-        for v in poly:
-            for a, b in zip(other, nxt, strict=True):
-                best = min(best, point_segment_distance(v, a, b))
+        # every vertex of poly against every edge a -> b of other at once (point_segment_distance)
+        a = np.asarray(other, dtype=float)
+        ab = np.roll(a, -1, axis=0) - a
+        ap = np.asarray(poly, dtype=float)[:, None, :] - a[None, :, :]
+        denom = np.einsum("ej,ej->e", ab, ab)
+        t = np.einsum("vej,ej->ve", ap, ab) / np.where(denom > 0.0, denom, 1.0)
+        t = np.where(denom > 0.0, np.clip(t, 0.0, 1.0), 0.0)
+        best = min(best, float(np.min(np.linalg.norm(ap - t[..., None] * ab, axis=2))))
     return float(best)
 
 

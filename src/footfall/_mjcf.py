@@ -3,10 +3,23 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from footfall._validate import check_fields, non_negative, positive
+from footfall.errors import MissingExtraError
+
+
+def require_mujoco() -> Any:
+    """Import MuJoCo (the ``sim`` extra) or raise a MissingExtraError saying how to install it."""
+    try:
+        import mujoco
+    except ImportError as exc:
+        raise MissingExtraError(
+            f"MuJoCo is required: pip install 'footfall[sim]' ({exc})"
+        ) from None
+    return mujoco
 
 
 def fmt(*values: float | np.floating, digits: int = 6) -> str:

@@ -27,6 +27,15 @@ def non_negative(field: str, value: object) -> float:
     return v
 
 
+def in_range(field: str, value: object, lo: float, hi: float, unit: str) -> float:
+    """Return ``value`` as a float after checking it is a finite number in ``[lo, hi]``: the
+    physical range of a parameter, outside which the models overflow or underflow."""
+    v = finite(field, value)
+    if not lo <= v <= hi:
+        raise InputError(field, value, f"a number in [{lo:g}, {hi:g}] {unit}".rstrip())
+    return v
+
+
 def finite(field: str, value: object) -> float:
     """Return ``value`` as a float after checking it is a finite real number (not bool)."""
     if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
@@ -57,6 +66,18 @@ def finite_vector(field: str, value: object, length: int | None = None) -> NDArr
         raise InputError(field, value, f"exactly {length} numbers")
     if arr.shape[0] == 0:
         raise InputError(field, value, "at least one number")
+    if not np.all(np.isfinite(arr)):
+        raise InputError(field, value, "finite numbers (no NaN or inf)")
+    return arr
+
+
+def finite_array(field: str, value: object) -> NDArray[np.float64]:
+    """Return ``value`` as a float array (any shape) after checking every entry is a finite
+    number: a NaN or inf given to a model would come back as NaN results, not as an error."""
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InputError(field, value, "finite numbers") from None
     if not np.all(np.isfinite(arr)):
         raise InputError(field, value, "finite numbers (no NaN or inf)")
     return arr

@@ -25,7 +25,7 @@ from footfall.experiments.study import (
 from footfall.experiments.study import stats as st
 from footfall.experiments.study import store as store_mod
 from footfall.experiments.study.design import MAX_TRIALS, study_from_dict
-from footfall.experiments.study.store import TrialStore
+from footfall.experiments.study.store import TrialStore, read_rows
 from footfall.experiments.study.trials import normalise_row
 
 Z95 = 1.959963984540054  # standard normal quantile at 0.975
@@ -510,21 +510,25 @@ def test_store_round_trip(tmp_path: Path) -> None:
     assert str(table.schema.field("n_steps").type) == "int64"
 
 
-def test_store_flushes_part_files_as_rows_arrive_and_a_crash_keeps_them(
+def test_every_row_is_on_disk_when_added_and_a_crash_keeps_them(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setattr(store_mod, "FLUSH_ROWS", 2)
+    """A finished walk is reported done after its row was added: the row must already be on
+    disk (rows used to wait for 25 rows or 10 s, so a crash lost 3 of 5 finished walks)."""
+    monkeypatch.setattr(store_mod, "COMPACT_PARTS", 3)
     d = _design()
     rows = _rows(5)
     s = TrialStore(tmp_path, d)
-    for r in rows:
+    for k, r in enumerate(rows):
         s.add(r)
-    assert len(list((tmp_path / "trials.parts").glob("part-*.parquet"))) == 2  # 2 + 2 rows
-    # no close (a crash): a new store sees the flushed rows, not the pending one
-    s2 = TrialStore(tmp_path, d)
-    assert set(s2.rows) == {r["key"] for r in rows[:4]}
-    s2.add(rows[4])
-    s2.close()
+        # no close (a crash right after the walk was reported): a new store sees every row
+        assert set(TrialStore(tmp_path, d).rows) == {r["key"] for r in rows[: k + 1]}
+    # 3 parts were merged into the table, the last 2 rows are parts
+    assert len(list((tmp_path / "trials.parts").glob("part-*.parquet"))) == 2
+    assert {r["key"] for r in read_rows(tmp_path / "trials.parquet")} == {
+        r["key"] for r in rows[:3]
+    }
+    s.close()
     assert set(TrialStore(tmp_path, d).rows) == {r["key"] for r in rows}
     assert not (tmp_path / "trials.parts").exists()
 
@@ -571,4 +575,14 @@ def test_store_refuses_a_damaged_table_or_meta(tmp_path: Path) -> None:
     (tmp_path / "study.json").write_text("{not json")
     with pytest.raises(InputError) as e:
         TrialStore(tmp_path, d)
+    assert e.value.field == "study folder"
+
+
+@pytest.mark.parametrize("meta", ['{"fingerprint": 3}', '{"fingerprint": ["seeds"]}', "[1, 2]"])
+def test_store_refuses_an_edited_meta_with_one_line(tmp_path: Path, meta: str) -> None:
+    """A study.json that is JSON but not the store's (a fingerprint that is not a mapping) is an
+    InputError naming it, not a TypeError from comparing the fingerprints."""
+    (tmp_path / "study.json").write_text(meta)
+    with pytest.raises(InputError) as e:
+        TrialStore(tmp_path, _design())
     assert e.value.field == "study folder"

@@ -22,6 +22,7 @@ from footfall.errors import InputError
 from footfall.planning import PlannerOptions, make_plan, plan_min_steps
 from footfall.planning.bounds import (
     SLACK,
+    BackwardSets,
     ForwardSets,
     bucket_bounds,
     footstep_sets,
@@ -380,6 +381,27 @@ def test_shared_reachable_sets_give_the_same_bound_and_members() -> None:
         np.testing.assert_array_equal(a.segments, b.segments)
         np.testing.assert_array_equal(a.regions, b.regions)
         assert not a.segments[1 : n - 1].all() and not a.regions[1 : n - 1].all()
+
+
+def test_backward_sets_shared_between_n_and_cut_short_by_a_deadline_give_the_same_members() -> None:
+    """The smallest-N search keeps the backward sets of every N it tried (two chains, one per
+    side of the goal foot) and may stop computing them at a deadline: the members of each N are
+    those computed from scratch for it alone."""
+    import time
+
+    sc = builtin_scene("stairs_slope_gap")
+    options = PlannerOptions()
+    backward = BackwardSets(sc, sc.robot, options)
+    with pytest.raises(TimeoutError):
+        live_members(
+            sc, sc.robot, options, 13, deadline=time.perf_counter() - 1.0, backward=backward
+        )
+    for n in (11, 12, 13, 14):
+        shared = live_members(sc, sc.robot, options, n, backward=backward)
+        alone = live_members(sc, sc.robot, options, n)
+        np.testing.assert_array_equal(shared.segments, alone.segments)
+        np.testing.assert_array_equal(shared.regions, alone.regions)
+    assert {len(chain) for chain in backward.chains.values()} == {12, 13}  # levels 0..N - 2
 
 
 def test_members_of_another_problem_are_bad_input() -> None:

@@ -121,6 +121,21 @@ def test_plane_height_of_a_tilted_plane() -> None:
             assert _plane_height(corners, np.array([x, y])) == pytest.approx(z(x, y), abs=1e-12)
 
 
+def test_plane_height_with_collinear_corners() -> None:
+    """A height map's polygon may start with three collinear corners (a vertex on a straight
+    edge): the plane through them is undefined, the plane through the polygon is not. Exactly
+    collinear corners and ones a round-off off the line give the tilted plane's height."""
+
+    def z(x: float, y: float) -> float:
+        return 0.1 + 0.2 * x - 0.15 * y
+
+    for wobble in (0.0, 1e-13):
+        xy = [(1.0, 1.0), (2.0, 1.0 + wobble), (3.0, 1.0), (3.0, 2.0), (1.0, 2.0)]
+        corners = np.array([[x, y, z(x, y)] for x, y in xy])
+        for x, y in [(2.0, 1.5), (1.0, 1.0), (-1.0, 4.0)]:
+            assert _plane_height(corners, np.array([x, y])) == pytest.approx(z(x, y), abs=1e-12)
+
+
 def test_single_support_simulation_matches_the_closed_form() -> None:
     """c(t) = p + (c0 - p) cosh(w t) + v0 / w sinh(w t) about the CoP p of a constant torque."""
     robot = _base("stones")[0].robot

@@ -110,3 +110,23 @@ def test_invalid_yaml_names_the_line(tmp_path: Path) -> None:
     res = run("plan", str(bad), "--steps", "5", "--out", str(tmp_path))
     assert res.returncode == 2
     assert "line" in res.stderr and "height" in res.stderr
+
+
+def test_a_plan_the_checker_rejects_exits_1(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An optimal plan that the independent checker rejects is a failed run, not a success."""
+    from typer.testing import CliRunner
+
+    import footfall.planning as planning
+    from footfall.cli import app
+    from footfall.planning.check import CheckReport, Violation
+
+    rejected = CheckReport((Violation("region", 2, 0.0917, "9.17e-02 m off the plane"),), 0.0)
+    monkeypatch.setattr(planning, "check_plan", lambda plan, scene: rejected)
+    scene_file = tmp_path / "flat.yaml"
+    scene_file.write_text(SHORT_FLAT)
+    res = CliRunner().invoke(app, ["plan", str(scene_file), "--steps", "3", "--out", str(tmp_path)])
+    assert res.exit_code == 1, res.output
+    data = json.loads((tmp_path / "plan.json").read_text())
+    assert data["status"] == "optimal" and data["check"]["ok"] is False

@@ -149,6 +149,54 @@ def test_plan_on_recovered_discrete_steps_passes_the_checker_and_stands_on_the_r
         assert dz and min(dz) <= MAX_HEIGHT_ERROR, p
 
 
+#: tilted blocks on a floor (x0, y0, width, depth, slope x, slope y, height) [m]: the outline of
+#: the third, 10 deg tilted, once kept a vertex on a straight edge, its first three corners
+#: collinear (the checker then saw a plan on it 9 cm off its plane)
+TILTED_BLOCKS = [
+    (0.886, 0.566, 0.506, 0.414, -0.178, -0.047, 0.123),
+    (0.05, 0.034, 0.7, 0.561, -0.106, -0.026, 0.292),
+    (0.987, 0.591, 0.457, 0.497, 0.071, -0.176, 0.167),
+]
+
+
+def _tilted_blocks() -> HeightMap:
+    ys, xs = np.mgrid[0:60, 0:80] * 0.02
+    z = np.zeros(xs.shape)
+    for x0, y0, w, h, sx, sy, z0 in TILTED_BLOCKS:
+        b = (xs >= x0) & (xs < x0 + w) & (ys >= y0) & (ys < y0 + h)
+        z[b] = z0 + sx * (xs[b] - x0) + sy * (ys[b] - y0)
+    return HeightMap(z, 0.02, (0.0, 0.0))
+
+
+def test_regions_have_no_collinear_vertices_and_the_checker_sees_their_planes() -> None:
+    from footfall.planning.check import _plane_height
+
+    result = regions_from_heightmap(_tilted_blocks())
+    assert any(r.slope_deg > 5.0 for r in result.regions)
+    for r in result.regions:
+        v = r.vertices
+        prev, nxt = np.roll(v, 1, axis=0), np.roll(v, -1, axis=0)
+        chord = nxt - prev
+        cross = chord[:, 0] * (v[:, 1] - prev[:, 1]) - chord[:, 1] * (v[:, 0] - prev[:, 0])
+        off_line = np.abs(cross) / np.linalg.norm(chord, axis=1)
+        assert off_line.min() > 1e-6, (r.name, v.tolist())  # a 2 cm map: corners are cells apart
+        for p in np.vstack([v, r.centroid[None, :2]]):  # the checker's plane is the region's
+            assert _plane_height(r.vertices3d, p) == pytest.approx(r.height_at(p), abs=1e-9)
+
+
+def test_drop_collinear_removes_exactly_the_vertices_on_straight_edges() -> None:
+    from footfall._geometry import drop_collinear
+
+    hexagon = np.array([[np.cos(a), np.sin(a)] for a in np.arange(6) * np.pi / 3])
+    # midpoints on three edges (one a round-off off its edge) and a repeated corner
+    mid = 0.5 * (hexagon + np.roll(hexagon, -1, axis=0))
+    mid[2] += 1e-13
+    noisy = np.vstack([hexagon[0], mid[0], hexagon[1], hexagon[2], mid[2], hexagon[3],
+                       hexagon[3], hexagon[4], mid[4], hexagon[5]])  # fmt: skip
+    np.testing.assert_array_equal(drop_collinear(noisy, 1e-9), hexagon)
+    np.testing.assert_array_equal(drop_collinear(hexagon, 1e-9), hexagon)  # nothing to drop
+
+
 # ============================================================================= decomposition
 L_SHAPE = [(0.0, 0.0), (1.0, 0.0), (1.0, 0.4), (0.4, 0.4), (0.4, 1.0), (0.0, 1.0)]
 

@@ -14,7 +14,13 @@ import sys
 import time
 
 from footfall.cli._common import _say_error, app
-from footfall.errors import FootfallError, InputError, Stopped
+from footfall.errors import (
+    FootfallError,
+    InputError,
+    MissingExtraError,
+    SolverUnavailableError,
+    Stopped,
+)
 
 
 def _end_children() -> None:
@@ -48,7 +54,9 @@ def main() -> None:
     """Entry point of the ``footfall`` console script.
 
     Exit codes: 0 success, 1 a run that failed (no plan, a solver error, a fall reported as a
-    failure), 2 bad input (:class:`footfall.errors.InputError`), 128 + the signal number when
+    failure), 2 bad input (:class:`footfall.errors.InputError`) or a missing optional package
+    (:class:`~footfall.errors.MissingExtraError`, :class:`~footfall.errors.SolverUnavailableError`:
+    nothing ran, the message says what to install), 128 + the signal number when
     stopped by SIGINT (130) or SIGTERM (143), after ending every worker process. Errors footfall
     raises are printed as one line, never as a traceback.
     """
@@ -58,7 +66,7 @@ def main() -> None:
         signal.signal(signum, _on_signal)
     try:
         app()
-    except InputError as exc:
+    except (InputError, MissingExtraError, SolverUnavailableError) as exc:
         _say_error("error", str(exc))
         sys.exit(2)
     except FootfallError as exc:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -70,6 +70,40 @@ def output_folder(out: Path) -> Path:
     if not os.access(out, os.W_OK | os.X_OK):
         raise InputError("out", str(out), "a folder this user may write to")
     return out
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` name one file (the same inode when ``b`` exists: links and
+    symlinks included; the same resolved path when it does not)."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return a.resolve() == b.resolve()
+
+
+def refuse_inputs_as_outputs(
+    inputs: Sequence[str | Path | None], outputs: Mapping[str, Iterable[Path]]
+) -> None:
+    """Refuse, before any work, an output path that is one of the command's input files.
+
+    Args:
+        inputs: the files the command reads (a string that names no existing file, such as a
+            built-in scene name, and None are skipped).
+        outputs: per option (``"out"``, ``"log_json"``), the files the command will write.
+
+    Raises:
+        InputError: naming the option, the output path and the input it would replace.
+    """
+    files = [Path(i) for i in inputs if i is not None and Path(i).is_file()]
+    for field, paths in outputs.items():
+        for path in paths:
+            for source in files:
+                if _same_file(source, Path(path)):
+                    raise InputError(
+                        field,
+                        str(path),
+                        f"a path that is not an input of this command (it would replace {source})",
+                    )
 
 
 def parse_floats(field: str, text: str) -> list[float]:

@@ -58,6 +58,7 @@ class ProgressLog:
         self.start = time.perf_counter()
         self.logged_at = -math.inf
         self.json: IO[str] | None = None
+        self.json_path = str(json_path)
         if json_path is not None:
             try:
                 self.json = json_path.open("w", encoding="utf-8")
@@ -68,11 +69,20 @@ class ProgressLog:
         self.status: Any = None
 
     def __enter__(self) -> ProgressLog:
+        # the first JSON line is written before any work: a file that cannot take it (a full
+        # disk, /dev/full) is bad input, refused before the planning starts
+        try:
+            self._write({"event": "start", "what": self.title})
+        except OSError as e:
+            self._close()
+            raise InputError(
+                "log_json", self.json_path, f"a file that can be written ({e.strerror})"
+            ) from None
         if self.terminal and not self.quiet:
             self.status = console.status(f"planning {self.title} ...")
             self.status.__enter__()
         # without a terminal the log says what it is about (a command may plan several times)
-        self._emit({"event": "start", "what": self.title}, f"planning {self.title}", False)
+        self._emit(None, f"planning {self.title}", False)
         return self
 
     def __exit__(
@@ -83,8 +93,15 @@ class ProgressLog:
     ) -> None:
         if self.status is not None:
             self.status.__exit__(kind, exc, tb)
+        self._close()
+
+    def _close(self) -> None:
         if self.json is not None:
-            self.json.close()
+            try:
+                self.json.close()
+            except OSError:  # what could not be flushed was reported when it was written
+                pass
+            self.json = None
 
     # --- the SearchMonitor interface ------------------------------------------------------------
     def skipped(self, first: int, last: int, reason: str) -> None:
@@ -152,13 +169,26 @@ class ProgressLog:
         self._emit(record, None)
 
     # --- output -----------------------------------------------------------------------------------
-    def _emit(self, record: dict[str, Any], text: str | None, permanent: bool = True) -> None:
-        """Write ``record`` to the JSON lines and ``text`` as a plain line (``permanent``: also
-        above the status line in a terminal; otherwise only without one)."""
-        elapsed = time.perf_counter() - self.start
+    def _write(self, record: dict[str, Any]) -> None:
+        """One JSON line, flushed (a reader following the file sees each line as it happens)."""
         if self.json is not None:
+            elapsed = time.perf_counter() - self.start
             self.json.write(json.dumps({"elapsed": round(elapsed, 3), **record}) + "\n")
-            self.json.flush()  # a reader following the file sees each line as it happens
+            self.json.flush()
+
+    def _emit(
+        self, record: dict[str, Any] | None, text: str | None, permanent: bool = True
+    ) -> None:
+        """Write ``record`` to the JSON lines and ``text`` as a plain line (``permanent``: also
+        above the status line in a terminal; otherwise only without one). A JSON line that
+        cannot be written (the disk filled up) ends the JSON log with one warning; the planning
+        goes on."""
+        if record is not None:
+            try:
+                self._write(record)
+            except OSError as e:
+                self._close()
+                console.print(f"warning: --log-json {self.json_path}: {e.strerror}; log stopped")
         if text is None or self.quiet or (self.status is not None and not permanent):
             return
-        console.print(f"[{elapsed:7.1f} s] {text}")
+        console.print(f"[{time.perf_counter() - self.start:7.1f} s] {text}")

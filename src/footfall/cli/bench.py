@@ -6,13 +6,14 @@ from pathlib import Path
 
 import typer
 
-from footfall._io import write_json
+from footfall._io import remove_outputs, write_json, write_text
 from footfall.cli._common import (
     _threads,
     app,
     console,
     output_folder,
     parse_floats,
+    refuse_inputs_as_outputs,
 )
 from footfall.errors import InputError
 
@@ -68,8 +69,9 @@ def bench_plan_cmd(
         ),
     )
     table = format_table(rows)
+    remove_outputs(out, "bench_plan.json", "bench_plan.md")  # no file of another run beside ours
     write_json(out / "bench_plan.json", {"runs": rows_to_dict(rows)})
-    (out / "bench_plan.md").write_text(table + "\n")
+    write_text(out / "bench_plan.md", table + "\n")
     print(table)
 
 
@@ -112,6 +114,7 @@ def bench_sim_cmd(
                 "nodes", nodes, "comma-separated integers >= 2 or 'plan', e.g. plan,10"
             )
     sc = resolve_scene(scene)
+    refuse_inputs_as_outputs([scene], {"out": [out / "bench_sim.json", out / "bench_sim.md"]})
     output_folder(out)
     plan = make_plan(sc, planner, None, PlannerOptions(threads=_threads(None)))
     if not plan.has_solution:
@@ -120,25 +123,30 @@ def bench_sim_cmd(
         raise InfeasibleError(f"{planner} found no plan for {sc.name}: {plan.message}")
     rows = bench_sim(plan, k_list, runs=runs, options=bench_sim_options(rate))
     table = format_sim_table(rows)
+    remove_outputs(out, "bench_sim.json", "bench_sim.md")  # no file of another run beside ours
     write_json(
         out / "bench_sim.json",
         {"scene": sc.name, "planner": planner, "rows": sim_speed_to_dict(rows)},
     )
-    (out / "bench_sim.md").write_text(table + "\n")
+    write_text(out / "bench_sim.md", table + "\n")
     print(table)
 
 
 @bench_app.command("quadruped")
 def bench_quadruped_cmd(
     slope_deg: float = typer.Option(15.0, help="Slope angle [deg]."),
-    body_deg: float = typer.Option(10.0, help="Body angle [deg]."),
+    body_deg: float | None = typer.Option(
+        None, help="Body angle [deg]; default: two thirds of the slope (10 on 15)."
+    ),
     out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_quadruped.json."),
 ) -> None:
     """Quadruped slope walk: simulated s per wall s vs bare mj_step, and gait-plan time."""
+    from footfall.cli.simulation import default_body_deg
     from footfall.experiments.bench import benchmark_quadruped
 
     output_folder(out)
-    result = benchmark_quadruped(slope_deg=slope_deg, body_deg=body_deg)
+    body = default_body_deg(slope_deg) if body_deg is None else body_deg
+    result = benchmark_quadruped(slope_deg=slope_deg, body_deg=body)
     write_json(out / "bench_quadruped.json", result)
     for key, value in result.items():
         console.print(f"{key}: {value}")

@@ -9,7 +9,7 @@ from typing import Any
 import typer
 from rich.console import Console
 
-from footfall._io import write_json
+from footfall._io import remove_outputs, write_json, write_text
 from footfall.cli._common import (
     _THREADS_HELP,
     ROBOT_HELP,
@@ -18,6 +18,7 @@ from footfall.cli._common import (
     console,
     output_folder,
     parse_floats,
+    refuse_inputs_as_outputs,
 )
 from footfall.cli._progress import ProgressLog
 from footfall.errors import InputError
@@ -84,6 +85,7 @@ def lip(
     params = lip_params(example, **{k: v for k, v in given.items() if v is not None})
     title = "LIP walk" if example is None else f"LIP walk: {example} (document 004)"
     walk = lip_walk(params)
+    remove_outputs(out, "lip_walk.json", "lip_walk.png")  # no file of another run beside ours
     write_json(out / "lip_walk.json", lip_walk_to_dict(walk, dt))
     plot_lip_walk(walk, out / "lip_walk.png", title=title)
     speed = math.hypot(*walk.final_vel)
@@ -125,8 +127,10 @@ def scenes_command(
     from footfall.viz.terrain_plot import plot_scene
 
     scene = resolve_scene(show)
+    refuse_inputs_as_outputs([show], {"out": [out / "scene.yaml", out / "scene.png"]})
     output_folder(out)
-    (out / "scene.yaml").write_text(scene_to_yaml(scene))
+    remove_outputs(out, "scene.yaml", "scene.png")  # no file of another run beside ours
+    write_text(out / "scene.yaml", scene_to_yaml(scene))
     plot_scene(scene, out / "scene.png")
     console.print(f"wrote {out / 'scene.png'} and {out / 'scene.yaml'}")
 
@@ -149,7 +153,11 @@ def plan(
     ),
     min_steps: bool = typer.Option(False, help="Search the smallest feasible N."),
     planner: str = typer.Option("miqcqp", help="miqcqp, kinematic or reactive."),
-    time_limit: float = typer.Option(60.0, help="Solver time limit per solve [s]."),
+    time_limit: float = typer.Option(
+        60.0,
+        help="Time limit of the solve [s]; in the smallest-N search, of each N tried (its checks "
+        "before the solve included).",
+    ),
     gap: float = typer.Option(1e-4, help="Relative optimality gap at which to stop."),
     solver: str = typer.Option(
         "bnb", help="Backend: bnb (fast exact, default), scip (direct model) or gurobi."
@@ -187,17 +195,24 @@ def plan(
         "and while a solve runs, at most one every 5 s), with or without a terminal.",
     ),
 ) -> None:
-    """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists.
+    """Plan footsteps over a scene; writes plan.json and plan.png. Exit 1 when no plan exists or
+    the independent checker rejects the plan.
 
     Progress: a status line in a terminal; without one, a plain line on stderr per N tried and at
     most every 5 s while a solve runs."""
     from footfall.planning import PlannerOptions, check_plan, make_plan, plan_min_steps
+    from footfall.planning.check import unexpected_violations
     from footfall.planning.plan import check_planner_name
     from footfall.terrain.resolve import resolve_scene_arguments
     from footfall.viz.plan_plot import plot_plan
 
     check_planner_name(planner)
     sc = resolve_scene_arguments(scene_file, scene)
+    outputs = {
+        "out": [out / "plan.json", out / "plan.png"],
+        "log_json": [log_json] if log_json else [],
+    }
+    refuse_inputs_as_outputs([scene_file, scene], outputs)
     output_folder(out)
     if steps is not None and min_steps:
         raise InputError("steps", steps, "no --steps with --min-steps (which searches N)")
@@ -220,23 +235,29 @@ def plan(
             result = make_plan(sc, planner, steps, options, robot_params, solve_progress=hook)
         log.done(result)
     payload = result.to_dict(sc.name)
-    checked = True
+    unexpected: list[Any] = []
     if result.has_solution:
         report = check_plan(result, sc)
-        checked = report.ok
+        # a kinematic plan over U_max is what that planner makes; anything else is a failure
+        unexpected = unexpected_violations(report, result)
         payload["check"] = {"ok": report.ok, "violations": report.summary().splitlines()}
+    remove_outputs(out, "plan.json", "plan.png")  # no file of an earlier run beside ours
     write_json(out / "plan.json", payload)
     if result.has_solution:
         plot_plan(result, sc, out / "plan.png")
-    else:  # no figure of an earlier run beside this run's plan.json
-        (out / "plan.png").unlink(missing_ok=True)
     console.print(
         f"{sc.name}: {planner} -> {result.status.value}, {result.n_steps} steps, "
         f"objective {result.objective:.4g}, {result.solve_time:.2f} s. {result.message}"
     )
     console.print(f"wrote {out / 'plan.json'}" + (" and plan.png" if result.has_solution else ""))
-    if not checked:
-        console.print("the plan violates the checker's constraints (see plan.json 'check')")
+    if unexpected:
+        # a plan the independent checker rejects is not a plan to walk: a failed run
+        console.print(
+            f"the plan violates the checker's constraints: {unexpected[0].describe()}"
+            + (f" and {len(unexpected) - 1} more" if len(unexpected) > 1 else "")
+            + " (see plan.json 'check')"
+        )
+        raise typer.Exit(1)
     if not result.reaches_goal:
         raise typer.Exit(1)
 
@@ -258,6 +279,7 @@ def check_command(
 
     sc = resolve_scene_arguments(scene_file, scene)
     if out is not None:
+        refuse_inputs_as_outputs([plan_file, scene_file, scene], {"out": [out / "check.json"]})
         output_folder(out)
     result = load_plan(plan_file, sc)
     report = check_plan(result, sc)

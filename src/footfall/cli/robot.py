@@ -6,7 +6,8 @@ from pathlib import Path
 
 import typer
 
-from footfall.cli._common import app, console, output_folder
+from footfall._io import remove_outputs, write_text
+from footfall.cli._common import app, console, output_folder, refuse_inputs_as_outputs
 
 robot_app = typer.Typer(
     help="Robots from their URDF or MJCF: inspect a model, write its robot file.",
@@ -37,12 +38,15 @@ def inspect_command(
     OUT/robot.yaml (which `--robot OUT/robot.yaml` takes as it is) and the figure OUT/robot.png."""
     from footfall.robots.inspect import inspect_robot, plot_inspection, robot_file_text
 
+    files = ("robot.yaml", "robot.png")
+    refuse_inputs_as_outputs([model, config], {"out": [out / f for f in files]})
     output_folder(out)
     with console.status(f"inspecting {model} ..."):
         ins = inspect_robot(model, config, name)
     for line in ins.lines():
         console.print(line)
     path = out / "robot.yaml"
-    path.write_text(robot_file_text(ins.robot, out))
+    remove_outputs(out, *files)  # this run's files replace the last run's as a set
+    write_text(path, robot_file_text(ins.robot, out))
     fig = plot_inspection(ins, out / "robot.png")
     console.print(f"wrote {path}, {fig}")

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from footfall._io import write_json
+from footfall._io import remove_outputs, write_json
 from footfall.cli._common import (
     _THREADS_HELP,
     ROBOT_HELP,
@@ -28,6 +28,7 @@ from footfall.cli._common import (
     console,
     disturbance_of,
     output_folder,
+    refuse_inputs_as_outputs,
 )
 from footfall.cli._progress import ProgressLog
 from footfall.errors import InputError
@@ -50,6 +51,7 @@ def demo(out: Path = typer.Option(Path("out/demo"), help="Output folder.")) -> N
     """Run the main demo on built-in defaults and write figures and JSON into OUT."""
     from footfall.experiments.demo import run_demo
 
+    output_folder(out)
     labels = {
         "lip": "LIP walks (document 004)",
         "plans": "footstep plans (document 000)",
@@ -71,7 +73,8 @@ def quadruped_cmd(
     ),
     body_deg: float | None = typer.Option(
         None,
-        help="Body angle beta_B to the horizontal [deg], between 0 and the slope. [default: 10]",
+        help="Body angle beta_B to the horizontal [deg], between 0 and the slope. [default: two "
+        "thirds of the slope, the compromise posture: 10 on 15, -10 on -15]",
     ),
     step: float | None = typer.Option(None, help="Step length S along the slope [m]. [0.4]"),
     height: float | None = typer.Option(None, help="Swing height H normal to the slope [m]. [0.1]"),
@@ -109,13 +112,16 @@ def quadruped_cmd(
     if video:
         # must be chosen before MuJoCo is imported; EGL works headless here
         os.environ.setdefault("MUJOCO_GL", "egl")
+    from footfall._mjcf import require_mujoco
+
+    require_mujoco()  # before any work: a missing extra is one line, exit 2
     from footfall.experiments.slope_walk import compare_strategies, plan_strategies
     from footfall.quadruped import QuadrupedRobot
     from footfall.sim.quadruped.mjcf import SimSettings
     from footfall.sim.quadruped.sim import simulate
     from footfall.sim.quadruped.slip import SLIP_ACTIONS, SlipGuard
     from footfall.sim.replay import REPLAY_FILE, ReplayRecorder, quadruped_traces
-    from footfall.viz.quadruped_plots import save_walk_figures
+    from footfall.viz.quadruped_plots import WALK_FIGURES, save_walk_figures
 
     if controller not in ("servo", "wbc"):
         raise InputError("--controller", controller, "servo or wbc")
@@ -148,14 +154,19 @@ def quadruped_cmd(
             settings = SimSettings(friction=sc.friction)
         label = sc.name
     else:
+        slope = 15.0 if slope_deg is None else slope_deg
         params = _slope_params(
-            15.0 if slope_deg is None else slope_deg,
-            10.0 if body_deg is None else body_deg,
+            slope,
+            default_body_deg(slope) if body_deg is None else body_deg,
             (step, height, cycles, swing_period, shift_period),
             "osp" if strategy is None else strategy,
         )
         label = f"{math.degrees(params.slope):g}°/{math.degrees(params.body_pitch):g}°"
+    outputs = ["quadruped.json", "quadruped.mp4", REPLAY_FILE, *WALK_FIGURES]
+    refuse_inputs_as_outputs([scene], {"out": [out / name for name in outputs]})
     output_folder(out)
+    # this run's files replace the last run's as a set: none of theirs is left beside ours
+    remove_outputs(out, *outputs)
     plans, infeasible = plan_strategies(QuadrupedRobot(), params, compare)
     plan = plans[params.strategy]
     console.print(f"simulating {params.cycles} cycles on {label} ({plan.duration:.1f} s)...")
@@ -214,6 +225,14 @@ def quadruped_cmd(
     console.print(f"wrote {out / 'quadruped.json'} and {REPLAY_FILE}")
     if m.fell:
         raise typer.Exit(1)
+
+
+def default_body_deg(slope_deg: float) -> float:
+    """The body angle [deg] that follows a slope of ``slope_deg`` [deg] when none is given: the
+    compromise posture (``BODY_RATIO`` of the slope, so downhill is negative too)."""
+    from footfall.quadruped.gait import BODY_RATIO
+
+    return BODY_RATIO * slope_deg if math.isfinite(slope_deg) else slope_deg
 
 
 def _slope_params(
@@ -533,7 +552,13 @@ def walk_cmd(
     )
     model = robot_model(robot)
     sc = resolve_scene_arguments(scene_file, scene)
+    files = ("plan.json", "walk.json", "walk.png", "walk.mp4", REPLAY_FILE)
+    logs = [log_json] if log_json else []
+    refuse_inputs_as_outputs(
+        [scene_file, scene], {"out": [out / f for f in files], "log_json": logs}
+    )
     output_folder(out)
+    remove_outputs(out, *files)  # no file of an earlier run beside this run's
     with ProgressLog(f"{sc.name} with {planner} for the {robot}", quiet, log_json) as log:
         plan = plan_for_walk(
             sc,

@@ -7,12 +7,14 @@ import math
 import os
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import typer
 
-from footfall.cli._common import app, console, output_folder
+from footfall._io import write_text
+from footfall.cli._common import app, console, output_folder, refuse_inputs_as_outputs
 from footfall.errors import FootfallError, InputError
 
 if TYPE_CHECKING:
@@ -64,7 +66,7 @@ def study_command(
         if study_file is not None
         else builtin_study("quick" if quick else str(builtin))
     )
-    run_design(design, out, executor, workers, address, limit, quiet)
+    run_design(design, out, executor, workers, address, limit, quiet, inputs=[study_file])
 
 
 def run_design(
@@ -75,9 +77,12 @@ def run_design(
     address: str | None,
     limit: int | None,
     quiet: bool,
+    inputs: Sequence[Path | None] = (),
 ) -> None:
     """Run ``design`` into ``out`` with progress lines, write the report and say the verdict
-    (``footfall study`` and its presets, such as ``footfall compare``)."""
+    (``footfall study`` and its presets, such as ``footfall compare``). ``inputs``: the files
+    the command read besides the design's scene and robot files (the study file); none of them
+    may be an output."""
     from footfall.experiments.study import run_study, write_report
     from footfall.planning.plan import available_cores
 
@@ -85,6 +90,12 @@ def run_design(
         workers = available_cores()
     if limit is not None and limit < 0:
         raise InputError("--limit", limit, "an integer >= 0")
+    from footfall.experiments.study.report import report_names
+    from footfall.experiments.study.store import META, TABLE
+
+    names = [TABLE, META, "run.json", *report_names(design)]
+    read = [*inputs, *design.scenes, design.robot]
+    refuse_inputs_as_outputs(read, {"out": [out / name for name in names]})
     output_folder(out)
     # small matrices run fastest single-threaded; spawned workers and Ray workers read this
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -144,7 +155,8 @@ def run_design(
     summary, paths = write_report(out, design, run.rows, run.plans, header)
     for line in summary.verdict:
         console.print(line)
-    (out / "run.json").write_text(
+    write_text(
+        out / "run.json",
         json.dumps(
             {
                 "executor": executor,
@@ -156,7 +168,7 @@ def run_design(
                 "rows": len(run.rows),
             },
             indent=1,
-        )
+        ),
     )
     console.print(f"wrote {out / 'trials.parquet'}, " + ", ".join(str(p) for p in paths))
     missing = [p for p in run.plans if not p.plan.has_solution]

@@ -8,7 +8,14 @@ from pathlib import Path
 
 import typer
 
-from footfall.cli._common import app, console, output_folder, parse_floats
+from footfall._io import remove_outputs, write_text
+from footfall.cli._common import (
+    app,
+    console,
+    output_folder,
+    parse_floats,
+    refuse_inputs_as_outputs,
+)
 from footfall.errors import InputError
 
 terrain_app = typer.Typer(
@@ -85,6 +92,9 @@ def from_heightmap(
         raise InputError(
             "out", str(out), "a file path for the scene YAML (a folder of that name exists)"
         )
+    if out.suffix.lower() == ".png":
+        raise InputError("out", str(out), "a .yaml path (the figure goes beside it as .png)")
+    refuse_inputs_as_outputs([map_file], {"out": [out, out.with_suffix(".png")]})
     output_folder(out.parent if str(out.parent) else Path("."))
     options = HeightmapOptions(
         max_slope_deg=max_slope,
@@ -111,7 +121,8 @@ def from_heightmap(
     elapsed = time.perf_counter() - t0
     text = scene_to_yaml(scene)
     load_scene(text)  # the file must pass the scene loader's own validation
-    out.write_text(text)
+    remove_outputs(out.parent, out.name, out.with_suffix(".png").name)  # no mixed runs
+    write_text(out, text)
     figure = plot_heightmap_regions(result, out.with_suffix(".png"), scene)
     h, w = hm.shape
     spikes = int(result.spikes.sum())

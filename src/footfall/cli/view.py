@@ -9,7 +9,7 @@ from pathlib import Path
 
 import typer
 
-from footfall.cli._common import app, console
+from footfall.cli._common import app, console, refuse_inputs_as_outputs
 from footfall.errors import InputError
 
 
@@ -56,6 +56,8 @@ def view_command(
         raise InputError("screenshot", str(screenshot), "a path in an existing folder")
     if not path.exists():  # before anything starts
         raise InputError("path", str(path), "an existing file or folder that footfall wrote")
+    if screenshot is not None:
+        refuse_inputs_as_outputs([path, scene], {"screenshot": [screenshot]})
     # serve first: a browser loads the page while the planner's modules are imported and the
     # files read and drawn into it
     server = start_server(host, 0 if screenshot is not None else port)

@@ -65,7 +65,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.linalg.lapack import dposv, dpotrf, dtrtri
 
 from footfall._typing import FloatArray
-from footfall._validate import finite, positive
+from footfall._validate import finite, instance_of, positive
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
 
@@ -348,6 +348,7 @@ def build_mpc(
     Returns:
         The precomputed :class:`CondensedMPC`.
     """
+    instance_of("robot", robot, BipedParams, "a BipedParams (footfall.models.biped)")
     weights = weights or MPCWeights()
     if not isinstance(weights, MPCWeights):
         raise InputError("weights", weights, "an MPCWeights")

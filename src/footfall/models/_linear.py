@@ -7,6 +7,25 @@ from scipy.linalg import expm
 
 from footfall._typing import FloatArray
 from footfall._validate import positive
+from footfall.errors import InputError
+
+#: largest ``|lambda| dt`` of a discretisation: ``exp`` overflows a float beyond ~709
+MAX_EXPONENT = 700.0
+
+
+def check_horizon(field: str, rate: float, dt: float) -> None:
+    """Refuse a period ``dt`` [s] over which a mode of growth ``rate`` [1/s] (the largest
+    eigenvalue magnitude) overflows a float (``exp(rate dt)``, cosh, sinh), instead of
+    returning inf or NaN matrices."""
+    if rate * abs(dt) > MAX_EXPONENT:
+        limit = f"at most {MAX_EXPONENT / rate:.4g} s (longer overflows exp(|eigenvalue| dt))"
+        raise InputError(field, dt, limit)
+
+
+def finite_matrices(field: str, dt: float, *mats: FloatArray) -> None:
+    """Refuse ``dt`` when a matrix computed for it is not finite (an overflow)."""
+    if not all(np.all(np.isfinite(m)) for m in mats):
+        raise InputError(field, dt, "a shorter period (the matrices overflow)")
 
 
 def zoh(a: FloatArray, b: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
@@ -25,11 +44,13 @@ def zoh(a: FloatArray, b: FloatArray, dt: float) -> tuple[FloatArray, FloatArray
         ``(Ad, Bd)`` of shapes (n, n) and (n, m).
     """
     dt = positive("dt", dt)
+    check_horizon("dt", float(np.max(np.abs(np.linalg.eigvals(a)))), dt)
     n, m = b.shape
     aug = np.zeros((n + m, n + m))
     aug[:n, :n] = a
     aug[:n, n:] = b
     e = expm(aug * dt)
+    finite_matrices("dt", dt, e)
     return e[:n, :n].copy(), e[:n, n:].copy()
 
 

@@ -35,8 +35,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.linalg import expm
 
 from footfall._typing import FloatArray
-from footfall._validate import finite_vector, positive
-from footfall.models._linear import LinearModel
+from footfall._validate import finite_array, finite_vector, positive
+from footfall.models._linear import LinearModel, check_horizon, finite_matrices
 from footfall.models.lip import GRAVITY
 
 #: index slices into the ALIP state
@@ -112,11 +112,13 @@ class ALIP(LinearModel):
             ``p+ - p-`` [m] and its z column is zero.
         """
         t_ds = positive("t_ds", t_ds)
+        check_horizon("t_ds", self.omega, t_ds)
         m = np.zeros((10, 10))
         m[:4, :4] = self.A
         m[:4, 4:7] = self.E
         m[4:7, 7:10] = np.eye(3)
         e = expm(m * t_ds)
+        finite_matrices("t_ds", t_ds, e)
         a_r = e[:4, :4].copy()
         b_r = e[:4, 7:10] / t_ds
         # Re-express the CoM position relative to the new stance foot: the -I block (see module doc).
@@ -125,7 +127,7 @@ class ALIP(LinearModel):
 
     def velocity(self, x: ArrayLike) -> NDArray[np.float64]:
         """CoM horizontal velocity ``(L_y, -L_x) / (m z_H)`` [m/s] of states ``x`` (..., 4)."""
-        xx = np.asarray(x, dtype=float)
+        xx = finite_array("x", x)
         mzh = self.mass * self.com_height
         return np.stack([xx[..., 3] / mzh, -xx[..., 2] / mzh], axis=-1)
 
@@ -141,13 +143,13 @@ class ALIP(LinearModel):
 
     def zmp(self, stance: ArrayLike, u: ArrayLike) -> NDArray[np.float64]:
         """Zero-moment point ``stance + (-tau_y, tau_x) / (m g)`` [m] for torques ``u`` (..., 2)."""
-        s = np.asarray(stance, dtype=float)[..., :2]
-        uu = np.asarray(u, dtype=float)
+        s = finite_array("stance", stance)[..., :2]
+        uu = finite_array("u", u)
         mg = self.mass * self.g
         return s + np.stack([-uu[..., 1], uu[..., 0]], axis=-1) / mg
 
     def torque_for_zmp(self, offset: ArrayLike) -> NDArray[np.float64]:
         """Ankle torque ``(m g d_y, -m g d_x)`` [N m] that puts the ZMP at ``offset`` (..., 2) [m]."""
-        d = np.asarray(offset, dtype=float)
+        d = finite_array("offset", offset)
         mg = self.mass * self.g
         return np.stack([mg * d[..., 1], -mg * d[..., 0]], axis=-1)

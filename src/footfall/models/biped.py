@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike
 
 from footfall._geometry import convexity_defect, outward_halfspaces, signed_area
 from footfall._typing import FloatArray
-from footfall._validate import check_fields, positive
+from footfall._validate import in_range
 from footfall.errors import InputError
 from footfall.models.alip import ALIP
 from footfall.models.lip import GRAVITY
@@ -121,6 +121,23 @@ class ReachTrapezoid:
 
 #: most ALIP nodes K per single support (the problem grows linearly in K; the document uses 5)
 MAX_NODES = 50
+#: physical range of each parameter (and its unit): a 10 g toy to a 100 t machine. Beyond it the
+#: models' products underflow or overflow (m z_H squared is 0 for m = 1e-300)
+RANGES: dict[str, tuple[float, float, str]] = {
+    "mass": (1e-2, 1e5, "kg"),
+    "com_height": (1e-2, 1e2, "m"),
+    "t_ss": (1e-3, 60.0, "s"),
+    "t_ds": (1e-3, 60.0, "s"),
+    "u_max": (1e-6, 1e7, "N m"),
+    "stance_width": (1e-4, 1e2, "m"),
+    "step_height_max": (1e-6, 1e2, "m"),
+    "foot_length": (1e-4, 1e2, "m"),
+    "foot_width": (1e-4, 1e2, "m"),
+    "g": (1e-2, 1e3, "m/s^2"),
+}
+#: longest single or double support in time constants 1 / omega = sqrt(z_H / g) (the ALIP's
+#: matrices hold cosh(omega T): beyond ~20 its foot placement has no significant digit left)
+MAX_TIME_CONSTANTS = 20.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -159,22 +176,18 @@ class BipedParams:
     g: float = GRAVITY
 
     def __post_init__(self) -> None:
-        check_fields(
-            self,
-            positive,
-            (
-                "mass",
-                "com_height",
-                "t_ss",
-                "t_ds",
-                "u_max",
-                "stance_width",
-                "step_height_max",
-                "foot_length",
-                "foot_width",
-                "g",
-            ),
-        )
+        for name, (lo, hi, unit) in RANGES.items():
+            object.__setattr__(self, name, in_range(name, getattr(self, name), lo, hi, unit))
+        omega = math.sqrt(self.g / self.com_height)
+        for name in ("t_ss", "t_ds"):
+            if omega * getattr(self, name) > MAX_TIME_CONSTANTS:
+                longest = MAX_TIME_CONSTANTS / omega
+                raise InputError(
+                    name,
+                    getattr(self, name),
+                    f"at most {longest:.3g} s ({MAX_TIME_CONSTANTS:g} time constants "
+                    "sqrt(com_height / g) of this robot)",
+                )
         n = self.n_nodes
         if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 2 <= n <= MAX_NODES:
             raise InputError(

@@ -18,8 +18,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from footfall._typing import FloatArray
-from footfall._validate import positive
-from footfall.models._linear import LinearModel
+from footfall._validate import finite_array, positive
+from footfall.models._linear import LinearModel, check_horizon
 
 #: standard gravity [m/s^2]
 GRAVITY = 9.81
@@ -77,11 +77,13 @@ class LIP(LinearModel):
         Returns:
             ``(pos, vel)`` each of shape (T, d) (or (d,) for scalar ``t``).
         """
-        x0 = np.asarray(pos0, dtype=float)
-        v0 = np.asarray(vel0, dtype=float)
-        p = np.asarray(foot, dtype=float)
-        tt = np.asarray(t, dtype=float)
+        x0 = finite_array("pos0", pos0)
+        v0 = finite_array("vel0", vel0)
+        p = finite_array("foot", foot)
+        tt = finite_array("t", t)
         tc = self.Tc
+        if tt.size:
+            check_horizon("t", 1.0 / tc, float(np.max(np.abs(tt))))
         c = np.cosh(tt / tc)[..., None]
         s = np.sinh(tt / tc)[..., None]
         pos = (x0 - p) * c + tc * v0 * s + p
@@ -95,9 +97,9 @@ class LIP(LinearModel):
 
         It is conserved along every LIP trajectory (Kajita eq. 4.21).
         """
-        x = np.asarray(pos, dtype=float)
-        v = np.asarray(vel, dtype=float)
-        p = np.asarray(foot, dtype=float)
+        x = finite_array("pos", pos)
+        v = finite_array("vel", vel)
+        p = finite_array("foot", foot)
         return np.asarray(0.5 * v**2 - self.g / (2.0 * self.z_c) * (x - p) ** 2)
 
     def sample_step(

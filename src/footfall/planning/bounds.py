@@ -54,6 +54,7 @@ problems shrink by about a third and their searches by 3-20x, ``benchmarks/RESUL
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from functools import partial
@@ -168,6 +169,32 @@ class _Setup:
     feet: dict[Side, FloatArray]
     #: memo of :func:`_both_frames_step`
     pair_steps: dict[tuple[Side, int, int], FloatArray | None] = field(default_factory=dict)
+    #: the regions' boxes (lower and upper corners, (R, 2)) and height ranges ((R,) each)
+    boxes: tuple[FloatArray, FloatArray, FloatArray, FloatArray] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        # the regions' bounding boxes and height ranges as arrays: a set is tested against all
+        # of them at once (a scene may hold 1000 regions; a loop per region and set was most of
+        # the search's time), and only the regions it can meet are cut
+        n = len(self.region_poly)
+        lo, hi = np.full((n, 2), np.inf), np.full((n, 2), -np.inf)
+        for r, poly in enumerate(self.region_poly):
+            if poly.shape[0]:
+                lo[r], hi[r] = poly.min(axis=0), poly.max(axis=0)
+        zr = np.array(self.z_range, dtype=float).reshape(n, 2)
+        zr[~np.isfinite(zr).all(axis=1)] = 0.0  # an empty region: its infinite box excludes it
+        object.__setattr__(self, "boxes", (lo, hi, zr[:, 0], zr[:, 1]))
+
+    def regions_near(
+        self, lo: FloatArray, hi: FloatArray, z_lo: float, z_hi: float, dz: float
+    ) -> NDArray[np.int64]:
+        """Indices (ascending) of the non-empty regions whose box comes within ``SLACK`` of the
+        box ``[lo, hi]`` [m] and whose height range within ``dz`` [m] of ``[z_lo, z_hi]``: every
+        region a set in that box can meet within a step height (a superset)."""
+        r_lo, r_hi, rz_lo, rz_hi = self.boxes
+        gap_z = np.maximum(0.0, np.maximum(rz_lo - z_hi, z_lo - rz_hi))
+        ok = np.all(r_lo <= hi + SLACK, axis=1) & np.all(r_hi >= lo - SLACK, axis=1) & (gap_z <= dz)
+        return np.flatnonzero(ok)
 
 
 def _setup(scene: Scene, robot: BipedParams, options: PlannerOptions, horizon: int) -> _Setup:
@@ -234,6 +261,12 @@ def _near(poly: FloatArray, x: FloatArray) -> bool:
     return distance_to_convex(x, poly) <= SLACK
 
 
+def _regions_at(s: _Setup, x: FloatArray) -> list[int]:
+    """The regions (their polygons with the margin) within ``SLACK`` of the point ``x`` [m]."""
+    near = s.regions_near(x, x, -math.inf, math.inf, math.inf)
+    return [int(r) for r in near if _near(s.region_poly[r], x)]
+
+
 _Sets = dict[tuple[int, int], FloatArray]
 
 
@@ -257,10 +290,13 @@ def _first_sets(s: _Setup, robot: BipedParams, both: bool) -> _Sets:
         reach = s.p0 + step
         if s.swing is not None:
             reach = clip_rows(reach, *_shifted_rows(s.swing, s.swing_from))
-        for r, (a, rhs) in enumerate(s.region_rows):
-            if _gap(s.z0, s.z0, *s.z_range[r]) > robot.step_height_max + SLACK:
-                continue
-            piece = clip_rows(reach, a, rhs)
+        if reach.shape[0] == 0:
+            continue
+        near = s.regions_near(
+            reach.min(axis=0), reach.max(axis=0), s.z0, s.z0, robot.step_height_max + SLACK
+        )
+        for r in near:
+            piece = clip_rows(reach, *s.region_rows[r])
             if piece.shape[0]:
                 out[(b, r)] = convex_hull(piece)
     return out
@@ -316,19 +352,14 @@ def _next_sets(
 def _cuts(s: _Setup, robot: BipedParams, r: int, moved: FloatArray) -> list[tuple[int, FloatArray]]:
     """The non-empty parts ``(r2, moved ∩ region r2)`` of the regions a footstep in region ``r``
     can step to (height ranges within ``step_height_max``)."""
-    lo_m, hi_m = moved.min(axis=0), moved.max(axis=0)
+    near = s.regions_near(
+        moved.min(axis=0), moved.max(axis=0), *s.z_range[r], robot.step_height_max + SLACK
+    )
     out = []
-    for r2, (a, rhs) in enumerate(s.region_rows):
-        poly = s.region_poly[r2]
-        if poly.shape[0] == 0:
-            continue
-        if _gap(*s.z_range[r], *s.z_range[r2]) > robot.step_height_max + SLACK:
-            continue
-        if np.any(poly.min(axis=0) > hi_m + SLACK) or np.any(poly.max(axis=0) < lo_m - SLACK):
-            continue
-        cut = clip_rows(moved, a, rhs)
+    for r2 in near:
+        cut = clip_rows(moved, *s.region_rows[r2])
         if cut.shape[0]:
-            out.append((r2, cut))
+            out.append((int(r2), cut))
     return out
 
 
@@ -362,7 +393,7 @@ def _goal_reached(
     side_a, side_b = s.sides[n - 1], s.sides[n]
     g_a, g_b = s.feet[side_a], s.feet[side_b]
     tg = s.theta_goal
-    regions_b = [r for r, poly in enumerate(s.region_poly) if poly.shape[0] and _near(poly, g_b)]
+    regions_b = _regions_at(s, g_b)
     if s.swing is not None and not any(_near(minkowski_sum(p, s.swing), g_b) for p in before):
         return False
     for (b, r), piece in sets.items():
@@ -459,6 +490,7 @@ def reachable_steps_bound(
     options: PlannerOptions,
     horizon: int,
     forward: ForwardSets | None = None,
+    deadline: float = math.inf,
 ) -> StepsBound:
     """The smallest N in 2..``horizon`` that the reachable sets do not rule out (module
     docstring), or ``horizon + 1`` if they rule out all of them.
@@ -471,6 +503,8 @@ def reachable_steps_bound(
         horizon: the largest N to examine (the work grows linearly with it).
         forward: the reachable sets of these arguments to use (and extend), e.g. shared with
             :func:`live_members`; its horizon must be at least ``horizon``.
+        deadline: ``time.perf_counter()`` value past which :class:`TimeoutError` is raised
+            (between two footsteps' sets; those computed are kept in ``forward``).
 
     Returns:
         A :class:`StepsBound`; every N below ``n_steps`` has no plan in the planner's model.
@@ -485,6 +519,7 @@ def reachable_steps_bound(
         forward = ForwardSets(scene, robot, options, horizon)
     forward.check_reaches(horizon)
     for i, sets, goal in forward.upto(horizon - 1):
+        _check_clock(deadline)
         n = i + 1  # footstep N - 1 = i must be the goal foot
         if not sets:
             return StepsBound(horizon + 1, horizon, f"no footstep {i} can be placed: {what}")
@@ -509,37 +544,66 @@ def _meet(p: FloatArray, q: FloatArray) -> bool:
     return True
 
 
-def _backward_sets(s: _Setup, robot: BipedParams, both: bool, n_steps: int) -> list[_Sets]:
-    """``B_i`` for i = 1..N - 2 (index i - 1): for each heading bucket and region, a convex
-    polygon holding every position of footstep ``i`` from which the goal feet can still be
-    reached by the reach, heading-rate, step-height and region rows (swings dropped: a
-    superset). ``B_{N-1}`` is the goal foot, at the goal heading."""
-    side_a = s.sides[n_steps - 1]
-    g_a = s.feet[side_a]
-    cur: _Sets = {}
-    for b in range(len(s.lo)):
-        if not s.lo[b] - ANGLE_SLACK <= s.theta_goal <= s.hi[b] + ANGLE_SLACK:
-            continue
-        for r, poly in enumerate(s.region_poly):
-            if poly.shape[0] and _near(poly, g_a):
-                cur[(b, r)] = g_a[None, :]
-    out: list[_Sets] = []
-    for i in range(n_steps - 2, 0, -1):
-        side = s.sides[i]
+class BackwardSets:
+    """The backward sets of :func:`live_members`, computed as far as asked and kept.
+
+    ``B`` at ``j`` steps before the goal foot (footstep N - 1) depends on N only through the
+    goal foot's side: level ``j`` holds, per heading bucket and region, a convex polygon with
+    every position of footstep ``N - 1 - j`` from which the goal feet can still be reached by
+    the reach, heading-rate, step-height and region rows (swings dropped: a superset). So the
+    smallest-N search extends two chains (one per side of the goal foot) instead of computing
+    every N's sets anew; a level cut short by a deadline is dropped, the finished ones kept."""
+
+    def __init__(self, scene: Scene, robot: BipedParams, options: PlannerOptions) -> None:
+        self.s = _setup(scene, robot, options, 1)
+        self.robot = robot
+        self.both = options.reach_both_frames
+        #: per side of the goal foot: level 0 (the goal foot at the goal heading), 1, 2, ...
+        self.chains: dict[Side, list[_Sets]] = {}
+
+    def levels(self, side_a: Side, count: int, deadline: float = math.inf) -> list[_Sets]:
+        """Levels 1..``count`` of the chain whose goal foot is on ``side_a``.
+
+        Raises:
+            TimeoutError: ``time.perf_counter()`` passed ``deadline`` first.
+        """
+        s = self.s
+        chain = self.chains.get(side_a)
+        if chain is None:
+            g_a = s.feet[side_a]
+            goal: _Sets = {}
+            for b in range(len(s.lo)):
+                if s.lo[b] - ANGLE_SLACK <= s.theta_goal <= s.hi[b] + ANGLE_SLACK:
+                    for r in _regions_at(s, g_a):
+                        goal[(b, r)] = g_a[None, :]
+            chain = self.chains[side_a] = [goal]
+        while len(chain) <= count:
+            # level j is footstep N - 1 - j, whose stance side alternates from the goal foot's
+            side = side_a if len(chain) % 2 == 0 else side_a.other
+            chain.append(self._step_back(chain[-1], side, deadline))
+        return chain[1 : count + 1]
+
+    def _step_back(self, cur: _Sets, side: Side, deadline: float) -> _Sets:
+        """The sets one footstep before ``cur``, whose stance foot is on ``side``."""
+        s, robot = self.s, self.robot
         gathered: dict[tuple[int, int], list[FloatArray]] = {}
         for (b2, r2), piece in cur.items():
+            _check_clock(deadline)
             for b in range(len(s.lo)):
                 if _gap(s.lo[b], s.hi[b], s.lo[b2], s.hi[b2]) > robot.theta_max + ANGLE_SLACK:
                     continue
-                step = _both_frames_step(s, side, b, b2) if both else s.step[side][b]
+                step = _both_frames_step(s, side, b, b2) if self.both else s.step[side][b]
                 if step is None:
                     continue
                 for r, cut in _cuts(s, robot, r2, minkowski_sum(piece, -step)):
                     gathered.setdefault((b, r), []).append(cut)
-        cur = {key: convex_hull(np.vstack(parts)) for key, parts in gathered.items()}
-        out.append(cur)
-    out.reverse()
-    return out
+        return {key: convex_hull(np.vstack(parts)) for key, parts in gathered.items()}
+
+
+def _check_clock(deadline: float) -> None:
+    """Raise :class:`TimeoutError` once ``time.perf_counter()`` has passed ``deadline``."""
+    if time.perf_counter() > deadline:
+        raise TimeoutError("the reachable sets were not complete within the time limit")
 
 
 @dataclass(frozen=True)
@@ -562,6 +626,8 @@ def live_members(
     options: PlannerOptions,
     n_steps: int,
     forward: ForwardSets | None = None,
+    deadline: float = math.inf,
+    backward: BackwardSets | None = None,
 ) -> LiveMembers:
     """The heading segments (eq. 5.12g-h) and regions (5.12i-j) each free footstep ``1..N-2`` of
     an ``n_steps`` plan can use: a pair (segment bucket, region) is live at footstep ``i`` when
@@ -569,27 +635,37 @@ def live_members(
     positions from which the goal feet can still be reached in ``N - 1 - i`` steps by the same
     rows. Both are supersets of what the model allows, so a member that is not live is used by
     no plan of the model: fixing its binary to 0 leaves the feasible set (and the optimum) as it
-    is. The goal feet (footsteps N - 1 and N) and footstep 0 are left live. ``forward``: the
-    reachable sets of these arguments to reuse (:class:`ForwardSets`).
+    is. The goal feet (footsteps N - 1 and N) and footstep 0 are left live. ``forward`` and
+    ``backward``: the reachable sets of these arguments to reuse (:class:`ForwardSets`,
+    :class:`BackwardSets`).
+
+    Raises:
+        TimeoutError: ``time.perf_counter()`` passed ``deadline`` before the sets were complete
+            (the members are an optimisation: a caller out of time solves without them).
     """
     check_planning_arguments(scene, robot, options)
     check_n_steps(n_steps)
-    s = _setup(scene, robot, options, n_steps)
-    both = options.reach_both_frames
     n_seg = options.heading_segments
     n_reg = len(scene.terrain)
     segments = np.ones((n_steps + 1, n_seg), dtype=bool)
     regions = np.ones((n_steps + 1, n_reg), dtype=bool)
     if n_steps < 3:
         return LiveMembers(segments, regions)
-    backward = _backward_sets(s, robot, both, n_steps)
+    if backward is None:
+        backward = BackwardSets(scene, robot, options)
+    side_a = scene.start.stance if n_steps % 2 == 1 else scene.start.stance.other
+    # B_i for i = 1..N - 2 (index i - 1): level N - 1 - i of the goal foot's chain
+    bwd_sets = backward.levels(side_a, n_steps - 2, deadline)[::-1]
     firsts, lasts = _bucket_segments(n_seg)
     if forward is None:
         forward = ForwardSets(scene, robot, options, n_steps)
     forward.check_reaches(n_steps)
-    fwd_sets = {i: sets for i, sets, _ in forward.upto(n_steps - 2)}
+    fwd_sets = {}
+    for i, sets, _ in forward.upto(n_steps - 2):  # each level is kept: a later call goes on
+        fwd_sets[i] = sets
+        _check_clock(deadline)
     for i in range(1, n_steps - 1):
-        fwd, bwd = fwd_sets.get(i, {}), backward[i - 1]
+        fwd, bwd = fwd_sets.get(i, {}), bwd_sets[i - 1]
         live = [key for key, piece in fwd.items() if key in bwd and _meet(piece, bwd[key])]
         seg = np.zeros(n_seg, dtype=bool)
         for b, _ in live:

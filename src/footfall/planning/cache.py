@@ -27,7 +27,7 @@ import numpy as np
 from footfall._io import write_json
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
-from footfall.planning.check import check_plan
+from footfall.planning.check import check_plan, unexpected_violations
 from footfall.planning.plan import FootstepPlan, PlannerOptions
 from footfall.planning.run import SearchMonitor, make_plan
 from footfall.terrain.scene import Scene, robot_to_dict, scene_to_dict
@@ -139,8 +139,19 @@ class PlanCache:
         plan = FootstepPlan.from_dict(data, robot, source=str(path))
         return dataclasses.replace(plan, message=plan.message + " (loaded from cache)")
 
+    def check_writable(self, key: str) -> None:
+        """Refuse, before any planning, a cache whose file of ``key`` could not be written: the
+        folder is a file, or the file's path is a folder (or another non-file)."""
+        folder, path = Path(self.folder), self.path(key)
+        if folder.exists() and not folder.is_dir():
+            raise InputError(
+                "plan cache folder", str(folder), "a folder (a file of that name exists)"
+            )
+        if path.exists() and not path.is_file():
+            raise InputError("plan cache file", str(path), "a regular file or nothing (remove it)")
+
     def save(self, key: str, plan: FootstepPlan, scene_name: str = "") -> Path:
-        """Write ``plan`` under ``key``; returns the path."""
+        """Write ``plan`` under ``key`` (atomically); returns the path."""
         payload = plan.to_dict(scene_name)
         payload["cache_key"] = key
         return write_json(self.path(key), payload)
@@ -158,16 +169,18 @@ def cached_plan(
     """:func:`footfall.planning.make_plan`, served from ``cache`` when it holds the plan
     (``monitor`` hears of a smallest-N search that runs, :func:`~footfall.planning.run.plan_min_steps`).
 
-    Only plans with footsteps are stored: a failed search is made again next time (it may have
-    hit a time limit). A cached plan is re-checked before use (:func:`cache_mismatch`): one that
-    an edited or damaged file broke (or that is no longer a valid plan file at all) is
-    discarded, planned again (the file is overwritten) and the new plan's message says so.
+    Only plans with footsteps that pass their re-check are stored: a failed search is made
+    again next time (it may have hit a time limit). A cached plan is re-checked in full before
+    use (:func:`cache_mismatch`): one that an edited or damaged file broke (or that is no longer
+    a valid plan file at all) is discarded, planned again (the file is overwritten) and the new
+    plan's message says so.
     """
     options = options or PlannerOptions()
     robot = robot if robot is not None else scene.robot
     key = plan_key(scene, planner, n_steps, options, robot)
     discarded = ""
     if cache is not None:
+        cache.check_writable(key)  # before the planning, whose plan would be lost
         try:
             hit = cache.load(key, robot)
         except InputError as exc:  # a damaged file is a miss: plan again and overwrite it
@@ -179,29 +192,36 @@ def cached_plan(
             discarded = f" (cached plan {cache.path(key).name} discarded: {problem}; planned again)"
     plan = make_plan(scene, planner, n_steps, options, robot, monitor=monitor)
     if cache is not None and plan.has_solution:
-        cache.save(key, plan, scene.name)
+        # a plan its own re-check would refuse is not stored: it would be discarded every time
+        problem = cache_mismatch(plan, scene, n_steps)
+        if not problem:
+            try:
+                cache.save(key, plan, scene.name)
+            except OSError as e:  # a full disk: the plan is still returned, uncached
+                problem = f"{cache.path(key)}: {e.strerror}"
+        if problem:
+            discarded += f" (not cached: {problem})"
     if discarded:
         plan = dataclasses.replace(plan, message=plan.message + discarded)
     return plan
-
-
-#: the checker's violations that no planner's output has, so a cached plan showing one was
-#: altered after it was made (a kinematic plan may exceed U_max and a reactive one stop short of
-#: the goal by design, so torque and goal are not among them)
-CACHE_RECHECK = ("start", "alternation", "region")
 
 
 def cache_mismatch(plan: FootstepPlan, scene: Scene, n_steps: int | None) -> str:
     """Why a cached ``plan`` cannot be the one asked for on ``scene`` ("" when it can).
 
     It must have footsteps (only those are stored), ``n_steps`` of them when N was asked for,
-    start from the scene's stance foot and keep every footstep on its region
-    (:func:`footfall.planning.check_plan`, the kinds of :data:`CACHE_RECHECK`).
+    and pass every check of the independent checker (:func:`footfall.planning.check_plan`:
+    start, regions, reach, step height, swing, heading rate, torque, the re-simulated ALIP
+    dynamics, goal) but those its planner makes by design
+    (:func:`~footfall.planning.check.unexpected_violations`): any other violation means the file
+    was altered (or the plan was never valid).
     """
     if not plan.has_solution:
         return "no footsteps"
     if n_steps is not None and plan.n_steps != n_steps:
         return f"{plan.n_steps} footsteps where N = {n_steps} was asked for"
-    report = check_plan(plan, scene)
-    bad = [v for v in report.violations if v.kind in CACHE_RECHECK]
-    return bad[0].describe() if bad else ""
+    bad = unexpected_violations(check_plan(plan, scene), plan)
+    if not bad:
+        return ""
+    more = f" (and {len(bad) - 1} more violation(s))" if len(bad) > 1 else ""
+    return bad[0].describe() + more

@@ -37,6 +37,8 @@ from footfall.models.lip import GRAVITY, LIP
 #: longest support phase, in time constants T_c: cosh(20) = 2.4e8 still leaves the foot placement
 #: (differences of such terms) about 8 significant digits in double precision
 MAX_SUPPORT_TIME_CONSTANTS = 20
+#: most CoM samples of :meth:`LipWalk.com_trajectory` (a JSON of ~100 MB; 1 ms over 16 min)
+MAX_SAMPLES = 1_000_000
 
 
 @dataclass(frozen=True)
@@ -167,6 +169,9 @@ class LipWalk:
             ``step`` (T,) the index of the support phase each sample belongs to.
         """
         dt = positive("dt", dt)
+        if self.duration / dt > MAX_SAMPLES:  # refused before an array of that size is made
+            shortest = self.duration / MAX_SAMPLES
+            raise InputError("dt", dt, f"at least {shortest:.3g} s (at most {MAX_SAMPLES} samples)")
         t_sup = self.params.t_sup
         n = self.footholds.shape[0]
         t = np.arange(0.0, self.duration + 0.5 * dt, dt)

@@ -94,7 +94,9 @@ class PlannerOptions:
         solver: backend name: ``bnb`` (default: footfall's exact branch and bound for this
             problem, falls back to SCIP for other structures), ``scip`` (the direct model on
             SCIP), ``gurobi`` (optional).
-        time_limit: solver wall-time limit [s].
+        time_limit: solver wall-time limit [s]; in the smallest-N search
+            (:func:`~footfall.planning.run.plan_min_steps`) each N tried gets this long, its
+            checks before the solve included.
         gap: relative optimality gap at which the solver stops.
         threads: solver threads; for ``bnb``, the forked worker processes that solve node
             relaxations in parallel (1, the default: the serial search in the calling process, so
@@ -260,6 +262,8 @@ class FootstepPlan:
         if feet.ndim != 2 or feet.shape[1] != 3:
             raise InputError("plan.footsteps", f"shape {feet.shape}", "shape (N + 1, 3)")
         rows = feet.shape[0]
+        if rows > MAX_STEPS + 1:  # no planner makes more; the checker's work grows with them
+            raise InputError("plan.footsteps", f"{rows} footsteps", f"at most {MAX_STEPS + 1}")
         headings = np.asarray(self.headings, dtype=float)
         if headings.shape != (rows,):
             raise InputError("plan.headings", f"shape {headings.shape}", f"shape ({rows},)")
@@ -537,6 +541,8 @@ def _plan_from_dict(data: object, robot: BipedParams, source: str) -> FootstepPl
     n = len(steps) - 1
     if n < 0:
         return _empty_from_dict(data, status, robot)
+    if n > MAX_STEPS:  # refused before any work per footstep
+        raise bad("footsteps", f"{n + 1} footsteps", f"at most {MAX_STEPS + 1} (N <= {MAX_STEPS})")
     k = robot.n_nodes
     sides = r.sides(steps)
     alip = get(data, "alip", "alip")

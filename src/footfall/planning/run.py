@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import replace
@@ -11,6 +12,7 @@ from typing import Protocol
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams
 from footfall.planning.bounds import (
+    BackwardSets,
     ForwardSets,
     LiveMembers,
     StepsBound,
@@ -21,6 +23,7 @@ from footfall.planning.diagnose import min_steps_lower_bound
 from footfall.planning.plan import (
     FootstepPlan,
     PlannerOptions,
+    check_n_steps,
     check_planner_name,
     check_planning_arguments,
     result_meta,
@@ -36,6 +39,8 @@ BOUND_HORIZON = 40
 FEASIBILITY_GAP = 1.0
 #: most seconds a kinematic feasibility solve may take (it only pays when it proves quickly)
 KINEMATIC_CHECK_LIMIT = 30.0
+#: share of each N's time limit the live members may take before the solve goes on without them
+MEMBERS_SHARE = 0.5
 
 
 def make_plan(
@@ -68,6 +73,8 @@ def make_plan(
     """
     check_planning_arguments(scene, robot, options)
     check_planner_name(planner)
+    if n_steps is not None:
+        check_n_steps(n_steps)
     options = options or PlannerOptions()
     if members is not None and (planner != "miqcqp" or n_steps is None):
         raise InputError("members", "given", "only with the miqcqp planner and a given N")
@@ -182,7 +189,12 @@ def plan_min_steps(
     horizon = n_max if n_max is not None else distance + BOUND_HORIZON
     # the reachable sets serve the bound and every N's live members (computed as far as needed)
     forward = ForwardSets(scene, robot, options, horizon + MIN_STEPS_SPAN + 1)
-    bound = reachable_steps_bound(scene, robot, options, horizon, forward)
+    backward = BackwardSets(scene, robot, options)
+    try:  # within the time limit of one N: a bound that takes longer than a solve does not pay
+        deadline = time.perf_counter() + options.time_limit
+        bound = reachable_steps_bound(scene, robot, options, horizon, forward, deadline)
+    except TimeoutError:
+        bound = StepsBound(distance, horizon, "distance and heading")
     start = max(distance, bound.n_steps)
     skipped = _skipped(distance, start, bound)
     n_max = n_max if n_max is not None else start + MIN_STEPS_SPAN
@@ -197,23 +209,32 @@ def plan_min_steps(
     precheck = planner == "miqcqp"
     for n in range(start, n_max + 1):
         t0 = time.perf_counter()
+        # options.time_limit bounds each N as a whole: its live members, its kinematic check and
+        # its solve share it (a small limit was overrun 10-25 times by the work before the solve)
+        deadline = t0 + options.time_limit
         proof = "solver"
         plan = None
         members = None
         if planner == "miqcqp":
-            members = live_members(scene, robot, options, n, forward)
-            plan = _members_proof(planner, robot, options, n, members)
-            if plan is not None:
-                proof = "reachable sets"
-        if plan is None and precheck:
+            # at most a share of the N's time: the solve keeps the rest (the sets computed are
+            # kept for the next N, so a search on a large terrain still gets its members)
+            sets_deadline = t0 + MEMBERS_SHARE * options.time_limit
+            try:
+                members = live_members(scene, robot, options, n, forward, sets_deadline, backward)
+            except TimeoutError:  # an optimisation only: the solve goes on without it
+                members = None
+            else:
+                plan = _members_proof(planner, robot, options, n, members)
+                if plan is not None:
+                    proof = "reachable sets"
+        if plan is None and precheck and time.perf_counter() < deadline:
             hook = _hook(monitor, n, "kinematic relaxation")
-            plan = _kinematic_proof(scene, robot, n, options, hook, members)
+            plan = _kinematic_proof(scene, robot, n, options, hook, members, deadline)
             precheck = plan is not None
             if plan is not None:
                 proof = "kinematic relaxation"
         if plan is None:
-            hook = _hook(monitor, n, planner)
-            plan = make_plan(scene, planner, n, options, robot, hook, members=members)
+            plan = _solve_within(scene, planner, n, options, robot, monitor, members, deadline)
         if progress is not None:
             progress(n, plan)
         if monitor is not None:
@@ -236,6 +257,36 @@ def plan_min_steps(
     )
 
 
+def _solve_within(
+    scene: Scene,
+    planner: str,
+    n_steps: int,
+    options: PlannerOptions,
+    robot: BipedParams,
+    monitor: SearchMonitor | None,
+    members: LiveMembers | None,
+    deadline: float,
+) -> FootstepPlan:
+    """The planner's solve of N = ``n_steps`` with what is left of this N's time limit (an
+    undecided N, status ``time_limit``, when nothing is left)."""
+    left = deadline - time.perf_counter()
+    if left <= 0.0:
+        from footfall.solvers import SolveStatus
+
+        message = (
+            f"no solve of N = {n_steps}: its time limit of {options.time_limit:g} s ran out in "
+            "the checks before it"
+        )
+        return FootstepPlan.empty(
+            planner, SolveStatus.TIME_LIMIT, robot, message, solver=options.solver
+        )
+    hook = _hook(monitor, n_steps, planner)
+    within = replace(options, time_limit=left)
+    plan = make_plan(scene, planner, n_steps, within, robot, hook, members=members)
+    # the plan was made with the options asked for; only its clock was shorter
+    return plan
+
+
 def _hook(
     monitor: SearchMonitor | None, n_steps: int, model: str
 ) -> Callable[[SolveProgress], None] | None:
@@ -250,6 +301,7 @@ def _kinematic_proof(
     options: PlannerOptions,
     solve_progress: Callable[[SolveProgress], None] | None = None,
     members: LiveMembers | None = None,
+    deadline: float = math.inf,
 ) -> FootstepPlan | None:
     """An infeasible plan if the MIQCQP's rows *without* the ALIP dynamics, torque bound and
     their objective terms (the kinematic planner's model, ``dynamics=False``) are proven to have
@@ -272,10 +324,13 @@ def _kinematic_proof(
     else:
         # a feasibility question: any incumbent answers it (a gap of 1 stops at the first one,
         # the objective being a sum of squares, >= 0)
+        left = min(options.time_limit, KINEMATIC_CHECK_LIMIT, deadline - time.perf_counter())
+        if left <= 0.0:
+            return None
         feasibility = replace(
             options.solver_options(),
             gap=FEASIBILITY_GAP,
-            time_limit=min(options.time_limit, KINEMATIC_CHECK_LIMIT),
+            time_limit=left,
             progress=solve_progress,
         )
         result = solve(kin.problem, options.solver, feasibility)

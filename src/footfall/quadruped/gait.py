@@ -54,6 +54,11 @@ class PhaseKind(str, Enum):
 MAX_CYCLES = 1000
 
 
+#: the compromise posture's body angle as a fraction of the slope (fig. 7; 10 deg on 15 deg):
+#: the default body pitch on the document's slope and on any other ground (``body_ratio``)
+BODY_RATIO = 2.0 / 3.0
+
+
 @dataclass(frozen=True)
 class GaitParams:
     """Inputs of the gait sequencer.
@@ -93,7 +98,7 @@ class GaitParams:
     hold_time: float = 0.5
     side_slope: float = 0.0
     ground: QuadrupedGround | None = None
-    body_ratio: float = 2.0 / 3.0
+    body_ratio: float = BODY_RATIO
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "step", positive("step", self.step))

@@ -19,6 +19,8 @@ from footfall.quadruped.gait import GaitParams
 from footfall.quadruped.ground import PlaneGround, QuadrupedGround, Stairs, VaryingSlope
 from footfall.quadruped.zmp_planning import ZmpStrategy
 from footfall.terrain.scene import (
+    MAX_DESCRIPTION,
+    Name,
     StrictSpec,
     YamlLocator,
     packaged_scene_names,
@@ -64,8 +66,8 @@ class _GaitSpec(StrictSpec):
 
 
 class _QuadrupedSceneSpec(StrictSpec):
-    name: str
-    description: str = ""
+    name: Name
+    description: Annotated[str, Field(max_length=MAX_DESCRIPTION)] = ""
     ground: _GroundSpec
     gait: _GaitSpec = Field(default_factory=_GaitSpec)
     friction: float | None = None

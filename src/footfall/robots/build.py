@@ -33,8 +33,9 @@ from typing import Any
 
 import numpy as np
 
+from footfall._mjcf import require_mujoco
 from footfall._typing import FloatArray
-from footfall.errors import FootfallError, InputError, MissingExtraError
+from footfall.errors import FootfallError, InputError
 from footfall.models.biped import Side
 from footfall.robots import names as nm
 from footfall.robots.file import LEG_JOINT_ROLES, LegJoints, RobotFile, Sole
@@ -48,17 +49,6 @@ _ANKLE_AXIS_ROLE = {0: "ankle_roll", 1: "ankle_pitch"}
 LINK_RADIUS = 0.025
 #: colours (RGBA) of the links, feet and the pelvis and torso boxes
 _GREY, _DARK, _BLUE = [0.7, 0.7, 0.72, 1.0], [0.15, 0.15, 0.15, 1.0], [0.25, 0.35, 0.6, 1.0]
-
-
-def require_mujoco() -> Any:
-    """Import MuJoCo or raise a :class:`MissingExtraError` saying how to install it."""
-    try:
-        import mujoco
-    except ImportError as exc:  # optional dependency: footfall[sim]
-        raise MissingExtraError(
-            f"MuJoCo is required: pip install 'footfall[sim]' ({exc})"
-        ) from None
-    return mujoco
 
 
 # ------------------------------------------------------------------------------------ the raw model

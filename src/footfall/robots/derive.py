@@ -30,11 +30,11 @@ from typing import Any
 
 import numpy as np
 
+from footfall._mjcf import require_mujoco
 from footfall._typing import FloatArray
 from footfall.errors import InputError
 from footfall.models.biped import Side
 from footfall.robots import names as nm
-from footfall.robots.build import require_mujoco
 
 #: a leg joint must stay this far inside its range in a stance counted feasible [rad]
 JOINT_MARGIN = 0.05

@@ -205,8 +205,15 @@ class RobotFile:
     package: tuple[str, str] | None = None
 
     def __post_init__(self) -> None:
-        if not isinstance(self.name, str) or not self.name.strip() or len(self.name) > 64:
-            raise InputError("name", self.name, "a short non-empty name (at most 64 characters)")
+        if (
+            not isinstance(self.name, str)
+            or not self.name.strip()
+            or len(self.name) > 64
+            or not self.name.isprintable()  # one line: it titles figures and heads the file
+        ):
+            raise InputError(
+                "name", self.name, "a short non-empty line (at most 64 printable characters)"
+            )
         if Path(self.model).suffix.lower() not in MODEL_FORMATS:
             raise InputError("model", str(self.model), "a .urdf, .xml or .mjcf file")
         if self.pelvis_height is not None:

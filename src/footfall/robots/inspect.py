@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from footfall._io import save_figure
 from footfall.errors import InputError
 from footfall.models.biped import Side
 from footfall.robots.file import MODEL_FORMATS, RobotFile, load_robot_file, package_of
@@ -139,7 +140,7 @@ def inspect_robot(model: Path, config: Path | None = None, name: str | None = No
 
 
 def _compiled(walker: RobotModel) -> tuple[Any, Any]:
-    from footfall.robots.build import require_mujoco
+    from footfall._mjcf import require_mujoco
 
     mj = require_mujoco()
     return mj, mj.MjModel.from_xml_string(walker.mjcf())
@@ -242,7 +243,4 @@ def plot_inspection(ins: Inspection, path: Path) -> Path:
     ax.set_title(f"reach; steps up/down to {rf.step_height_max:.2f} m")
     ax.legend(fontsize=7)
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=110)

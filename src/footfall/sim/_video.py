@@ -6,6 +6,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+from footfall._io import PendingFile
+
 #: video frame rate [1/s]
 VIDEO_FPS = 30
 
@@ -13,7 +15,9 @@ VIDEO_FPS = 30
 class Video:
     """MP4 of a named camera (offscreen GL), one frame every ``1 / VIDEO_FPS`` of simulated time
     (every ``frame_every`` control ticks of ``dt``). Without a path it does nothing; without GL
-    there is no video and :attr:`note` says why, and the walk goes on.
+    there is no video and :attr:`note` says why, and the walk goes on. The file is written under
+    a temporary name beside ``path`` and put in place only when :meth:`close` says the walk is
+    complete (:class:`~footfall._io.PendingFile`): an interrupted walk leaves the previous video.
 
     Attributes:
         note: why there is no video ("" when there is one or none was asked).
@@ -31,6 +35,7 @@ class Video:
     ) -> None:
         self.renderer: Any = None
         self.writer: Any = None
+        self.file: PendingFile | None = None
         self.note = ""
         self.render_time = 0.0
         self.path = path
@@ -45,8 +50,9 @@ class Video:
             return
         import imageio.v2 as imageio
 
-        path.parent.mkdir(parents=True, exist_ok=True)
-        self.writer = imageio.get_writer(str(path), fps=VIDEO_FPS, macro_block_size=8)
+        # written beside the destination and renamed over it when complete (close)
+        self.file = PendingFile(path)
+        self.writer = imageio.get_writer(str(self.file.tmp), fps=VIDEO_FPS, macro_block_size=8)
 
     def frame(self, k: int, data: Any) -> bool:
         """Render control tick ``k`` if a frame is due; whether one was."""
@@ -58,10 +64,20 @@ class Video:
         self.render_time += time.perf_counter() - r0
         return True
 
-    def close(self) -> Path | None:
-        """Finish the file and free the renderer; the file's path, None when none was written."""
-        if self.writer is not None:
-            self.writer.close()
-        if self.renderer is not None:
-            self.renderer.close()
-        return self.path if self.writer is not None else None
+    def close(self, complete: bool = True) -> Path | None:
+        """Finish the file (put in place when ``complete``; removed, the previous video left,
+        when the walk was interrupted) and free the renderer; the file's path, None when none
+        was written."""
+        written = False
+        try:
+            if self.writer is not None:
+                self.writer.close()
+                assert self.file is not None
+                self.file.finish(complete)
+                written = complete
+        finally:
+            if self.renderer is not None:
+                self.renderer.close()
+                self.renderer = None
+            self.writer = None
+        return self.path if written else None

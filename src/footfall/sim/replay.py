@@ -19,13 +19,13 @@ Keys (F display frames, ``nq`` the model's position coordinates):
 
 from __future__ import annotations
 
-import os
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from footfall._io import atomic_open
 from footfall._typing import FloatArray
 from footfall.errors import InputError
 
@@ -97,10 +97,9 @@ class ReplayRecorder:
             arrays[f"trace/{name}"] = (
                 values.astype(np.float32) if values.dtype.kind == "f" else values
             )
-        tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-        with tmp.open("wb") as fh:
+        # written whole or not at all, like every other output (footfall._io.atomic_open)
+        with atomic_open(path, "wb") as fh:
             np.savez_compressed(fh, **arrays)
-        os.replace(tmp, path)
         return path
 
 

@@ -85,7 +85,8 @@ class BnbSettings:
             best improvement per sweep; 0: off; default 20).
         map_depth: tasks in flight per worker in a synchronous batch (default 2).
         drain_timeout: at the end of a parallel search, the workers get this long [s] to finish
-            their solves in flight and exit before they are terminated (default 1.0).
+            their solves in flight and exit before they are terminated; at the time limit they
+            are terminated at once (default 1.0).
     """
 
     feas_tol: float = 1e-6

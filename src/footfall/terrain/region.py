@@ -32,6 +32,20 @@ MIN_NORMAL_Z = 0.2
 
 #: most vertices of one region's polygon (each is a row of the region constraint, eq. 5.18)
 MAX_VERTICES = 256
+#: longest name of a region or a scene [characters]: names go into plans, titles and figures
+MAX_NAME = 200
+#: a name: a non-empty line of at most MAX_NAME printable characters
+NAME_EXPECTED = f"a non-empty line of at most {MAX_NAME} printable characters"
+
+
+def valid_name(name: object) -> bool:
+    """Whether ``name`` is a non-empty line of at most :data:`MAX_NAME` printable characters."""
+    return (
+        isinstance(name, str)
+        and bool(name.strip())
+        and len(name) <= MAX_NAME
+        and name.isprintable()
+    )
 
 
 def _error(name: str, attr: str, value: object, expected: str) -> SceneError:
@@ -63,8 +77,8 @@ class Region:
 
     def __post_init__(self) -> None:
         name = self.name
-        if not isinstance(name, str) or not name.strip():
-            raise SceneError("region name", name, "a non-empty string")
+        if not valid_name(name):
+            raise SceneError("region name", name, NAME_EXPECTED)
         try:
             n = np.array(self.normal, dtype=float)
             d = float(self.offset)

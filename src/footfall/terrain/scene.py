@@ -23,14 +23,17 @@ from footfall._geometry import outward_halfspaces, polygon_distance, rot2
 from footfall._io import read_bounded
 from footfall._typing import FloatArray
 from footfall._validate import finite, finite_vector
+from footfall._yaml import UniqueKeyLoader
 from footfall.errors import InputError, SceneError
 from footfall.models.biped import BipedParams, ReachTrapezoid, Side
-from footfall.terrain.region import Region
+from footfall.terrain.region import MAX_NAME, NAME_EXPECTED, Region, valid_name
 from footfall.terrain.terrain import MAX_REGIONS, Terrain
 
 #: tolerance [m] for the start feet and the goal to count as on a region (plane and polygon); looser
 #: than Region.contains' default because hand-written YAML heights are rounded
 SCENE_TOL = 1e-3
+#: longest scene description [characters] (a figure's title)
+MAX_DESCRIPTION = 2000
 
 
 # ============================================================================= scene dataclasses
@@ -125,10 +128,12 @@ class Scene:
     goal: Goal
 
     def __post_init__(self) -> None:
-        if not isinstance(self.name, str) or not self.name.strip():
-            raise SceneError("name", self.name, "a non-empty string")
-        if not isinstance(self.description, str):
-            raise SceneError("description", self.description, "a string")
+        if not valid_name(self.name):
+            raise SceneError("name", self.name, NAME_EXPECTED)
+        if not isinstance(self.description, str) or len(self.description) > MAX_DESCRIPTION:
+            raise SceneError(
+                "description", self.description, f"at most {MAX_DESCRIPTION} characters"
+            )
         for attr, typ in (
             ("robot", BipedParams),
             ("terrain", Terrain),
@@ -216,8 +221,11 @@ class _GoalSpec(StrictSpec):
     heading_deg: float | None = None
 
 
+Name = Annotated[str, Field(min_length=1, max_length=MAX_NAME)]
+
+
 class _RegionSpec(StrictSpec):
-    name: str
+    name: Name
     vertices: Annotated[list[list[float]], Field(min_length=3)]
     normal: Vec3 | None = None
     offset: float | None = None
@@ -225,8 +233,8 @@ class _RegionSpec(StrictSpec):
 
 
 class _SceneSpec(StrictSpec):
-    name: str
-    description: str = ""
+    name: Name
+    description: Annotated[str, Field(max_length=MAX_DESCRIPTION)] = ""
     robot: _RobotSpec = Field(default_factory=_RobotSpec)
     start: _StartSpec
     goal: _GoalSpec
@@ -400,8 +408,9 @@ def _pydantic_error(err: ValidationError, loc: YamlLocator) -> SceneError:
     return loc.error(path, first.get("input"), f"{first['msg'].lower()}{more}")
 
 
-#: YAML's safe loader (no Python objects from tags), libyaml's C implementation when installed
-_SAFE_LOADER: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+#: YAML's safe loader (no Python objects from tags, libyaml's C parser when installed) that
+#: refuses a repeated key
+_SAFE_LOADER: Any = UniqueKeyLoader
 #: largest scene file or text accepted [bytes]; the largest built-in scene is a few kB
 MAX_SCENE_BYTES = 4_000_000
 #: most YAML nodes a scene may expand to, aliases counted at every use (a ~1 kB "billion laughs"

@@ -13,8 +13,7 @@ from footfall._typing import FloatArray
 from footfall.errors import SceneError, UnknownNameError
 from footfall.terrain.region import Region
 
-#: most regions of a terrain: one binary per region and footstep, and the region graph is
-#: quadratic in the count
+#: most regions of a terrain: one binary per region and footstep
 MAX_REGIONS = 1000
 #: a landed foot stands on a region when its sole centre is inside the region's polygon in plan
 #: view and within this height of its surface [m] (a measured sole centre sits a few millimetres
@@ -138,10 +137,26 @@ class Terrain:
         if not np.isfinite(m) or m < 0.0:
             raise SceneError("margin", margin, "a finite distance >= 0 [m]")
         adj: dict[str, set[str]] = {r.name: set() for r in self.regions}
-        polys = [(r.name, self.inset(r, m)) for r in self.regions]
-        for i, (na, pa) in enumerate(polys):
-            for nb, pb in polys[i + 1 :]:
-                if pa is not None and pb is not None and polygon_distance(pa, pb) <= radius:
+        inset = [(r.name, self.inset(r, m)) for r in self.regions]
+        polys = [(name, p) for name, p in inset if p is not None]
+        if not polys:
+            return adj
+        # sweep over the bounding boxes sorted by their left edge: only the pairs whose boxes
+        # come within the radius (a lower bound on the polygons' distance) are measured, so a
+        # terrain of R regions costs O(R log R) plus its near pairs instead of R^2 / 2 pairs
+        lo = np.array([p.min(axis=0) for _, p in polys])
+        hi = np.array([p.max(axis=0) for _, p in polys])
+        order = np.argsort(lo[:, 0], kind="stable")
+        lo, hi = lo[order], hi[order]
+        polys = [polys[k] for k in order]
+        ends = np.searchsorted(lo[:, 0], hi[:, 0] + radius, side="right")
+        for a in range(len(polys)):
+            cand = np.arange(a + 1, ends[a])
+            gap = np.maximum(0.0, np.maximum(lo[cand] - hi[a], lo[a] - hi[cand]))
+            na, pa = polys[a]
+            for b in cand[np.hypot(gap[:, 0], gap[:, 1]) <= radius]:
+                nb, pb = polys[b]
+                if polygon_distance(pa, pb) <= radius:
                     adj[na].add(nb)
                     adj[nb].add(na)
         return adj

@@ -11,13 +11,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
 
+from footfall._io import save_figure
+
 
 def save(fig: Figure, path: Path) -> Path:
-    """Save ``fig`` to ``path`` (parents created), close it and return the path."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120, bbox_inches="tight")
-    plt.close(fig)
-    return path
+    """Save ``fig`` to ``path`` atomically (parents created), close it and return the path."""
+    return save_figure(fig, path, dpi=120, bbox_inches="tight")
 
 
 __all__ = ["plt", "save"]

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from footfall._io import save_figure
 from footfall._typing import FloatArray
 from footfall.quadruped.kinematics import body_rotation, foot_in_leg_frame
 from footfall.quadruped.robot import LEGS, Leg
@@ -113,9 +114,7 @@ def plot_swing_frames(plan: GaitPlan, path: Path, leg: Leg = Leg.LF) -> Path:
     ax.set_ylim(w0[2] - 0.3, hip[2] + 0.35)
     ax.legend(fontsize=7, loc="upper left")
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def plot_foot_path(
@@ -135,9 +134,7 @@ def plot_foot_path(
     ax.set_aspect("equal")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def plot_body_height(
@@ -161,9 +158,7 @@ def plot_body_height(
     ax.set_title("Body centre z trajectory (fig. 11)", fontsize=10)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def plot_stability(plan: GaitPlan, res: QuadrupedTrace | None, path: Path) -> Path:
@@ -214,20 +209,25 @@ def plot_stability(plan: GaitPlan, res: QuadrupedTrace | None, path: Path) -> Pa
     ax1.set_ylabel("stability margin S_m [m] (eq. 8)")
     ax1.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)
+
+
+#: the files of :func:`save_walk_figures`
+WALK_FIGURES = (
+    "fig8_swing_frames.png",
+    "fig10_lf_foot_path.png",
+    "fig11_body_z.png",
+    "stability.png",
+)
 
 
 def save_walk_figures(plan: GaitPlan, res: QuadrupedTrace, out: Path, label: str) -> list[Path]:
     """The figures of one simulated walk in ``out``: swing frames (fig. 8), the LF foot path
     (fig. 10), body height (fig. 11, one run called ``label``) and the stability plot."""
+    swing, foot, body, stability = (out / name for name in WALK_FIGURES)
     return [
-        plot_swing_frames(plan, out / "fig8_swing_frames.png"),
-        plot_foot_path(plan, res, out / "fig10_lf_foot_path.png"),
-        plot_body_height(
-            [(label, res.t, res.trunk_pos[:, 2], res.planned.body_pos[:, 2])],
-            out / "fig11_body_z.png",
-        ),
-        plot_stability(plan, res, out / "stability.png"),
+        plot_swing_frames(plan, swing),
+        plot_foot_path(plan, res, foot),
+        plot_body_height([(label, res.t, res.trunk_pos[:, 2], res.planned.body_pos[:, 2])], body),
+        plot_stability(plan, res, stability),
     ]

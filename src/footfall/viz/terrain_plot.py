@@ -13,6 +13,7 @@ from matplotlib.patches import Polygon
 from matplotlib.tri import Triangulation
 
 from footfall._geometry import convex_hull
+from footfall._io import save_figure
 from footfall.terrain.scene import Scene
 from footfall.terrain.terrain import Terrain
 
@@ -135,7 +136,4 @@ def plot_scene(scene: Scene, path: Path, dpi: int = 120) -> Path:
     ax_side.plot(goal[0], goal[2], "*", color="gold", mec="k", ms=14)
     ax_top.set_title(f"{scene.name}: {scene.description}", fontsize=9)
     fig.colorbar(mappable, ax=ax_top, label="z [m]", shrink=0.8)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=dpi)

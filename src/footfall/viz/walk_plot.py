@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Protocol
 
+from footfall._io import save_figure
 from footfall.results.walk import WalkResult
 from footfall.terrain.scene import Scene
 
@@ -89,7 +90,4 @@ def plot_walk(
     ax.set_ylabel("height [m]")
     ax.legend(fontsize=7)
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=110)

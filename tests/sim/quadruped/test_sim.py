@@ -168,3 +168,33 @@ def test_metrics_dict_has_one_key_per_field_and_nested_sway(walk) -> None:
         res.metrics.body_sway_measured.path_per_cycle_m
     )
     json.dumps(d)  # JSON-ready
+
+
+class _Planned(Exception):
+    """Stops the command once it has its gait parameters."""
+
+
+@pytest.mark.parametrize(("slope", "body"), [("-15", -10.0), ("15", 10.0), ("21", 14.0)])
+def test_the_default_body_angle_follows_the_slope(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, slope: str, body: float
+) -> None:
+    """Downhill, the default body angle is downhill too (10 deg up was refused on -15 deg)."""
+    import math
+
+    from typer.testing import CliRunner
+
+    from footfall.experiments import slope_walk
+
+    seen = []
+
+    def plan_strategies(robot: object, params: object, compare: bool) -> None:
+        seen.append(params)
+        raise _Planned
+
+    monkeypatch.setattr(slope_walk, "plan_strategies", plan_strategies)
+    args = ["quadruped", "--slope-deg", slope, "--no-video", "--out", str(tmp_path)]
+    res = CliRunner().invoke(_cli_app(), args)
+    assert isinstance(res.exception, _Planned), res.output
+    (params,) = seen
+    assert math.degrees(params.slope) == pytest.approx(float(slope), abs=1e-12)
+    assert math.degrees(params.body_pitch) == pytest.approx(body, abs=1e-12)

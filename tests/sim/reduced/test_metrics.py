@@ -143,6 +143,7 @@ def test_metrics_of_a_hand_made_trace_have_their_closed_form_values() -> None:
     walk, trace = hand_made_run()
     t0 = time.perf_counter()
     res = _result(walk, trace, "python", t0)  # type: ignore[arg-type]
+    elapsed = time.perf_counter() - t0
     met = res.metrics
     assert met.zmp_offset_mean == pytest.approx(0.21 / 6, rel=1e-12)
     assert met.zmp_offset_rms == pytest.approx(math.sqrt(0.0139 / 6), rel=1e-12)
@@ -162,7 +163,7 @@ def test_metrics_of_a_hand_made_trace_have_their_closed_form_values() -> None:
     assert met.mpc_time_p99 == pytest.approx(2.98e-4, rel=1e-12)  # linear interpolation
     assert (met.mpc_solves, met.mpc_fallbacks, met.sim_time) == (3, 0, 0.08)
     assert not met.fell and math.isnan(met.fall_time) and met.engine == "python"
-    assert 0.0 <= met.wall_time < 60.0
+    assert 0.0 <= met.wall_time <= elapsed  # the run's own clock, read within ours
     # the trajectories are the written samples, trimmed; the rest is echoed
     n = trace.samples
     for got, want in (

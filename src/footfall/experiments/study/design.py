@@ -24,6 +24,7 @@ import yaml
 
 from footfall._io import read_bounded
 from footfall._validate import non_negative, positive
+from footfall._yaml import safe_load
 from footfall.errors import InputError
 from footfall.planning.plan import PLANNERS
 from footfall.terrain.scene import builtin_scene_names
@@ -301,7 +302,7 @@ def parse_study(text: str | bytes, source: str = "study", base: Path | None = No
         except UnicodeDecodeError:
             raise InputError(source, "undecodable bytes", "UTF-8 YAML text") from None
     try:
-        data = yaml.safe_load(text)
+        data = safe_load(text)  # footfall's loader: a repeated key is an error
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f" (line {mark.line + 1})" if mark else ""

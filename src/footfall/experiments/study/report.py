@@ -8,7 +8,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from footfall._io import write_json
+from footfall._io import atomic_open, write_json, write_text
 from footfall.experiments.study import stats
 from footfall.experiments.study.design import StudyDesign
 from footfall.experiments.study.runner import PlanEntry
@@ -136,6 +136,12 @@ def markdown(
     return "\n".join(md)
 
 
+def report_names(design: StudyDesign) -> list[str]:
+    """The files :func:`write_report` may write into the study folder."""
+    zmp = [f"zmp_{mode}_n.png" for mode in design.steps]
+    return ["summary.md", "summary.json", "cells.csv", "fragility.png", *zmp, "paired.png"]
+
+
 def write_report(
     out: Path,
     design: StudyDesign,
@@ -149,7 +155,7 @@ def write_report(
     summary = summarise(design, rows)
     out = Path(out)
     paths = [out / "summary.md"]
-    paths[0].write_text(markdown(design, summary, plans, len(rows), header))
+    write_text(paths[0], markdown(design, summary, plans, len(rows), header))
     paths.append(
         write_json(
             out / "summary.json",
@@ -161,7 +167,7 @@ def write_report(
         )
     )
     cells_csv = out / "cells.csv"
-    with cells_csv.open("w", newline="") as fh:
+    with atomic_open(cells_csv, "w", newline="") as fh:
         fields = [*stats.Cell.__dataclass_fields__, "success_rate"]
         w = csv.DictWriter(fh, fieldnames=fields)
         w.writeheader()

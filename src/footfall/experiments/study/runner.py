@@ -22,7 +22,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from footfall.errors import InputError
+from footfall._process import DeferredSignals, unreachable
+from footfall.errors import InputError, MissingExtraError
 from footfall.experiments.study.design import StudyDesign
 from footfall.experiments.study.store import TrialStore
 from footfall.experiments.study.trials import Trial, plan_digest, run_trial, trial_key
@@ -38,6 +39,8 @@ EXECUTORS = ("local", "ray")
 MonitorFactory = Callable[[str], AbstractContextManager[SearchMonitor | None]]
 #: trials in flight per worker (keeps every worker busy without shipping the whole study at once)
 IN_FLIGHT = 2
+#: longest wait [s] in one call into Ray (signals are handled between calls)
+POLL = 0.5
 
 
 @dataclass(frozen=True)
@@ -221,10 +224,19 @@ def _local(trials: list[Trial], workers: int) -> Iterator[dict[str, Any]]:
             yield run_trial(t)
         return
     import multiprocessing as mp
+    import os
     from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 
-    # spawn: children import numpy afresh (single-threaded BLAS from the environment)
-    pool = ProcessPoolExecutor(workers, mp_context=mp.get_context("spawn"))
+    from footfall._process import die_with_parent
+
+    # spawn: children import numpy afresh (single-threaded BLAS from the environment); each dies
+    # with this process, even killed (kill -9 leaves no clean-up to run)
+    pool = ProcessPoolExecutor(
+        workers,
+        mp_context=mp.get_context("spawn"),
+        initializer=die_with_parent,
+        initargs=(os.getpid(),),
+    )
     try:
         todo = iter(trials[1:])
         running: set[Future[dict[str, Any]]] = set()
@@ -244,37 +256,62 @@ def _local(trials: list[Trial], workers: int) -> Iterator[dict[str, Any]]:
 
 
 def _ray(trials: list[Trial], workers: int, address: str | None) -> Iterator[dict[str, Any]]:
+    """The rows from Ray. Checked when called (before any planning, see :func:`run_study`):
+    Ray is installed and a cluster ``address`` accepts connections (Ray itself retries an
+    unreachable one for minutes, deaf to SIGTERM)."""
     try:
         import ray
     except ImportError:
-        raise InputError("--executor", "ray", "pip install 'footfall[study]' (Ray)") from None
-    started = not ray.is_initialized()
-    if started:
-        kw: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
-        if address is None:
-            kw["num_cpus"] = workers
-        ray.init(address=address, **kw)
-    try:
-        remote = ray.remote(num_cpus=1, max_retries=2)(run_trial)
-        todo = iter(trials)
-        running: list[Any] = []
-        cap = IN_FLIGHT * max(1, int(ray.cluster_resources().get("CPU", workers)))
-        while True:
-            while len(running) < cap:
-                t = next(todo, None)
-                if t is None:
-                    break
-                running.append(remote.remote(t))
-            if not running:
-                break
-            finished, running = ray.wait(running, num_returns=1)
-            for ref in finished:
-                yield ray.get(ref)
-    finally:
-        for ref in locals().get("running", []):
-            ray.cancel(ref, force=True)
+        raise MissingExtraError(
+            "the ray executor needs Ray: pip install 'footfall[study]'"
+        ) from None
+    if address is not None and address != "auto" and not ray.is_initialized():
+        why = unreachable(address)
+        if why is not None:
+            raise InputError("--address", address, f"a reachable Ray cluster, host:port ({why})")
+    return _ray_rows(ray, trials, workers, address)
+
+
+def _ray_rows(
+    ray: Any, trials: list[Trial], workers: int, address: str | None
+) -> Iterator[dict[str, Any]]:
+    # a signal handler that raises inside Ray's core worker (it calls back into Python while it
+    # waits) comes out as a SystemError or a crash: signals are recorded and handed to the
+    # command's handlers between two Ray calls, which wait at most POLL seconds
+    with DeferredSignals() as signals:
+        started = not ray.is_initialized()
         if started:
-            ray.shutdown()
+            kw: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
+            if address is None:
+                kw["num_cpus"] = workers
+            with signals.blocked():  # ray.init installs SIGTERM handlers of its own
+                ray.init(address=address, **kw)
+        running: list[Any] = []
+        try:
+            signals.check()
+            remote = ray.remote(num_cpus=1, max_retries=2)(run_trial)
+            todo = iter(trials)
+            cap = IN_FLIGHT * max(1, int(ray.cluster_resources().get("CPU", workers)))
+            while True:
+                while len(running) < cap:
+                    t = next(todo, None)
+                    if t is None:
+                        break
+                    running.append(remote.remote(t))
+                if not running:
+                    break
+                finished, running = ray.wait(running, num_returns=1, timeout=POLL)
+                signals.check()
+                for ref in finished:
+                    row = ray.get(ref)
+                    signals.check()
+                    yield row
+        finally:
+            for ref in running:
+                ray.cancel(ref, force=True)
+            if started:
+                with signals.blocked():
+                    ray.shutdown()
 
 
 def execute(

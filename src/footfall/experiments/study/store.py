@@ -1,9 +1,10 @@
 """The study's table on disk: ``DIR/trials.parquet``, one row per trial, written as trials finish.
 
-Finished rows are appended in small Parquet part files (``DIR/trials.parts/part-*.parquet``, each
-written to a temporary name and renamed, so a crash leaves either a whole part or none); closing the
-store merges the parts into ``trials.parquet`` sorted by key and removes them. A rerun reads both, so
-Ctrl-C, a crash or a lost worker loses at most the trials that had not finished. The folder also
+Each finished row is written at once as a small Parquet part file (``DIR/trials.parts/part-*.parquet``,
+written to a temporary name, flushed to disk and renamed, so a crash leaves either a whole part or
+none) before the walk is reported done; every ``COMPACT_PARTS`` parts, and when the store is closed,
+the rows are merged into ``trials.parquet`` sorted by key and the parts removed. A rerun reads both,
+so Ctrl-C, a crash, ``kill -9`` or a lost worker loses only the walks that had not finished. The folder also
 holds ``study.json`` (the design's fingerprint): a folder is reused only by a study whose trials
 compute the same numbers.
 """
@@ -16,6 +17,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from footfall._io import atomic_path, write_text
 from footfall.errors import InputError
 from footfall.experiments.study.design import StudyDesign
 from footfall.experiments.study.trials import COLUMNS, OPTIONAL_COLUMNS
@@ -23,10 +25,9 @@ from footfall.experiments.study.trials import COLUMNS, OPTIONAL_COLUMNS
 TABLE = "trials.parquet"
 PARTS = "trials.parts"
 META = "study.json"
-#: a part file is written after this many rows or ...
-FLUSH_ROWS = 25
-#: ... this many seconds since the last one
-FLUSH_SECONDS = 10.0
+#: part files after which the rows are merged into the table and the parts removed (a part per
+#: finished walk keeps every walk on disk; the merge keeps their number small)
+COMPACT_PARTS = 100
 
 
 def _arrow() -> Any:
@@ -70,9 +71,8 @@ def write_rows(path: Path, rows: list[dict[str, Any]]) -> Path:
     """Write ``rows`` as one Parquet file, atomically (temporary name, then rename)."""
     pa = _arrow()
     table = pa.Table.from_pylist(rows, schema=schema())
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    pa.parquet.write_table(table, tmp)
-    os.replace(tmp, path)
+    with atomic_path(path) as tmp:  # flushed to disk, then renamed
+        pa.parquet.write_table(table, tmp)
     return path
 
 
@@ -95,6 +95,8 @@ class TrialStore:
             try:
                 old = json.loads(meta.read_text())["fingerprint"]
             except (OSError, ValueError, KeyError, TypeError):
+                old = None
+            if not isinstance(old, dict):  # unreadable, damaged or edited
                 raise InputError(
                     "study folder", str(meta), "a study.json written by footfall study"
                 ) from None
@@ -106,7 +108,7 @@ class TrialStore:
                     f"a folder of this study or a new one: its trials were run with other "
                     f"{', '.join(diff)} ({', '.join(f'{k}={old.get(k)!r}' for k in diff)})",
                 )
-        meta.write_text(json.dumps({"fingerprint": fp, "design": design.to_dict()}, indent=1))
+        write_text(meta, json.dumps({"fingerprint": fp, "design": design.to_dict()}, indent=1))
         self.parts = self.folder / PARTS
         self.rows: dict[str, dict[str, Any]] = {}
         table = self.folder / TABLE
@@ -118,7 +120,6 @@ class TrialStore:
                 for r in read_rows(p):
                     self.rows[r["key"]] = r
         self.pending: list[dict[str, Any]] = []
-        self.flushed_at = time.monotonic()
         self.n_parts = 0
 
     def done(self, key: str, plan: str | None = None) -> bool:
@@ -131,11 +132,13 @@ class TrialStore:
         return row is not None and (plan is None or row["plan"] == plan)
 
     def add(self, row: dict[str, Any]) -> None:
-        """Keep a finished row; write a part file every ``FLUSH_ROWS`` rows or ``FLUSH_SECONDS``."""
+        """Keep a finished row, on disk when this returns (its own part file): a walk reported
+        done is never lost. Every ``COMPACT_PARTS`` parts the table is merged (:meth:`compact`)."""
         self.rows[row["key"]] = row
         self.pending.append(row)
-        if len(self.pending) >= FLUSH_ROWS or time.monotonic() - self.flushed_at > FLUSH_SECONDS:
-            self.flush()
+        self.flush()
+        if self.n_parts >= COMPACT_PARTS:
+            self.compact()
 
     def flush(self) -> None:
         """Write the pending rows as one part file."""
@@ -145,15 +148,21 @@ class TrialStore:
             write_rows(self.parts / name, self.pending)
             self.n_parts += 1
             self.pending = []
-        self.flushed_at = time.monotonic()
 
-    def close(self) -> Path:
-        """Merge everything into ``trials.parquet`` (sorted by key) and remove the parts."""
+    def compact(self) -> Path:
+        """Merge every row into ``trials.parquet`` (sorted by key) and remove the parts: the
+        table is written whole first, so a crash between the two leaves rows twice (read once),
+        never none."""
         self.flush()
         path = write_rows(self.folder / TABLE, [self.rows[k] for k in sorted(self.rows)])
         if self.parts.is_dir():
-            # the parts and any temporary file a crash left mid-write (.part-*.tmp)
-            for p in [*self.parts.glob("part-*.parquet"), *self.parts.glob(".part-*.tmp")]:
+            # the parts and any temporary file a crash left mid-write (.part-*.tmp*)
+            for p in [*self.parts.glob("part-*.parquet"), *self.parts.glob(".part-*.tmp*")]:
                 p.unlink()
             self.parts.rmdir()
+        self.n_parts = 0
         return path
+
+    def close(self) -> Path:
+        """Merge everything into ``trials.parquet`` (sorted by key) and remove the parts."""
+        return self.compact()

@@ -32,12 +32,13 @@ from footfall._mjcf import (
     mjcf_document,
     mjcf_preamble,
     position_actuator,
+    require_mujoco,
     rod_inertia,
 )
 from footfall._typing import FloatArray
 from footfall._validate import check_fields, non_negative, positive
 from footfall.control.adjusters import U_MAX_FOOT_SHARE
-from footfall.errors import FootfallError, InputError
+from footfall.errors import InputError
 from footfall.models.biped import BipedParams, ReachTrapezoid, Side
 from footfall.robots import names as nm
 
@@ -51,15 +52,6 @@ SWING_MAX = 0.70
 #: :func:`footfall.sim.biped.plans.plan_for_walk`: with 16, straight plans with both reach frames
 #: alternate narrow and wide steps and drift sideways.
 WALK_HEADING_SEGMENTS = 64
-
-
-def require_mujoco() -> Any:
-    """Import MuJoCo or raise a FootfallError saying how to install it."""
-    try:
-        import mujoco
-    except ImportError as exc:  # optional dependency: footfall[sim]
-        raise FootfallError(f"MuJoCo is required: pip install 'footfall[sim]' ({exc})") from None
-    return mujoco
 
 
 @dataclass(frozen=True)

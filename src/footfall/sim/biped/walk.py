@@ -216,11 +216,15 @@ class BipedWalk:
             replay.begin(sim.xml)
         wall0 = time.perf_counter()
         k = 0
-        for k in range(self.n_ticks):
-            if not self.step(k):
-                break
-            if progress is not None and k % 100 == 0:
-                progress(k / self.n_ticks)
+        try:
+            for k in range(self.n_ticks):
+                if not self.step(k):
+                    break
+                if progress is not None and k % 100 == 0:
+                    progress(k / self.n_ticks)
+        except BaseException:  # an error or a signal: no half-written video in place
+            self.video.close(complete=False)
+            raise
         wall = time.perf_counter() - wall0
         self.log.timing["render"] = self.video.render_time
         return self._result(k + 1, wall, self.video.close())

@@ -19,9 +19,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from footfall._geometry import cross3
+from footfall._mjcf import require_mujoco
 from footfall._typing import FloatArray
 from footfall._validate import positive
-from footfall.errors import FootfallError, InputError
+from footfall.errors import InputError
 from footfall.quadruped.gait import GaitParams, GaitPlan, GaitTrajectory, PhaseKind, plan_gait
 from footfall.quadruped.ground import PlaneGround, QuadrupedGround
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
@@ -69,13 +70,7 @@ class QuadrupedSim:
         settings: SimSettings | None = None,
         x_range: tuple[float, float] = (-3.0, 12.0),
     ) -> None:
-        try:
-            import mujoco  # optional dependency: footfall[sim]
-        except ImportError as exc:
-            raise FootfallError(
-                f"MuJoCo is required: pip install 'footfall[sim]' ({exc})"
-            ) from None
-
+        mujoco = require_mujoco()
         self.mujoco = mujoco
         self.robot = robot
         self.settings = settings if settings is not None else SimSettings()
@@ -372,15 +367,19 @@ def simulate(
         replay.begin(sim.xml)
 
     wall0 = time.perf_counter()
-    if controller == "wbc":
-        _track_wbc(
-            sim, rec, video, control_dt, progress, wbc_gains, settle_time, pushes, guard, replay
-        )
-    else:
-        # settle in the initial pose so the legs take the weight before the gait starts
-        for _ in range(round(settle_time / sim.model.opt.timestep)):
-            sim.mujoco.mj_step(sim.model, sim.data)
-        _track(sim, rec, video, control_dt, progress, pushes, guard, replay)
+    try:
+        if controller == "wbc":
+            _track_wbc(
+                sim, rec, video, control_dt, progress, wbc_gains, settle_time, pushes, guard, replay
+            )
+        else:
+            # settle in the initial pose so the legs take the weight before the gait starts
+            for _ in range(round(settle_time / sim.model.opt.timestep)):
+                sim.mujoco.mj_step(sim.model, sim.data)
+            _track(sim, rec, video, control_dt, progress, pushes, guard, replay)
+    except BaseException:  # an error or a signal: no half-written video in place
+        video.close(complete=False)
+        raise
     tr = rec.trace
     tr.wall_time = time.perf_counter() - wall0 - video.render_time
     tr.sim_time = settle_time + float(ref.t[-1])

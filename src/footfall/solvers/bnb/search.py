@@ -201,6 +201,8 @@ class _Search:
         root_allowed = _root_allowed(self.s)
         timed_out = False
         root = None
+        if time.perf_counter() > self.deadline:  # the set-up took the whole time limit
+            return self.result(True)
         if all(root_allowed):
             root = self.evaluate(root_allowed, -math.inf, 0, False)
         pool = None
@@ -226,7 +228,9 @@ class _Search:
                 timed_out = self._loop_async(pool, dive_from)
         finally:
             if pool is not None:
-                pool.close()
+                # at the time limit the solves in flight are dropped at once (their results
+                # would be dropped anyway); otherwise the workers get their drain time
+                pool.close(grace=0.0 if timed_out else None)
         return self.result(timed_out)
 
     @property
@@ -405,7 +409,14 @@ class _Search:
             tid, (allowed, full) = mine.pop(0)
             answered = [(tid, self.relax.solve(allowed, full=full)), *pool.wait(0.0)]
         else:
-            answered = pool.wait(self.deadline - time.perf_counter())
+            # an empty wait is the time limit only once the clock says so (a wait may return a
+            # little early, and the clock is the search's, not the wait's timer)
+            answered = []
+            while not answered:
+                left = self.deadline - time.perf_counter()
+                if left <= 0.0:
+                    return []
+                answered = pool.wait(left)
         answered.reverse()
         return answered
 

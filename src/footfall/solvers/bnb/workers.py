@@ -8,9 +8,11 @@ with :class:`WorkerError`; every worker is reaped however the search ends.
 from __future__ import annotations
 
 import math
+import os
 import time
 from typing import Any
 
+from footfall._process import die_with_parent
 from footfall._typing import FloatArray
 from footfall.errors import SolverError
 from footfall.solvers.bnb.branching import _dive
@@ -47,14 +49,21 @@ def _work_dive(
     return chosen, None if chosen is None else _WORKER.solve(chosen)
 
 
-def _serve(conn: Any, relax: HullRelaxation, stop: Any) -> None:
+def _serve(conn: Any, relax: HullRelaxation, stop: Any, parent: int, theirs: list[Any]) -> None:
     """Body of a worker process: answer ``(id, kind, task)`` messages with ``(id, ok, result)``
     until ``None`` or the end of the pipe. A task's exception is sent back as text (it may not
-    pickle); SIGINT is left to the search, which shuts the workers down."""
+    pickle); SIGINT is left to the search, which shuts the workers down.
+
+    The worker dies with the search process ``parent`` (:func:`die_with_parent`), and closes
+    the search's ends of the pipes it inherited (``theirs``), so that its own pipe reads an end
+    of file once the search is gone."""
     import signal
     import traceback
 
     global _WORKER, _STOP
+    die_with_parent(parent)
+    for end in theirs:
+        end.close()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _WORKER, _STOP = relax, stop
     while True:
@@ -103,10 +112,14 @@ class _Workers:
         #: per worker, the ids of the tasks sent and not answered yet
         self.pending: list[list[int]] = []
         self.closed = False
+        parent = os.getpid()
         try:
             for _ in range(n):
                 here, there = ctx.Pipe(duplex=True)
-                proc = ctx.Process(target=_serve, args=(there, relax, self.stop), daemon=True)
+                theirs = [*self.conns, here]  # the search's ends, copied into the fork
+                proc = ctx.Process(
+                    target=_serve, args=(there, relax, self.stop, parent, theirs), daemon=True
+                )
                 proc.start()
                 there.close()
                 self.conns.append(here)

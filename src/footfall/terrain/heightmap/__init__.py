@@ -57,6 +57,9 @@ __all__ = [
 ]
 
 
+#: widest local fit window [cells]: the fit's arrays grow with its square, and a plane fitted over
+#: more than a hundred cells is no longer local
+MAX_WINDOW = 101
 #: the plane of a convex piece is fitted to its segment's cells within this many fit windows of
 #: it: an 8 cm strip under 1 cm noise alone fixes its cross tilt to ~3 deg, with the halo ~0.3 deg
 PLANE_HALO_WINDOWS = 2
@@ -117,6 +120,8 @@ class HeightmapOptions:
         w = self.window
         if isinstance(w, bool) or not isinstance(w, int | np.integer) or w < 3 or w % 2 == 0:
             raise InputError("window", w, "an odd whole number of cells >= 3")
+        if w > MAX_WINDOW:
+            raise InputError("window", w, f"an odd whole number of cells in 3..{MAX_WINDOW}")
         if self.max_spike_fraction > 1.0:
             raise InputError("max_spike_fraction", self.max_spike_fraction, "a fraction in [0, 1]")
 
@@ -279,7 +284,8 @@ def _convex_regions(
                 normal, offset = _piece_plane(cxy[near], cz[near])
                 if normal[2] < math.cos(math.radians(opts.max_slope_deg)):
                     continue
-                regions.append(Region(f"s{k}", normal, offset, polygons.ccw_vertices(piece)))
+                vertices = polygons.ccw_vertices(piece, res)
+                regions.append(Region(f"s{k}", normal, offset, vertices))
                 owner.append(k)
     return regions, owner
 

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from footfall._geometry import drop_collinear
 from footfall._typing import FloatArray
 
 #: relative area slack for "the union of two pieces is convex" (union area vs its hull's area)
@@ -30,6 +31,8 @@ SIMPLIFY_CELLS = 0.45
 CUTS_TRIED = 6
 #: most convex pieces of one segment (each is a region: binaries of the planner)
 MAX_PIECES = 32
+#: a vertex this close to the line through its neighbours [cells] is dropped from a region
+VERTEX_TOL_CELLS = 1e-6
 
 
 def cells_outline(mask: np.ndarray, resolution: float, origin: FloatArray) -> Any:
@@ -183,9 +186,14 @@ def _merge_convex(pieces: list[Any], resolution: float) -> list[Any]:
     return pieces
 
 
-def ccw_vertices(poly: Any) -> FloatArray:
-    """Counter-clockwise vertices (V, 2) of a polygon's exterior, without the closing repeat."""
+def ccw_vertices(poly: Any, resolution: float) -> FloatArray:
+    """Counter-clockwise vertices (V, 2) of a polygon's exterior, without the closing repeat and
+    without vertices within ``VERTEX_TOL_CELLS`` cells of the line through their neighbours.
+
+    Cuts and merges leave such vertices on straight edges (and repeats a round-off apart): each
+    would be a zero-length or duplicate region row, and three collinear corners define no plane."""
     import shapely
 
     poly = shapely.orient_polygons(poly)  # exterior counter-clockwise
-    return np.asarray(poly.exterior.coords, dtype=float)[:-1]
+    vertices = np.asarray(poly.exterior.coords, dtype=float)[:-1]
+    return drop_collinear(vertices, VERTEX_TOL_CELLS * resolution)

@@ -120,10 +120,12 @@ def capture(page: Any) -> bytes:
 
 
 def write_atomic(path: Path, content: bytes) -> Path:
-    """Write ``content`` to ``path`` through a temporary file and a rename."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_bytes(content)
-    os.replace(tmp, path)
+    """Write ``content`` to ``path`` whole or not at all (:func:`footfall._io.atomic_open`: a
+    temporary file beside it, flushed to disk and renamed over it)."""
+    from footfall._io import atomic_open
+
+    with atomic_open(path, "wb") as fh:
+        fh.write(content)
     return path
 
 
