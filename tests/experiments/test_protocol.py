@@ -209,11 +209,12 @@ def test_cli_refuses_bad_values(tmp_path: Path, args: list[str], field: str) -> 
 
 @pytest.mark.slow
 def test_cli_small_real_run(tmp_path: Path) -> None:
+    """Two walks in two worker processes: the rows come back in the protocol's order."""
     pytest.importorskip("mujoco")
     out = tmp_path / "out"
     r = footfall(
         "bench", "pushes", "--protocol", "--robot", "biped", "--scene", "flat", "--dv", "0.05",
-        "--phases", "0.45", "--directions", "forward,outward", "--out", str(out),
+        "--phases", "0.45", "--directions", "forward,outward", "--workers", "2", "--out", str(out),
         timeout=600,
     )  # fmt: skip
     assert r.returncode == 0, r.stderr[-2000:]
