@@ -8,6 +8,7 @@ import typer
 
 from footfall._io import remove_outputs, write_json, write_text
 from footfall.cli._common import (
+    ROBOT_HELP,
     _threads,
     app,
     console,
@@ -150,3 +151,109 @@ def bench_quadruped_cmd(
     write_json(out / "bench_quadruped.json", result)
     for key, value in result.items():
         console.print(f"{key}: {value}")
+
+
+_DV_HELP = (
+    "Velocity changes [m/s], comma separated, each > 0: the push as a velocity change; the impulse "
+    "is the robot's mass x dv [N s]."
+)
+
+
+@bench_app.command("pushes")
+def bench_pushes_cmd(
+    protocol: bool = typer.Option(
+        False,
+        "--protocol",
+        help="The field's push-recovery protocol (required: the command's only mode).",
+    ),
+    robot: str = typer.Option("biped", help=ROBOT_HELP),
+    scene: str = typer.Option("flat_long", "--scene", help="Built-in scene name or YAML file."),
+    steps: int | None = typer.Option(
+        None, help="Footsteps N of the plan; omitted: the planner's smallest N."
+    ),
+    planner: str = typer.Option("miqcqp", help="miqcqp, kinematic or reactive."),
+    controller: str = typer.Option("wbc", help="The walker's controller: wbc or servo."),
+    dv: str = typer.Option("0.1,0.2,0.3", "--dv", help=_DV_HELP),
+    phases: str = typer.Option(
+        "0.2,0.45,0.7",
+        help="When the push starts, as shares of the pushed single support in [0, 1], comma "
+        "separated.",
+    ),
+    directions: str = typer.Option(
+        "forward,backward,inward,outward",
+        help="Push directions relative to the stance foot at the push, comma separated: forward "
+        "(along its heading), backward, inward (toward the stance foot's side), outward (toward "
+        "the swing foot's side).",
+    ),
+    step: int | None = typer.Option(
+        None, help="The pushed single support (0-based). [default: the middle one, N // 2]"
+    ),
+    duration: float = typer.Option(0.05, help="Push length [s]."),
+    time_limit: float = typer.Option(300.0, help="Planner time limit per solve [s]."),
+    workers: int = typer.Option(1, help="Walks at once (worker processes)."),
+    out: Path = typer.Option(
+        Path("out/bench"), help="Output folder for protocol.csv/.md/.png (plans cached in plans/)."
+    ),
+) -> None:
+    """Push recovery as the field measures it: one push of --duration (0.05 s) in the middle
+    single support of a walk, at each phase and in each direction, per velocity change. A level
+    passes when every case reaches the goal without a fall; the summary names the largest.
+
+    Writes protocol.csv (one row per walk), protocol.md (direction x phase per level) and
+    protocol.png; exit 0 when every walk ran (a fall is a result, not an error).
+    """
+    from footfall.experiments.protocol import (
+        PushProtocol,
+        format_markdown,
+        format_summary,
+        plot_protocol,
+        rows_csv,
+        run_protocol,
+    )
+
+    if not protocol:
+        raise InputError(
+            "protocol",
+            "not given",
+            "--protocol (the only mode of bench pushes; seeded push sweeps: footfall study)",
+        )
+    dv_values = parse_floats("dv", dv)
+    if not dv_values or any(not v > 0 or v != v for v in dv_values):
+        raise InputError("dv", dv, "comma-separated velocity changes > 0 [m/s], e.g. 0.1,0.2")
+    phase_values = parse_floats("phases", phases)
+    if not phase_values or any(not 0.0 <= v <= 1.0 for v in phase_values):
+        raise InputError("phases", phases, "comma-separated shares in [0, 1], e.g. 0.2,0.45,0.7")
+    if workers < 1:
+        raise InputError("workers", workers, "an integer >= 1")
+    files = ("protocol.csv", "protocol.md", "protocol.png")
+    refuse_inputs_as_outputs([scene, robot], {"out": [out / f for f in files]})
+    proto = PushProtocol(
+        dv=tuple(dv_values),
+        phases=tuple(phase_values),
+        directions=tuple(d.strip() for d in directions.split(",") if d.strip()),
+        duration=duration,
+        step=step,
+        robot=robot,
+        scene=scene,
+        steps=steps,
+        planner=planner,
+        controller=controller,
+    )
+    from footfall.robots.registry import resolve_robot_file
+    from footfall.terrain.resolve import resolve_scene
+
+    resolve_robot_file(robot)  # an unknown robot or scene is refused before any output
+    resolve_scene(scene)
+    output_folder(out)
+    remove_outputs(out, *files)  # no file of another run beside ours
+
+    def progress(row: dict[str, object]) -> None:
+        verdict = "pass" if row["success"] else ("fell" if row["fell"] else "missed the goal")
+        console.print(f"dv {row['dv_m_s']:g} m/s {row['direction']}@{row['phase']:g}: {verdict}")
+
+    result = run_protocol(proto, out / "plans", workers, time_limit, progress)
+    write_text(out / "protocol.csv", rows_csv(result.rows))
+    write_text(out / "protocol.md", format_markdown(result))
+    plot_protocol(result, out / "protocol.png")
+    print(format_summary(result))
+    console.print(f"wrote {out / 'protocol.csv'}, protocol.md, protocol.png")

@@ -6,20 +6,21 @@
   plants apply it to the torso or trunk.
 - :class:`Disturbance` is what a trial asks for, as configuration: a push given as an impulse
   [N s], or as a velocity change [m/s] (impulse = robot mass x velocity change), a direction in
-  the world frame, and a time given as the single support it comes in (a step index, or a
+  the world frame or relative to the walk at the push (``frame``), and a time given as the single support it comes in (a step index, or a
   fraction of the plan's footsteps) and the phase of that single support; plus an optional
   initial perturbation while the robot still stands on both feet.
 - :meth:`Disturbance.of_seed` is the one seeded sampler: which step, which phase, which
   direction. For a given seed every planner, step count, plant and command gets the same draw
   (common random numbers); only the magnitude varies between push levels.
-- :class:`SupportTimeline` says when each single support of a walk starts and how long it lasts;
-  each plant gives its own (:meth:`footfall.sim.trial.Plant.timeline`), and
+- :class:`SupportTimeline` says when each single support of a walk starts and how long it lasts
+  (and, for a biped, which foot it stands on at which heading); each plant gives its own (:meth:`footfall.sim.trial.Plant.timeline`), and
   :meth:`Disturbance.pushes` turns the disturbance into the plant's :class:`Push` pulses.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -39,6 +40,11 @@ PUSH_PHASE_WINDOW = (0.2, 0.6)
 PUSH_DURATION = 0.1
 #: the initial perturbation ends this many push durations before the first single support
 INITIAL_LEAD = 1.5
+#: frames of a push direction: ``world`` (0 = +x) or ``walk`` (0 = forward along the stance
+#: foot's heading, pi / 2 = inward toward the stance foot's side, see :class:`Disturbance`)
+FRAMES = ("world", "walk")
+#: the sides a stance foot may have on a :class:`SupportTimeline`
+SIDES = ("left", "right")
 
 
 @dataclass(frozen=True)
@@ -123,20 +129,55 @@ class SupportTimeline:
         walk_start: when the first single support starts [s] (before it the robot stands).
         starts: start of each single support, shape (N,) [s].
         durations: length of each single support, shape (N,) [s].
+        headings: heading [rad] of the stance foot of each single support, shape (N,); empty
+            when the plant has no such feet (a push in the ``walk`` frame needs them).
+        sides: the stance foot (``left`` or ``right``) of each single support, length N; empty
+            with ``headings``.
     """
 
     walk_start: float
     starts: tuple[float, ...]
     durations: tuple[float, ...]
+    headings: tuple[float, ...] = ()
+    sides: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        n = len(self.starts)
+        if len(self.durations) != n:
+            raise InputError("timeline.durations", len(self.durations), f"{n} single supports")
+        if len(self.headings) != len(self.sides) or len(self.headings) not in (0, n):
+            raise InputError(
+                "timeline.headings", len(self.headings), f"0 or {n}, as many as timeline.sides"
+            )
+        object.__setattr__(
+            self, "headings", tuple(finite("timeline.headings", h) for h in self.headings)
+        )
+        sides = tuple(str(getattr(s, "value", s)) for s in self.sides)
+        for s in sides:
+            if s not in SIDES:
+                raise InputError("timeline.sides", s, f"one of {', '.join(SIDES)}")
+        object.__setattr__(self, "sides", sides)
 
     @classmethod
-    def periodic(cls, walk_start: float, n_steps: int, t_ss: float, t_ds: float) -> SupportTimeline:
-        """N single supports of ``t_ss`` [s], one every ``t_ss + t_ds`` [s] from ``walk_start``."""
+    def periodic(
+        cls,
+        walk_start: float,
+        n_steps: int,
+        t_ss: float,
+        t_ds: float,
+        headings: Sequence[float] | FloatArray = (),
+        sides: Sequence[str] = (),
+    ) -> SupportTimeline:
+        """N single supports of ``t_ss`` [s], one every ``t_ss + t_ds`` [s] from ``walk_start``,
+        standing on feet of ``sides`` at ``headings`` [rad] (the first N of a longer sequence:
+        a footstep plan's N + 1 footsteps; empty: unknown)."""
         period = t_ss + t_ds
         return cls(
             walk_start,
             tuple(walk_start + i * period for i in range(n_steps)),
             (t_ss,) * n_steps,
+            tuple(float(h) for h in headings[:n_steps]),
+            tuple(sides[:n_steps]),
         )
 
     @property
@@ -152,7 +193,7 @@ class Disturbance:
     Attributes:
         impulse: push impulse [N s] (0: no push); with ``dv`` it must be 0.
         dv: the push as a velocity change [m/s] instead: impulse = robot mass x ``dv``.
-        direction: push direction in the world frame [rad] (0 = +x, pi / 2 = +y).
+        direction: push direction [rad] in ``frame``.
         step: the single support the push comes in (0-based); None: ``step_fraction`` of N.
         step_fraction: with ``step`` None, the step ``floor(f N)`` (at most N - 1), f in [0, 1).
         phase: when in that single support, as a share of it in [0, 1].
@@ -162,6 +203,12 @@ class Disturbance:
             (starting at 0 at the latest).
         initial_direction: its direction in the world frame [rad].
         seed: the seed this disturbance was drawn from (None: given by hand).
+        frame: the frame of ``direction``: ``world`` (0 = +x, pi / 2 = +y), or ``walk``, relative
+            to the stance foot of the pushed single support: 0 = forward along its heading,
+            pi / 2 = inward (toward the stance foot's side), -pi / 2 = outward (toward the swing
+            foot's side), pi = backward. A left stance turns the direction to the world as
+            ``heading + direction``, a right stance mirrors it: ``heading - direction``. The
+            initial perturbation's direction is always in the world frame.
     """
 
     impulse: float = 0.0
@@ -174,8 +221,11 @@ class Disturbance:
     initial_impulse: float = 0.0
     initial_direction: float = 0.0
     seed: int | None = None
+    frame: str = "world"
 
     def __post_init__(self) -> None:
+        if self.frame not in FRAMES:
+            raise InputError("push frame", self.frame, f"one of {', '.join(FRAMES)}")
         object.__setattr__(self, "impulse", non_negative("push impulse [N s]", self.impulse))
         if self.dv is not None:
             object.__setattr__(self, "dv", non_negative("push velocity change [m/s]", self.dv))
@@ -250,6 +300,23 @@ class Disturbance:
         step = self.push_step(timeline.n_steps)
         return timeline.starts[step] + self.phase * timeline.durations[step]
 
+    def world_direction(self, timeline: SupportTimeline) -> float:
+        """The push direction in the world frame [rad] on ``timeline`` (``direction`` itself in
+        the ``world`` frame; in the ``walk`` frame from the pushed single support's stance foot).
+
+        Raises:
+            InputError: a ``walk`` push on a timeline without stance feet (a quadruped's).
+        """
+        if self.frame == "world":
+            return self.direction
+        if not timeline.headings:
+            raise InputError(
+                "push frame", self.frame, "world on a plant without stance feet of a biped"
+            )
+        step = self.push_step(timeline.n_steps)
+        sign = 1.0 if timeline.sides[step] == "left" else -1.0
+        return timeline.headings[step] + sign * self.direction
+
     def pushes(self, timeline: SupportTimeline, mass: float) -> tuple[Push, ...]:
         """The pulses of this disturbance on a walk with ``timeline`` by a robot of ``mass``
         [kg]: the initial perturbation (if any), then the push (if its impulse is > 0)."""
@@ -262,7 +329,8 @@ class Disturbance:
         impulse = self.impulse_for(mass)
         if impulse > 0:
             t = self.push_time(timeline)
-            out.append(Push.horizontal(t, impulse, self.direction, self.duration))
+            direction = self.world_direction(timeline)
+            out.append(Push.horizontal(t, impulse, direction, self.duration))
         return tuple(out)
 
     def to_dict(self) -> dict[str, Any]:
@@ -278,6 +346,7 @@ class Disturbance:
             "initial_impulse_Ns": self.initial_impulse,
             "initial_direction_rad": self.initial_direction,
             "seed": self.seed,
+            "frame": self.frame,
         }
 
 

@@ -46,9 +46,12 @@ class MujocoBipedPlant:
 
     def timeline(self, plan: FootstepPlan) -> SupportTimeline:
         """The robot stands for ``settle_time``, shifts its CoM over the first stance foot for
-        ``shift_time``, then single support i starts every ``T_ss + T_ds``."""
+        ``shift_time``, then single support i starts every ``T_ss + T_ds``,
+        standing on footstep i."""
         start = self.options.settle_time + self.options.shift_time
-        return SupportTimeline.periodic(start, plan.n_steps, plan.robot.t_ss, plan.robot.t_ds)
+        return SupportTimeline.periodic(
+            start, plan.n_steps, plan.robot.t_ss, plan.robot.t_ds, plan.headings, plan.sides
+        )
 
     def mass(self, plan: FootstepPlan) -> float:
         """The plan robot's mass [kg] (measured from the walker model when planned for it)."""

@@ -35,8 +35,11 @@ class ReducedPlant:
         check_settings(self.options, SimOptions, "a SimOptions")
 
     def timeline(self, plan: FootstepPlan) -> SupportTimeline:
-        """The walk starts at once: single support i starts at ``i (T_ss + T_ds)``."""
-        return SupportTimeline.periodic(0.0, plan.n_steps, plan.robot.t_ss, plan.robot.t_ds)
+        """The walk starts at once: single support i starts at ``i (T_ss + T_ds)``,
+        standing on footstep i."""
+        return SupportTimeline.periodic(
+            0.0, plan.n_steps, plan.robot.t_ss, plan.robot.t_ds, plan.headings, plan.sides
+        )
 
     def mass(self, plan: FootstepPlan) -> float:
         """The plan robot's mass [kg] (the model's, before any mismatch)."""
