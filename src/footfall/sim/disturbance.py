@@ -6,14 +6,16 @@
   plants apply it to the torso or trunk.
 - :class:`Disturbance` is what a trial asks for, as configuration: a push given as an impulse
   [N s], or as a velocity change [m/s] (impulse = robot mass x velocity change), a direction in
-  the world frame or relative to the walk at the push (``frame``), and a time given as the single support it comes in (a step index, or a
-  fraction of the plan's footsteps) and the phase of that single support; plus an optional
+  the world frame or relative to the walk at the push (``frame``), and a time given as the
+  single support it comes in (a step index, or a fraction of the plan's footsteps) and the
+  phase of that single support; plus an optional
   initial perturbation while the robot still stands on both feet.
 - :meth:`Disturbance.of_seed` is the one seeded sampler: which step, which phase, which
   direction. For a given seed every planner, step count, plant and command gets the same draw
   (common random numbers); only the magnitude varies between push levels.
 - :class:`SupportTimeline` says when each single support of a walk starts and how long it lasts
-  (and, for a biped, which foot it stands on at which heading); each plant gives its own (:meth:`footfall.sim.trial.Plant.timeline`), and
+  (and, for a biped, which foot it stands on at which heading); each plant gives its own
+  (:meth:`footfall.sim.trial.Plant.timeline`), and
   :meth:`Disturbance.pushes` turns the disturbance into the plant's :class:`Push` pulses.
 """
 
