@@ -254,13 +254,14 @@ class _Sole(StrictSpec):
 
 
 class _Physics(StrictSpec):
-    servo_saturation: float = 0.05
-    servo_damping_time: float = 0.02
-    armature: float = 0.02
-    joint_damping: float = 0.5
-    timestep: float = 0.002
-    friction: float = 1.0
-    impratio: float = 10.0
+    # the defaults are Physics' own (one place); Physics checks the values
+    servo_saturation: float = Physics.servo_saturation
+    servo_damping_time: float = Physics.servo_damping_time
+    armature: float = Physics.armature
+    joint_damping: float = Physics.joint_damping
+    timestep: float = Physics.timestep
+    friction: float = Physics.friction
+    impratio: float = Physics.impratio
 
 
 class _RobotFileSpec(StrictSpec):
