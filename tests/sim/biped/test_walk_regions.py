@@ -121,3 +121,31 @@ def test_new_scenes_are_walked_with_every_footstep_on_a_region(name: str) -> Non
             for r in scene.terrain.regions
         ), p
     assert res.metrics.footsteps_off_regions == 0
+
+
+@pytest.mark.parametrize("limited", [True, False])
+def test_the_swing_target_moves_at_most_its_speed_per_tick(limited: bool) -> None:
+    """The swing path's target moves toward a jumped MPC footstep by at most speed * dt per
+    tick; the speed crosses the reach trapezoid's diameter in one single support. By hand for
+    the biped: the corners (-0.20, 0.12) and (0.35, 0.12) are 0.55 m apart, T_ss = 0.4 s, so
+    1.375 m/s and 13.75 mm per 10 ms tick; a 0.10 m jump takes 8 ticks (7 full, 0.75 mm)."""
+    from footfall.sim.biped.walk import BipedWalk
+
+    scene = builtin_scene("stepping_stones")
+    plan = load_plan(PLAN, scene)
+    walker = BipedWalk(scene, plan, WalkOptions(swing_target_rate=limited))
+    assert walker.target_speed == pytest.approx(0.55 / 0.4)
+    assert walker.dt == pytest.approx(0.01)
+    walker._begin_step(0)
+    planned = np.asarray(plan.footsteps[1], dtype=float)
+    goal = planned + np.array([0.0, 0.10, 0.0])
+    if not limited:
+        assert np.allclose(walker._limit_target(goal), goal)
+        return
+    expected_y = [0.01375 * k for k in range(1, 8)] + [0.10, 0.10]
+    for y in expected_y:
+        target = walker._limit_target(goal)
+        assert target == pytest.approx(planned + np.array([0.0, y, 0.0]), abs=1e-12)
+    # the next step starts from its own planned footstep
+    walker._begin_step(1)
+    assert walker.swing.target == pytest.approx(np.asarray(plan.footsteps[2], dtype=float))

@@ -121,6 +121,16 @@ class WalkOptions:
             ``PLAN_ROBOT_RTOL`` from the walker model's
             (:func:`~footfall.sim.biped.model.planner_params`): its ALIP motion
             is then another pendulum's. False walks such a plan on purpose (a mismatch study).
+        swing_target_rate: the target the swing sole's path heads for moves toward the MPC's
+            footstep by at most :func:`~footfall.sim.biped.walk.swing_target_speed` times the
+            control period per tick, and the sole lands (and the trace logs its target) where the
+            limited target ends up. False: the path follows the MPC's footstep as it is, and a
+            footstep moved late in the swing jumps the swing reference (the whole-body
+            controller then restarts it with zero velocity). Default True: the G1's push
+            protocol on flat_long passed 12/12 at 0.1 m/s and 12/12 at 0.2 m/s against 10/12
+            and 6/12 with False, and the biped's held-out 4 N s pushes (wbc, seeds 100-149)
+            reached the goal in 93 of 100 against 84 (9 gained, 0 lost, exact McNemar
+            p = 0.004).
     """
 
     controller: str = "wbc"
@@ -146,6 +156,7 @@ class WalkOptions:
     region_aware: str = "planned"
     passive_landing: bool = True
     check_robot: bool = True
+    swing_target_rate: bool = True
 
     def __post_init__(self) -> None:
         if self.region_aware not in REGION_MODES:

@@ -48,6 +48,8 @@ class SwingState:
     descend: float = 1.0 - SWING_SHARES[0]
     #: the target (3,) [m] the apex was set for
     apex_for: FloatArray = field(default_factory=lambda: np.zeros(3))
+    #: the target (3,) [m] the swing path heads for (rate-limited toward the MPC's footstep)
+    target: FloatArray = field(default_factory=lambda: np.zeros(3))
 
 
 @dataclass

@@ -51,7 +51,7 @@ from footfall.control.adjusters import (
     sole_torque_limits,
 )
 from footfall.errors import InputError, SolverError
-from footfall.models.biped import Side
+from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import FootstepPlan
 from footfall.results.walk import WalkResult, WalkTrace
 from footfall.robots import names as nm
@@ -94,6 +94,23 @@ CONTACT_FORCE_SHARE = 0.02
 SWING_RETARGET = 0.01
 
 
+def swing_target_speed(robot: BipedParams) -> float:
+    """The fastest the swing target may move [m/s]: across the whole reach trapezoid (its
+    diameter, the farthest two reachable footsteps apart) within one single support T_ss."""
+    v = np.asarray(robot.reach.vertices, dtype=float)
+    diameter = max(float(np.linalg.norm(a - b)) for a in v for b in v)
+    return diameter / robot.t_ss
+
+
+def step_toward(current: FloatArray, goal: FloatArray, max_step: float) -> FloatArray:
+    """``current`` moved toward ``goal`` (both (3,) [m]) by at most ``max_step`` [m]."""
+    delta = np.asarray(goal, dtype=float) - current
+    dist = float(np.linalg.norm(delta))
+    if dist <= max_step:
+        return np.array(goal, dtype=float)
+    return current + delta * (max_step / dist)
+
+
 class BipedWalk:
     """One simulated walk of a plan: setup, then one :meth:`step` per control tick.
 
@@ -131,6 +148,7 @@ class BipedWalk:
         self.ds_map = ds_propagator(self.alip, self.dt)
         self.n = self.plan.n_steps
         self.t_ss, self.t_ds = robot.t_ss, robot.t_ds
+        self.target_speed = swing_target_speed(robot)
         self.t_step = self.t_ss + self.t_ds
         self.t_walk0 = opts.settle_time + opts.shift_time
         self.t_end_steps = self.t_walk0 + self.n * self.t_step
@@ -338,6 +356,17 @@ class BipedWalk:
             swing.apex - float(swing.start[2]), swing.apex - float(target[2]), self.t_ss
         )
         swing.apex_for = np.array(target, dtype=float)
+        swing.target = np.array(target, dtype=float)
+
+    def _limit_target(self, nxt: FloatArray) -> FloatArray:
+        """Move the swing target toward the MPC's footstep ``nxt`` (3,) [m] by at most
+        ``target_speed * dt`` this tick (``swing_target_rate``); return the target to use."""
+        swing = self.swing
+        if not self.opts.swing_target_rate:
+            swing.target = np.array(nxt, dtype=float)
+            return swing.target.copy()
+        swing.target = step_toward(swing.target, nxt, self.target_speed * self.dt)
+        return swing.target.copy()
 
     def _raise_swing(self, tp: float, nxt: FloatArray) -> None:
         """A corrected target (``region_aware``) may lie across other edges than the planned
@@ -371,6 +400,7 @@ class BipedWalk:
         else:
             x_meas = x_cv
         nxt, u = self.src.update(tp, x_meas, stance, i)
+        nxt = self._limit_target(nxt)
         self._raise_swing(tp, nxt)
         self.log.targets[i] = nxt
         self.log.zmp_planned[k] = alip.zmp(np.zeros(2), u)
