@@ -11,37 +11,30 @@ from __future__ import annotations
 
 import importlib.metadata
 import math
-import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-mujoco = pytest.importorskip("mujoco")
+# isort: off
+# first: without the robots extra this skips the module (or fails with FOOTFALL_REQUIRE_ROBOTS=1)
+from tests.robots._require import mujoco
 
-try:
-    importlib.metadata.distribution("example-robot-data")
-except importlib.metadata.PackageNotFoundError:
-    if os.environ.get("FOOTFALL_REQUIRE_ROBOTS") == "1":
-        raise
-    pytest.skip(
-        "example-robot-data is not installed (pip install 'footfall[robots]')",
-        allow_module_level=True,
-    )
+# isort: on
 
-from footfall._geometry import convex_hull  # noqa: E402
-from footfall.errors import InputError, MissingExtraError  # noqa: E402
-from footfall.models.biped import Side  # noqa: E402
-from footfall.robots import names as nm  # noqa: E402
-from footfall.robots.build import layout, raw_model, sole_from_geometry  # noqa: E402
-from footfall.robots.derive import IK_TOL, JOINT_MARGIN, stance_feasible  # noqa: E402
-from footfall.robots.file import LEG_JOINT_ROLES, parse_robot_file  # noqa: E402
-from footfall.robots.model import RobotModel, _kinematics  # noqa: E402
-from footfall.robots.registry import builtin_robot_file, builtin_robot_names  # noqa: E402
-from footfall.sim.biped.model import measure_model, planner_params  # noqa: E402
-from footfall.sim.biped.plans import robot_model  # noqa: E402
-from footfall.terrain import builtin_scene  # noqa: E402
+from footfall._geometry import convex_hull
+from footfall.errors import InputError, MissingExtraError
+from footfall.models.biped import Side
+from footfall.robots import names as nm
+from footfall.robots.build import layout, raw_model, sole_from_geometry
+from footfall.robots.derive import IK_TOL, JOINT_MARGIN, stance_feasible
+from footfall.robots.file import LEG_JOINT_ROLES, parse_robot_file
+from footfall.robots.model import RobotModel, _kinematics
+from footfall.robots.registry import builtin_robot_file, builtin_robot_names
+from footfall.sim.biped.model import measure_model, planner_params
+from footfall.sim.biped.plans import robot_model
+from footfall.terrain import builtin_scene
 
 pytestmark = pytest.mark.robots
 

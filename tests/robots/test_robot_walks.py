@@ -11,34 +11,26 @@ from __future__ import annotations
 import importlib.metadata
 import json
 import math
-import os
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-mujoco = pytest.importorskip("mujoco")
+# isort: off
+# first: without the robots extra this skips the module (or fails with FOOTFALL_REQUIRE_ROBOTS=1)
+from tests.robots._require import mujoco
 
-try:
-    importlib.metadata.distribution("example-robot-data")
-except importlib.metadata.PackageNotFoundError:
-    if os.environ.get("FOOTFALL_REQUIRE_ROBOTS") == "1":
-        raise
-    pytest.skip(
-        "example-robot-data is not installed (pip install 'footfall[robots]')",
-        allow_module_level=True,
-    )
+# isort: on
+from typer.testing import CliRunner
 
-from typer.testing import CliRunner  # noqa: E402
-
-from footfall.cli import app  # noqa: E402
-from footfall.errors import InputError, MissingExtraError  # noqa: E402
-from footfall.robots import file as robot_file  # noqa: E402
-from footfall.sim.biped.model import measure_model, planner_params  # noqa: E402
-from footfall.sim.biped.plans import robot_model  # noqa: E402
-from footfall.sim.biped.plant import BipedSim, ankle_joint_torque  # noqa: E402
-from footfall.terrain import Goal, builtin_scene  # noqa: E402
+from footfall.cli import app
+from footfall.errors import InputError, MissingExtraError
+from footfall.robots import file as robot_file
+from footfall.sim.biped.model import measure_model, planner_params
+from footfall.sim.biped.plans import robot_model
+from footfall.sim.biped.plant import BipedSim, ankle_joint_torque
+from footfall.terrain import Goal, builtin_scene
 
 pytestmark = pytest.mark.robots
 
