@@ -26,7 +26,7 @@ from footfall.quadruped.kinematics import (
     body_rotation,
     foot_in_leg_frame,
     leg_ik,
-    leg_points,
+    leg_mass_points,
     whole_body_com,
 )
 from footfall.quadruped.posture import BodyPosture, SlopePosture
@@ -361,7 +361,7 @@ def _initial_stance(
     pitch = post.body_pitch
     rot = body_rotation(pitch)
     d = post.leg_direction()
-    feet = np.array([ground.drop(body + rot @ robot.hip_offset(leg), d) for leg in LEGS])
+    feet = np.array([ground.drop(body + rot @ robot.stance_offset(leg), d) for leg in LEGS])
     return body, pitch, feet
 
 
@@ -382,8 +382,9 @@ def _body_for_com(
     rot = body_rotation(local.pitch)
     hips = robot.hip_offsets()
     for _ in range(_COM_ITERATIONS):
+        p_leg = (feet - body) @ rot - hips
         try:
-            q = leg_ik(robot, (feet - body) @ rot - hips)
+            q = np.concatenate([leg_ik(robot, p_leg[i], leg) for i, leg in enumerate(LEGS)])
         except InputError as exc:
             raise InputError(
                 "step",
@@ -419,15 +420,7 @@ def plan_gait(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
         if exc.field != "step":
             raise
         reason = exc.expected
-    # largest feasible step, by bisection on short plans (the gait repeats every cycle)
-    lo, hi = 0.0, params.step
-    for _ in range(_BISECT_STEPS // 2):
-        mid = 0.5 * (lo + hi)
-        try:
-            _plan(robot, replace(params, step=mid, cycles=min(params.cycles, 2)))
-            lo = mid
-        except InputError:
-            hi = mid
+    lo = largest_step(robot, params)
     raise InputError(
         "step",
         f"{params.step:.3f} m",
@@ -435,6 +428,30 @@ def plan_gait(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
         f"{math.degrees(params.body_pitch):.2f} deg and strategy {params.strategy.value} "
         f"(leg workspace; {reason})",
     )
+
+
+def largest_step(robot: QuadrupedRobot, params: GaitParams) -> float:
+    """The largest step length [m] up to ``params.step`` the leg workspace allows for this
+    ground, posture and strategy, by bisection on whole plans (within
+    ``params.step / 2**(_BISECT_STEPS // 2)``; on a plane the gait repeats every cycle, so two
+    cycles are planned); 0 when none does."""
+    check_reachability(robot, params)
+    cycles = params.cycles if params.ground is not None else min(params.cycles, 2)
+    lo, hi = 0.0, params.step
+    try:
+        _plan(robot, replace(params, cycles=cycles))
+        return params.step
+    except InputError as exc:
+        if exc.field != "step":
+            raise
+    for _ in range(_BISECT_STEPS // 2):
+        mid = 0.5 * (lo + hi)
+        try:
+            _plan(robot, replace(params, step=mid, cycles=cycles))
+            lo = mid
+        except InputError:
+            hi = mid
+    return lo
 
 
 def _plan(robot: QuadrupedRobot, params: GaitParams) -> GaitPlan:
@@ -719,22 +736,21 @@ def _step_angle(plan: GaitPlan, chord: FloatArray) -> float:
 def _point_masses(
     plan: GaitPlan, body: FloatArray, pitch: FloatArray, joints: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
-    """Point masses (trunk, per leg hip/thigh/shank), positions shape (T, 13, 3), masses (13,)."""
+    """Point masses (trunk, per leg ab/ad link/thigh/shank, each at its centre of mass),
+    positions shape (T, 13, 3), masses (13,)."""
     robot = plan.robot
     rot = _rotations(pitch)
     n = body.shape[0]
     pos = np.empty((n, 13, 3))
     masses = np.empty(13)
-    pos[:, 0] = body
+    pos[:, 0] = body + rot @ np.asarray(robot.body_com)
     masses[0] = robot.body_mass
     for i, leg in enumerate(LEGS):
-        pts = leg_points(robot, joints[:, 3 * i : 3 * i + 3])
-        knee, foot = pts[:, 0], pts[:, 1]
-        local = np.stack([np.zeros_like(knee), 0.5 * knee, 0.5 * (knee + foot)], axis=1)
+        local = leg_mass_points(robot, joints[:, 3 * i : 3 * i + 3], leg)
         pos[:, 1 + 3 * i : 4 + 3 * i] = body[:, None, :] + np.einsum(
             "tij,tkj->tki", rot, local + robot.hip_offset(leg)
         )
-        masses[1 + 3 * i : 4 + 3 * i] = (robot.hip_mass, robot.thigh_mass, robot.shank_mass)
+        masses[1 + 3 * i : 4 + 3 * i] = robot.leg_geometry(leg).masses
     return pos, masses
 
 
@@ -781,6 +797,7 @@ __all__ = [
     "GaitTrajectory",
     "PhaseKind",
     "check_reachability",
+    "largest_step",
     "plan_gait",
     "sample_plan",
 ]

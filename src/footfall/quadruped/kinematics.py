@@ -17,12 +17,14 @@ Body orientation: footfall's gaits only pitch the body. ``pitch_up`` is the docu
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
 
 from footfall._typing import FloatArray
 from footfall.errors import InputError
-from footfall.quadruped.robot import JOINT_NAMES, LEGS, Leg, QuadrupedRobot
+from footfall.quadruped.robot import JOINT_NAMES, LEGS, Leg, LegGeometry, QuadrupedRobot
 
 #: tolerance on the law-of-cosines argument before a target counts as out of reach
 _REACH_TOL = 1e-9
@@ -39,71 +41,121 @@ def body_rotation(pitch_up: float) -> FloatArray:
     return rot_y(-pitch_up)
 
 
-def leg_fk(robot: QuadrupedRobot, q: ArrayLike) -> FloatArray:
-    """Foot-centre position in the leg frame from joint angles (closed form).
+def _geometry(robot: QuadrupedRobot, leg: Leg | None) -> LegGeometry:
+    """The geometry of ``leg``; the document's legs are all alike, so ``leg`` may be None."""
+    if leg is None:
+        if robot.legs is not None:
+            raise ValueError("a robot loaded from its model needs the leg named")
+        return robot.leg_geometry(Leg.LF)
+    return robot.leg_geometry(leg)
+
+
+def _rx(t: FloatArray, v: FloatArray) -> FloatArray:
+    """Rotate vectors ``v`` (..., 3) about x by angles ``t`` (...)."""
+    c, s = np.cos(t), np.sin(t)
+    return np.stack([v[..., 0], c * v[..., 1] - s * v[..., 2], s * v[..., 1] + c * v[..., 2]], -1)
+
+
+def _ry(t: FloatArray, v: FloatArray) -> FloatArray:
+    """Rotate vectors ``v`` (..., 3) about y by angles ``t`` (...)."""
+    c, s = np.cos(t), np.sin(t)
+    return np.stack([c * v[..., 0] + s * v[..., 2], v[..., 1], -s * v[..., 0] + c * v[..., 2]], -1)
+
+
+def _chain(geo: LegGeometry, q: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Angles t = signs * q (..., 3) and the broadcast shape helpers."""
+    qa = np.asarray(q, dtype=float)
+    t = qa * np.asarray(geo.signs)
+    return t[..., 0], t[..., 1], t[..., 2]
+
+
+def leg_fk(robot: QuadrupedRobot, q: ArrayLike, leg: Leg | None = None) -> FloatArray:
+    """Foot-centre position in the leg frame from joint angles (closed form, eq. of
+    :class:`~footfall.quadruped.robot.LegGeometry`).
 
     Args:
-        robot: robot parameters (link lengths).
+        robot: robot parameters (link lengths or the model's leg geometry).
         q: joint angles ``(q1, q2, q3)`` [rad], shape (3,) or (N, 3).
+        leg: which leg (needed for a robot loaded from its model).
 
     Returns:
         Foot position(s) in the leg frame, shape (3,) or (N, 3) [m].
     """
-    qa = np.asarray(q, dtype=float)
-    q1, q2, q3 = qa[..., 0], qa[..., 1], qa[..., 2]
-    l1, l2 = robot.thigh_length, robot.shank_length
-    x = -l1 * np.sin(q2) - l2 * np.sin(q2 + q3)
-    r = l1 * np.cos(q2) + l2 * np.cos(q2 + q3)
-    return np.stack([x, r * np.sin(q1), -r * np.cos(q1)], axis=-1)
+    return leg_link_points(robot, q, leg)[..., 2, :]
 
 
-def leg_link_points(robot: QuadrupedRobot, q: ArrayLike) -> FloatArray:
-    """Hip, knee and foot positions in the leg frame, shape (3, 3) rows = (hip, knee, foot) [m]."""
-    q1, q2, _ = np.asarray(q, dtype=float)
-    l1 = robot.thigh_length
-    knee_sag = np.array([-l1 * np.sin(q2), l1 * np.cos(q2)])
-    knee = np.array([knee_sag[0], knee_sag[1] * np.sin(q1), -knee_sag[1] * np.cos(q1)])
-    return np.stack([np.zeros(3), knee, leg_fk(robot, q)])
+def leg_link_points(robot: QuadrupedRobot, q: ArrayLike, leg: Leg | None = None) -> FloatArray:
+    """Pitch-axis point, knee and foot positions in the leg frame, shape (..., 3, 3) rows =
+    (hip, knee, foot) [m] (the hip is the leg-frame origin for the document's robot)."""
+    geo = _geometry(robot, leg)
+    t1, t2, t3 = _chain(geo, q)
+    shape = np.shape(t1)
+    hfe = np.broadcast_to(np.asarray(geo.hfe), (*shape, 3))
+    knee_v = np.broadcast_to(np.asarray(geo.knee), (*shape, 3))
+    foot_v = np.broadcast_to(np.asarray(geo.foot), (*shape, 3))
+    knee_pitch = _ry(t2, knee_v)
+    foot_pitch = _ry(t2, knee_v + _ry(t3, foot_v))
+    return np.stack([_rx(t1, hfe), _rx(t1, hfe + knee_pitch), _rx(t1, hfe + foot_pitch)], axis=-2)
 
 
 def leg_ik(robot: QuadrupedRobot, foot: ArrayLike, leg: Leg | None = None) -> FloatArray:
-    """Closed-form inverse kinematics of one leg (knee-forward branch), vectorised.
+    """Closed-form inverse kinematics of one leg (the leg's knee branch), vectorised.
 
-    Inverts :func:`leg_fk`: ``q1 = atan2(y, -z)``, the sagittal length ``r = sqrt(y^2 + z^2)``, the
-    knee from the law of cosines and the hip pitch from the triangle hip-knee-foot. The foot is
-    taken to be below the hip in the leg's plane (``r > 0``), as it is in every stance and swing.
+    Inverts :func:`leg_fk`. The ab/ad angle turns the leg's plane so that the foot's sideways
+    offset from the ab/ad axis is the leg's :attr:`~LegGeometry.lateral`; in that plane the knee
+    angle follows from the law of cosines on the pitch-point-to-foot distance (branch
+    :attr:`~LegGeometry.branch`) and the pitch angle from the direction to the foot. The foot is
+    taken to be below the pitch axis (as it is in every stance and swing).
 
     Args:
         robot: robot parameters.
         foot: foot-centre position(s) in the leg frame, shape (3,) or (N, 3) [m].
-        leg: which leg (only used to name it in errors).
+        leg: which leg (names it in errors; needed for a robot loaded from its model).
 
     Returns:
-        Joint angles ``(q1, q2, q3)`` [rad], shape (3,) or (N, 3).
+        Joint angles ``(q1, q2, q3)`` [rad] (the model's), shape (3,) or (N, 3).
 
     Raises:
-        InputError: a target is farther than ``thigh + shank`` or violates a joint limit; the
-            message names the first offending target and limit.
+        InputError: a target out of the leg's reach or violating a joint limit; the message
+            names the first offending target and limit.
     """
+    geo = _geometry(robot, leg)
     p = np.asarray(foot, dtype=float)
     x, y, z = p[..., 0], p[..., 1], p[..., 2]
     name = f"foot[{leg.value}]" if leg is not None else "foot"
-    l1, l2 = robot.thigh_length, robot.shank_length
-    q1 = np.arctan2(y, -z)
-    r = np.hypot(y, z)
-    c3 = (x * x + r * r - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)
-    out_of_reach = np.abs(c3) > 1.0 + _REACH_TOL
+    hfe, kv, fv = np.asarray(geo.hfe), np.asarray(geo.knee), np.asarray(geo.foot)
+    lat = geo.lateral
+    # sagittal vectors (x, z) of the thigh and shank, and their lengths
+    a, b = kv[[0, 2]], fv[[0, 2]]
+    l1, l2 = float(np.hypot(*a)), float(np.hypot(*b))
+    rho2 = y * y + z * z - lat * lat
+    zs = -np.sqrt(np.maximum(rho2, 0.0))  # sagittal z of the foot, below the ab/ad axis
+    u_z = zs - hfe[2]
+    u2 = x * x + u_z * u_z
+    # |a + R_y(t3) b|^2 = l1^2 + l2^2 + 2 (A cos t3 + B sin t3)
+    big_a = a[0] * b[0] + a[1] * b[1]
+    big_b = a[0] * b[1] - a[1] * b[0]
+    psi = math.atan2(big_b, big_a)
+    c3 = (u2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)
+    out_of_reach = (np.abs(c3) > 1.0 + _REACH_TOL) | (rho2 < -_REACH_TOL)
     if np.any(out_of_reach):
         k = int(np.flatnonzero(np.atleast_1d(out_of_reach))[0])
         bad_p = p.reshape(-1, 3)[k]
         raise InputError(
             name, tuple(round(float(v), 4) for v in bad_p), f"within leg reach {l1 + l2:.3f} m"
         )
-    q3 = np.arccos(np.clip(c3, -1.0, 1.0))
-    q2 = np.arctan2(-x, r) - np.arctan2(l2 * np.sin(q3), l1 + l2 * np.cos(q3))
-    q = np.stack([q1, q2, q3], axis=-1)
-    lo = np.asarray(robot.joint_limits.lower)
-    hi = np.asarray(robot.joint_limits.upper)
+    t3 = psi + geo.branch * np.arccos(np.clip(c3, -1.0, 1.0))
+    t1 = np.arctan2(z, y) - np.arctan2(zs, lat)
+    # the pitch turns w = a + R_y(t3) b onto (x, u_z): angles measured as atan2(x, z)
+    c, s = np.cos(t3), np.sin(t3)
+    w_x = a[0] + c * b[0] + s * b[1]
+    w_z = a[1] - s * b[0] + c * b[1]
+    t2 = np.arctan2(x, u_z) - np.arctan2(w_x, w_z)
+    t = np.stack([t1, t2, t3], axis=-1)
+    t = (t + np.pi) % (2.0 * np.pi) - np.pi
+    q = t * np.asarray(geo.signs)
+    lo = np.asarray(geo.lower)
+    hi = np.asarray(geo.upper)
     bad = (q < lo - _REACH_TOL) | (q > hi + _REACH_TOL)
     if np.any(bad):
         flat = bad.reshape(-1, 3)
@@ -167,32 +219,44 @@ def whole_body_ik(
     return out
 
 
-def leg_points(robot: QuadrupedRobot, q: ArrayLike) -> FloatArray:
+def leg_points(robot: QuadrupedRobot, q: ArrayLike, leg: Leg | None = None) -> FloatArray:
     """Knee and foot positions in the leg frame, vectorised: shape (..., 2, 3) [m]."""
-    qa = np.asarray(q, dtype=float)
-    q1, q2 = qa[..., 0], qa[..., 1]
-    r1 = robot.thigh_length * np.cos(q2)
-    knee = np.stack([-robot.thigh_length * np.sin(q2), r1 * np.sin(q1), -r1 * np.cos(q1)], axis=-1)
-    return np.stack([knee, leg_fk(robot, qa)], axis=-2)
+    return leg_link_points(robot, q, leg)[..., 1:, :]
+
+
+def leg_mass_points(robot: QuadrupedRobot, q: ArrayLike, leg: Leg) -> FloatArray:
+    """Centres of mass of the ab/ad link, thigh and shank in the leg frame, vectorised: shape
+    (..., 3, 3) [m] (the hip and the link midpoints for the document's robot)."""
+    geo = robot.leg_geometry(leg)
+    t1, t2, t3 = _chain(geo, q)
+    shape = np.shape(t1)
+    hfe, kv = np.asarray(geo.hfe), np.asarray(geo.knee)
+    c = [np.broadcast_to(np.asarray(v), (*shape, 3)) for v in geo.coms]
+    hip = _rx(t1, c[0])
+    thigh = _rx(t1, hfe + _ry(t2, c[1]))
+    shank = _rx(t1, hfe + _ry(t2, np.broadcast_to(kv, (*shape, 3)) + _ry(t3, c[2])))
+    return np.stack([hip, thigh, shank], axis=-2)
 
 
 def whole_body_com(
     robot: QuadrupedRobot, body_pos: ArrayLike, pitch_up: float, q: ArrayLike
 ) -> FloatArray:
-    """Whole-robot centre of mass in ``{W}`` with point masses at the hips and link midpoints.
+    """Whole-robot centre of mass in ``{W}`` with point masses at the trunk's and each leg
+    link's centre of mass (:func:`leg_mass_points`).
 
     Args:
         robot: robot parameters (masses).
-        body_pos: body centre in ``{W}`` (the trunk's CoM), shape (3,) [m].
+        body_pos: body centre in ``{W}``, shape (3,) [m].
         pitch_up: body pitch beta_B [rad].
         q: joint angles in ``LEGS`` order, shape (12,) [rad].
 
     Returns:
         CoM position p_c in ``{W}``, shape (3,) [m].
     """
-    pts = leg_points(robot, np.asarray(q, dtype=float).reshape(4, 3))  # (4, 2, 3)
-    knee, foot = pts[:, 0], pts[:, 1]
-    # hip at the leg-frame origin; thigh mass at the thigh midpoint, shank at the shank midpoint
-    local = 0.5 * robot.thigh_mass * knee + 0.5 * robot.shank_mass * (knee + foot)
-    acc = robot.leg_mass * robot.hip_offsets().sum(axis=0) + local.sum(axis=0)
+    qa = np.asarray(q, dtype=float).reshape(4, 3)
+    acc = robot.body_mass * np.asarray(robot.body_com)
+    for i, leg in enumerate(LEGS):
+        geo = robot.leg_geometry(leg)
+        pts = leg_mass_points(robot, qa[i], leg) + robot.hip_offset(leg)
+        acc = acc + np.asarray(geo.masses) @ pts
     return np.asarray(body_pos, dtype=float) + body_rotation(pitch_up) @ acc / robot.total_mass

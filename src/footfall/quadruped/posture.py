@@ -157,7 +157,7 @@ class SlopePosture:
         n = self.slope_normal
         feet = np.empty((4, 3))
         for i, leg in enumerate(LEGS):
-            hip = body_pos + rot @ robot.hip_offset(leg)
+            hip = body_pos + rot @ robot.stance_offset(leg)
             # plane through the origin with normal n: n.(hip + s d) = 0
             s = -float(n @ hip) / float(n @ d)
             feet[i] = hip + s * d
