@@ -29,7 +29,7 @@ import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -52,6 +52,19 @@ _GREY, _DARK, _BLUE = [0.7, 0.7, 0.72, 1.0], [0.15, 0.15, 0.15, 1.0], [0.25, 0.3
 
 
 # ------------------------------------------------------------------------------------ the raw model
+class ModelSource(Protocol):
+    """What the raw model is read from: a humanoid's or a quadruped's robot file."""
+
+    @property
+    def model(self) -> Path: ...
+
+    @property
+    def base(self) -> str | None: ...
+
+    @property
+    def format(self) -> str: ...
+
+
 def _resolve_packages(text: str, model: Path) -> str:
     """URDF text with every ``package://NAME/`` replaced by the folder named NAME that holds the
     model file (the layout of ROS packages and example-robot-data)."""
@@ -69,7 +82,7 @@ def _resolve_packages(text: str, model: Path) -> str:
     return re.sub(r"package://([^/\"']+)/", lambda m: folder(m.group(1)), text)
 
 
-def _urdf_root(rf: RobotFile) -> ET.Element:
+def _urdf_root(rf: ModelSource) -> ET.Element:
     try:
         text = rf.model.read_text()
     except (OSError, UnicodeDecodeError) as e:
@@ -92,7 +105,7 @@ def _urdf_root(rf: RobotFile) -> ET.Element:
     return root
 
 
-def _spec_from(rf: RobotFile, root: ET.Element | None) -> Any:
+def _spec_from(rf: ModelSource, root: ET.Element | None) -> Any:
     mujoco = require_mujoco()
     try:
         if rf.format == "urdf":
@@ -106,7 +119,7 @@ def _spec_from(rf: RobotFile, root: ET.Element | None) -> Any:
     return spec
 
 
-def _base_name(rf: RobotFile, spec: Any) -> str:
+def _base_name(rf: ModelSource, spec: Any) -> str:
     roots = [b for b in spec.worldbody.bodies]
     if rf.base is not None:
         if spec.body(rf.base) is None:
@@ -134,6 +147,31 @@ class RawModel:
     data: Any
     base: str
     dropped: tuple[str, ...] = ()
+    repaired: tuple[str, ...] = ()
+
+
+def _repair_inertias(root: ET.Element) -> list[str]:
+    """Links whose URDF inertia is not positive definite (a placeholder such as every entry
+    0.001), their products of inertia dropped so that MuJoCo compiles the model; the links."""
+    keys = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+    repaired = []
+    for link in root.findall("./link"):
+        e = link.find("inertial/inertia")
+        if e is None:
+            continue
+        try:
+            xx, yy, zz, xy, xz, yz = (float(e.get(k, "0")) for k in keys)
+        except ValueError:
+            continue  # MuJoCo's parser names the bad number
+        tensor = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+        if not np.all(np.isfinite(tensor)) or np.linalg.eigvalsh(tensor)[0] > 0.0:
+            continue
+        if min(xx, yy, zz) <= 0.0:
+            continue  # nothing to keep: MuJoCo's error stands
+        for k in keys[3:]:
+            e.set(k, "0")
+        repaired.append(str(link.get("name")))
+    return repaired
 
 
 #: mesh files MuJoCo reads; geometry in other files (Collada, ...) is left out of the raw model
@@ -156,7 +194,7 @@ def _drop_meshes(root: ET.Element, keep: Any) -> list[str]:
     return dropped
 
 
-def raw_model(rf: RobotFile) -> RawModel:
+def raw_model(rf: ModelSource) -> RawModel:
     """The model as its file has it (visual and collision geometry and every joint kept), with a
     free base, at zero joint angles: what :func:`find_legs`, :func:`sole_from_geometry` and
     :func:`body_box` read. Meshes MuJoCo cannot read (another format, or a file its decoder
@@ -165,8 +203,10 @@ def raw_model(rf: RobotFile) -> RawModel:
     mujoco = require_mujoco()
     root = _urdf_root(rf) if rf.format == "urdf" else None
     dropped: list[str] = []
+    repaired: list[str] = []
     if root is not None:
         dropped += _drop_meshes(root, lambda f: f.lower().endswith(MESH_SUFFIXES))
+        repaired = _repair_inertias(root)
     for _ in range(MAX_DROPPED_MESHES):
         spec = _spec_from(rf, root)
         base = _base_name(rf, spec)
@@ -186,7 +226,7 @@ def raw_model(rf: RobotFile) -> RawModel:
         raise InputError("model", str(rf.model), "a model with fewer unreadable meshes")
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
-    return RawModel(model, data, base, tuple(dropped))
+    return RawModel(model, data, base, tuple(dropped), tuple(repaired))
 
 
 def _body_chain(m: Any, body: int, base: int) -> list[int]:

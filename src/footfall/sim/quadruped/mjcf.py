@@ -19,6 +19,7 @@ default pyramidal cone, which ``cone="elliptic" impratio="10"`` stops.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -30,16 +31,15 @@ from footfall._mjcf import (
     mjcf_document,
     mjcf_preamble,
     position_actuator,
-    rod_inertia,
 )
 from footfall._validate import positive
 from footfall.errors import InputError
 from footfall.quadruped.ground import PlaneGround, QuadrupedGround, VaryingSlope
-from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
+from footfall.quadruped.robot import DOCUMENT_LINK_RADII, JOINT_NAMES, LEGS, QuadrupedRobot
 from footfall.sim.quadruped import names as nm
 
 #: joint axes in the parent body frame, in ``JOINT_NAMES`` order (ab/ad about x, pitch/knee about y)
-_JOINT_AXES = ("1 0 0", "0 1 0", "0 1 0")
+_JOINT_AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 1.0, 0.0))
 
 
 def _quat_about_y(angle: float) -> tuple[float, float, float, float]:
@@ -145,38 +145,71 @@ def stairs_xml(
     return "\n    ".join(parts)
 
 
+def robot_settings(robot: QuadrupedRobot, friction: float | None = None) -> SimSettings:
+    """Physics settings for ``robot``: the defaults (made for document 001's 100 kg, 0.6 m robot)
+    scaled by its mass ``M`` and size ``k`` (its stance height over 0.6 m): rotor armature by
+    ``M k^2``, servo gains by ``M k`` (joint torques of the same posture scale so). The document's
+    robot gets the defaults."""
+    base = SimSettings()
+    if robot.legs is not None:
+        mass = robot.total_mass / QuadrupedRobot().total_mass
+        k = robot.stance_height / QuadrupedRobot().stance_height
+        base = replace(
+            base,
+            armature=base.armature * mass * k * k,
+            kp=base.kp * mass * k,
+            kv=base.kv * mass * k,
+        )
+    return base if friction is None else replace(base, friction=friction)
+
+
+def _inertial(pos: tuple[float, ...], mass: float, inertia: tuple[float, ...]) -> str:
+    """An ``<inertial>`` element (diagonal when the products of inertia are zero)."""
+    if any(abs(v) > 0.0 for v in inertia[3:]):
+        tensor = f'fullinertia="{fmt(*inertia)}"'
+    else:
+        tensor = f'diaginertia="{fmt(*inertia[:3])}"'
+    return f'<inertial pos="{fmt(*pos)}" mass="{mass:.6g}" {tensor}/>'
+
+
+def _pos(v: tuple[float, ...]) -> str:
+    """A ``pos`` attribute, left out at the origin."""
+    return f' pos="{fmt(*v)}"' if any(abs(x) > 0.0 for x in v) else ""
+
+
 def _leg_xml(robot: QuadrupedRobot, settings: SimSettings, leg_index: int) -> str:
     leg = LEGS[leg_index]
-    lo, hi = robot.joint_limits.lower, robot.joint_limits.upper
-    l1, l2, r = robot.thigh_length, robot.shank_length, robot.foot_radius
+    geo = robot.leg_geometry(leg)
+    lo, hi = geo.lower, geo.upper
+    r = robot.foot_radius
     hip = robot.hip_offset(leg)
-    thigh_r, shank_r = 0.035, 0.028
-    ti = rod_inertia(robot.thigh_mass, l1, thigh_r)
-    si = rod_inertia(robot.shank_mass, l2, shank_r)
-    hi_i = 0.4 * robot.hip_mass * 0.06**2  # solid sphere of radius 6 cm
+    scale = robot.thigh_length / QuadrupedRobot().thigh_length
+    hip_r, thigh_r, shank_r = (scale * v for v in DOCUMENT_LINK_RADII)
     nocol = 'contype="0" conaffinity="0"'
     j = [nm.joint(leg, name) for name in JOINT_NAMES]
+    axes = [
+        fmt(*(sg * a + 0.0 for a in axis)) for sg, axis in zip(geo.signs, _JOINT_AXES, strict=True)
+    ]
+    fs = geo.foot
     return f"""
       <body name="{nm.hip_body(leg)}" pos="{fmt(*hip)}">
-        <joint name="{j[0]}" axis="{_JOINT_AXES[0]}" range="{fmt(lo[0], hi[0])}"/>
-        <inertial pos="0 0 0" mass="{robot.hip_mass:.6g}" diaginertia="{fmt(hi_i, hi_i, hi_i)}"/>
-        <geom type="sphere" size="0.06" material="joint" {nocol}/>
-        <body name="{nm.thigh_body(leg)}">
-          <joint name="{j[1]}" axis="{_JOINT_AXES[1]}" range="{fmt(lo[1], hi[1])}"/>
-          <inertial pos="0 0 {-l1 / 2:.6g}" mass="{robot.thigh_mass:.6g}"
-                    diaginertia="{fmt(*ti)}"/>
-          <geom type="capsule" fromto="0 0 0 0 0 {-l1:.6g}" size="{thigh_r}" material="leg"
+        <joint name="{j[0]}" axis="{axes[0]}" range="{fmt(lo[0], hi[0])}"/>
+        {_inertial(geo.coms[0], geo.masses[0], geo.inertias[0])}
+        <geom type="sphere" size="{hip_r:.6g}" material="joint" {nocol}/>
+        <body name="{nm.thigh_body(leg)}"{_pos(geo.hfe)}>
+          <joint name="{j[1]}" axis="{axes[1]}" range="{fmt(lo[1], hi[1])}"/>
+          {_inertial(geo.coms[1], geo.masses[1], geo.inertias[1])}
+          <geom type="capsule" fromto="0 0 0 {fmt(*geo.knee)}" size="{thigh_r:.6g}" material="leg"
                 {nocol}/>
-          <body name="{nm.shank_body(leg)}" pos="0 0 {-l1:.6g}">
-            <joint name="{j[2]}" axis="{_JOINT_AXES[2]}" range="{fmt(lo[2], hi[2])}"/>
-            <inertial pos="0 0 {-l2 / 2:.6g}" mass="{robot.shank_mass:.6g}"
-                      diaginertia="{fmt(*si)}"/>
-            <geom type="capsule" fromto="0 0 0 0 0 {-l2:.6g}" size="{shank_r}" material="leg"
+          <body name="{nm.shank_body(leg)}" pos="{fmt(*geo.knee)}">
+            <joint name="{j[2]}" axis="{axes[2]}" range="{fmt(lo[2], hi[2])}"/>
+            {_inertial(geo.coms[2], geo.masses[2], geo.inertias[2])}
+            <geom type="capsule" fromto="0 0 0 {fmt(*fs)}" size="{shank_r:.6g}" material="leg"
                   {nocol}/>
-            <geom name="{nm.foot_geom(leg)}" type="sphere" size="{r:.6g}" pos="0 0 {-l2:.6g}"
+            <geom name="{nm.foot_geom(leg)}" type="sphere" size="{r:.6g}" pos="{fmt(*fs)}"
                   material="foot" friction="{settings.friction:.6g} 0.02 0.002" priority="1"
                   contype="{nm.ROBOT_CONTYPE}" conaffinity="{nm.ROBOT_CONAFFINITY}"/>
-            <site name="{nm.foot_site(leg)}" pos="0 0 {-l2:.6g}" size="0.01"/>
+            <site name="{nm.foot_site(leg)}" pos="{fmt(*fs)}" size="0.01"/>
           </body>
         </body>
       </body>"""
@@ -199,12 +232,25 @@ def quadruped_mjcf(
         The MJCF document as a string.
     """
     s = settings if settings is not None else SimSettings()
-    bi = box_inertia(robot.body_mass, robot.body_length, robot.body_width, robot.body_height)
+    bi: tuple[float, ...]
+    if robot.body_inertia is None:
+        bi = (
+            *box_inertia(robot.body_mass, robot.body_length, robot.body_width, robot.body_height),
+            0.0,
+            0.0,
+            0.0,
+        )
+    else:
+        bi = robot.body_inertia
     legs = "".join(_leg_xml(robot, s, i) for i in range(len(LEGS)))
     actuators = "\n    ".join(
-        position_actuator(nm.actuator(leg, jn), quoteattr(nm.joint(leg, jn)), s)
+        position_actuator(
+            nm.actuator(leg, jn),
+            quoteattr(nm.joint(leg, jn)),
+            s if (tq := robot.leg_geometry(leg).torque) is None else replace(s, torque_limit=tq[k]),
+        )
         for leg in LEGS
-        for jn in JOINT_NAMES
+        for k, jn in enumerate(JOINT_NAMES)
     )
     preamble = mjcf_preamble(s, 2.0, 'solref="0.005 1"', 0)
     half = (robot.body_length / 2, robot.body_width / 2, robot.body_height / 2)
@@ -217,7 +263,7 @@ def quadruped_mjcf(
       <freejoint name="{nm.ROOT_JOINT}"/>
       <camera name="{nm.TRACK_CAMERA}" mode="trackcom" pos="0.6 -3.2 0.9"
               xyaxes="1 0 0 0 0.25 1"/>
-      <inertial pos="0 0 0" mass="{robot.body_mass:.6g}" diaginertia="{fmt(*bi)}"/>
+      {_inertial(robot.body_com, robot.body_mass, bi)}
       <geom name="{nm.TRUNK_GEOM}" type="box" size="{fmt(*half)}" material="body"
             contype="{nm.ROBOT_CONTYPE}" conaffinity="{nm.ROBOT_CONAFFINITY}"/>{legs}
     </body>"""
