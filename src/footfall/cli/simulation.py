@@ -94,9 +94,18 @@ def quadruped_cmd(
     out: Path = typer.Option("out/quadruped", help="Output folder."),
     video: bool = typer.Option(True, "--video/--no-video", help="Render an MP4 (offscreen GL)."),
     controller: str = typer.Option(
-        "servo",
-        help="servo: the document's joint position servos on the planned angles; wbc: joint "
-        "torques from the whole-body QP that puts the centre of pressure on the planned ZMP.",
+        "wbc",
+        help="wbc: joint torques from the whole-body QP that puts the centre of pressure on the "
+        "planned ZMP; servo: the document's joint position servos on the planned angles.",
+    ),
+    robot: str = typer.Option(
+        "document",
+        "--robot",
+        help="The quadruped: document (document 001's 100 kg robot), a built-in (go2, solo12, "
+        "anymal_c, from example-robot-data) or a quadruped robot file (.yaml, see footfall robot "
+        "inspect). On another robot than the document's, the default gait and the scene's gait "
+        "and ground lengths scale with its stance height against 0.6 m, periods with the square "
+        "root; options given here are taken as they are.",
     ),
     on_slip: str = typer.Option(
         "off",
@@ -116,8 +125,6 @@ def quadruped_cmd(
 
     require_mujoco()  # before any work: a missing extra is one line, exit 2
     from footfall.experiments.slope_walk import compare_strategies, plan_strategies
-    from footfall.quadruped import QuadrupedRobot
-    from footfall.sim.quadruped.mjcf import SimSettings
     from footfall.sim.quadruped.sim import simulate
     from footfall.sim.quadruped.slip import SLIP_ACTIONS, SlipGuard
     from footfall.sim.replay import REPLAY_FILE, ReplayRecorder, quadruped_traces
@@ -139,7 +146,12 @@ def quadruped_cmd(
         "--shift-period": shift_period,
         "--strategy": strategy,
     }
-    settings = None
+    from footfall.quadruped.scaling import scale_gait
+    from footfall.robots.quadruped import resolve_quadruped
+    from footfall.sim.quadruped.mjcf import robot_settings
+
+    quad = resolve_quadruped(robot)
+    friction = None
     if scene is not None:
         from footfall.quadruped.scene import resolve_quadruped_scene
 
@@ -147,27 +159,36 @@ def quadruped_cmd(
         if given:
             raise InputError(given[0], options[given[0]], "no gait option with --scene")
         sc = resolve_quadruped_scene(scene)
-        params = sc.params
+        params = scale_gait(quad, sc.params)
         if cycles is not None:
             params = replace(params, cycles=cycles)
-        if sc.friction is not None:
-            settings = SimSettings(friction=sc.friction)
+        friction = sc.friction
         label = sc.name
     else:
         slope = 15.0 if slope_deg is None else slope_deg
-        params = _slope_params(
+        doc = _slope_params(
             slope,
             default_body_deg(slope) if body_deg is None else body_deg,
-            (step, height, cycles, swing_period, shift_period),
+            (None, None, cycles, None, None),
             "osp" if strategy is None else strategy,
         )
+        params = _slope_params(
+            slope,
+            math.degrees(doc.body_pitch),
+            (step, height, None, swing_period, shift_period),
+            doc.strategy.value,
+            scale_gait(quad, doc),
+        )
         label = f"{math.degrees(params.slope):g}°/{math.degrees(params.body_pitch):g}°"
+    settings = robot_settings(quad, friction)
+    if quad.legs is not None:
+        label = f"{quad.name}, {label}"
     outputs = ["quadruped.json", "quadruped.mp4", REPLAY_FILE, *WALK_FIGURES]
     refuse_inputs_as_outputs([scene], {"out": [out / name for name in outputs]})
     output_folder(out)
     # this run's files replace the last run's as a set: none of theirs is left beside ours
     remove_outputs(out, *outputs)
-    plans, infeasible = plan_strategies(QuadrupedRobot(), params, compare)
+    plans, infeasible = plan_strategies(quad, params, compare)
     plan = plans[params.strategy]
     console.print(f"simulating {params.cycles} cycles on {label} ({plan.duration:.1f} s)...")
     replay = ReplayRecorder("quadruped")
@@ -184,6 +205,17 @@ def quadruped_cmd(
         console.print(res.video_note)
     payload = res.metrics.to_dict()
     payload["controller"] = {"name": controller, "qp_failures": res.trace.qp_failures}
+    payload["robot"] = {
+        "name": quad.name,
+        "mass_kg": quad.total_mass,
+        "stance_height_m": quad.stance_height,
+        "gait": {
+            "step_m": params.step,
+            "swing_height_m": params.swing_height,
+            "swing_period_s": params.swing_period,
+            "shift_period_s": params.shift_period,
+        },
+    }
     payload["slip_guard"] = {
         "on_slip": on_slip,
         "limit_m": slip_limit,
@@ -240,6 +272,7 @@ def _slope_params(
     body_deg: float,
     gait: tuple[float | None, float | None, int | None, float | None, float | None],
     strategy: str,
+    base: Any = None,
 ) -> Any:
     """GaitParams of the document's slope from the CLI options (errors name the option)."""
     from footfall.quadruped import GaitParams, ZmpStrategy
@@ -259,6 +292,8 @@ def _slope_params(
     params = GaitParams(
         slope=math.radians(slope_deg), body_pitch=math.radians(body_deg), strategy=strat
     )
+    if base is not None:  # the gait already scaled to the robot: the options given replace it
+        params = base
     given: dict[str, Any] = {
         "step": step,
         "swing_height": height,

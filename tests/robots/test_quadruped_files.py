@@ -1,0 +1,233 @@
+"""Quadrupeds from their files: Go2, Solo-12 and ANYmal C (example-robot-data URDFs) checked
+against independent references: MuJoCo's own forward kinematics, masses and centres of mass of the
+model as its file has it, the standing postures example-robot-data ships (its SRDFs), and walks in
+MuJoCo measured by the simulator's contact forces.
+
+Needs the ``robots`` extra; without it the module is skipped, except with
+``FOOTFALL_REQUIRE_ROBOTS=1`` (set by .ci/run): then it fails.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+# isort: off
+# first: without the robots extra this skips the module (or fails with FOOTFALL_REQUIRE_ROBOTS=1)
+from tests.robots._require import mujoco
+
+# isort: on
+
+from footfall.errors import InputError
+from footfall.quadruped import GaitParams
+from footfall.quadruped.gait import largest_step, plan_gait
+from footfall.quadruped.ground import Stairs
+from footfall.quadruped.kinematics import leg_fk, leg_ik, whole_body_com, whole_body_ik
+from footfall.quadruped.robot import LEGS, QuadrupedRobot
+from footfall.quadruped.scaling import STEP_MARGIN, gait_scale, scale_gait
+from footfall.robots.build import RawModel, raw_model
+from footfall.robots.quadruped import (
+    builtin_quadruped_names,
+    derive_quadruped,
+    parse_quadruped_file,
+    resolve_quadruped,
+)
+
+ROBOTS = ("go2", "solo12", "anymal_c")
+PATHS = {
+    "go2": "go2_description/urdf/go2.urdf",
+    "solo12": "solo_description/robots/solo12.urdf",
+    "anymal_c": "anymal_c_simple_description/urdf/anymal.urdf",
+}
+PREFIX = "cmeel.prefix/share/example-robot-data/robots/"
+
+
+def _file(name: str, extra: str = "") -> str:
+    return (
+        f"name: {name}\nkind: quadruped\n"
+        f"model: {{package: example-robot-data, path: {PREFIX}{PATHS[name]}}}\n{extra}"
+    )
+
+
+def _raw(name: str) -> RawModel:
+    return raw_model(parse_quadruped_file(_file(name), name, None))
+
+
+def test_builtins_are_listed() -> None:
+    assert builtin_quadruped_names() == ["document", "anymal_c", "go2", "solo12"]
+    assert isinstance(resolve_quadruped("document"), QuadrupedRobot)
+    with pytest.raises(InputError) as e:
+        resolve_quadruped("spot")
+    assert e.value.field == "robot"
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_leg_kinematics_match_mujoco(name: str) -> None:
+    """The derived legs' closed-form FK against MuJoCo's kinematics of the file's own model
+    (bodies, joints and frames as the URDF has them) at random joint angles within limits."""
+    robot = resolve_quadruped(name)
+    raw = _raw(name)
+    m = raw.model
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        d.qpos[:] = m.qpos0
+        qs = []
+        for g in robot.legs or ():
+            q = rng.uniform(np.maximum(g.lower, -2.5), np.minimum(g.upper, 2.5))
+            qs.append(q)
+            for jn, v in zip(g.joints, q, strict=True):
+                d.qpos[m.jnt_qposadr[m.joint(jn).id]] = v
+        mujoco.mj_kinematics(m, d)
+        for leg, g, q in zip(LEGS, robot.legs or (), qs, strict=True):
+            knee_body = int(m.jnt_bodyid[m.joint(g.joints[2]).id])
+            # the foot is a point fixed in the knee's body: where it is at zero angles, carried
+            zero = np.asarray(g.origin) + np.add(g.hfe, g.knee) + np.asarray(g.foot)
+            local = raw.data.xmat[knee_body].reshape(3, 3).T @ (zero - raw.data.xpos[knee_body])
+            mj_foot = d.xpos[knee_body] + d.xmat[knee_body].reshape(3, 3) @ local
+            ours = robot.hip_offset(leg) + leg_fk(robot, q, leg)
+            np.testing.assert_allclose(ours, mj_foot, atol=1e-9)
+            # and IK gives back angles with the same foot, inside the limits
+            if robot.legs is not None:
+                try:
+                    q2 = leg_ik(robot, leg_fk(robot, q, leg), leg)
+                except InputError:
+                    continue  # the other knee bend than the leg's branch
+                np.testing.assert_allclose(leg_fk(robot, q2, leg), leg_fk(robot, q, leg), atol=1e-9)
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_mass_and_com_match_mujoco(name: str) -> None:
+    """Total mass and whole-body CoM of the planner's point masses against MuJoCo's subtree mass
+    and centre of mass of the file's model in the same posture (the link inertias are exact, so
+    only the rotational inertia the planner neglects differs: not at all for the CoM)."""
+    robot = resolve_quadruped(name)
+    raw = _raw(name)
+    m = raw.model
+    base = m.body(raw.base).id
+    assert robot.total_mass == pytest.approx(float(m.body_subtreemass[base]), rel=1e-9)
+    d = mujoco.MjData(m)
+    body, pitch = np.array([0.1, -0.05, robot.stance_height]), math.radians(8.0)
+    # feet under the neutral stance points, each shifted along x by a different amount
+    shift = np.array([[0.03 * (i - 1.5), 0.0, 0.0] for i in range(4)])
+    feet = np.array([robot.stance_offset(leg) for leg in LEGS]) + shift + [0.1, -0.05, 0.0]
+    feet[:, 2] = 0.0
+    q = whole_body_ik(robot, body, pitch, feet)
+    d.qpos[:] = m.qpos0
+    d.qpos[:3] = body
+    d.qpos[3:7] = (math.cos(-pitch / 2), 0.0, math.sin(-pitch / 2), 0.0)
+    for i, g in enumerate(robot.legs or ()):
+        for jn, v in zip(g.joints, q[3 * i : 3 * i + 3], strict=True):
+            d.qpos[m.jnt_qposadr[m.joint(jn).id]] = v
+    mujoco.mj_forward(m, d)
+    np.testing.assert_allclose(
+        whole_body_com(robot, body, pitch, q), d.subtree_com[base], atol=1e-9
+    )
+
+
+@pytest.mark.parametrize(("name", "front", "hind"), [("solo12", -1, 1), ("anymal_c", -1, 1)])
+def test_default_knees_bend_as_the_shipped_standing_pose(name: str, front: int, hind: int) -> None:
+    """The SRDFs' ``standing`` poses bend the front knees back (KFE < 0) and the hind knees
+    forward (KFE > 0): the default ``inward`` bend when the limits allow both."""
+    robot = resolve_quadruped(name)
+    for leg in LEGS:
+        q = leg_ik(
+            robot, np.array([0.0, robot.leg_geometry(leg).lateral, -0.9 * robot.stance_height]), leg
+        )
+        assert np.sign(q[2]) == (front if leg.is_front else hind), leg
+
+
+def test_go2_knees_follow_the_limits_and_a_contrary_file_is_refused() -> None:
+    robot = resolve_quadruped("go2")
+    assert all(g.upper[2] < 0.0 for g in robot.legs or ())
+    with pytest.raises(InputError) as e:
+        derive_quadruped(parse_quadruped_file(_file("go2", "knees: forward\n"), "x", None))
+    assert e.value.field == "knees"
+
+
+def test_anymal_placeholder_inertia_is_repaired_and_said() -> None:
+    raw = _raw("anymal_c")
+    assert "hatch" in raw.repaired
+
+
+@pytest.mark.parametrize(
+    ("extra", "field"),
+    [
+        ("knees: sideways\n", "knees"),
+        ("torque_limit: [1, -2, 3]\n", "torque_limit"),
+        ("foot_radius: 0\n", "foot_radius"),
+        ("legs: {LF: [a, b, c], RF: [a, b, c], RH: [a, b, c], LH: [a, b, c]}\n", "legs.LF"),
+    ],
+)
+def test_bad_files_name_the_field(extra: str, field: str) -> None:
+    with pytest.raises(InputError) as e:
+        derive_quadruped(parse_quadruped_file(_file("go2", extra), "x", None))
+    assert e.value.field == field
+
+
+def test_a_humanoid_is_not_a_quadruped(tmp_path: Path) -> None:
+    path = "talos_data/robots/talos_reduced.urdf"
+    text = (
+        f"name: t\nkind: quadruped\nmodel: {{package: example-robot-data, path: {PREFIX}{path}}}\n"
+    )
+    with pytest.raises(InputError) as e:
+        derive_quadruped(parse_quadruped_file(text, "t", None))
+    assert e.value.field.startswith("legs")
+
+
+def test_gait_scales_with_the_robot() -> None:
+    go2 = resolve_quadruped("go2")
+    doc = QuadrupedRobot()
+    k = gait_scale(go2)
+    params = GaitParams(slope=math.radians(15), body_pitch=math.radians(10))
+    assert scale_gait(doc, params) is params
+    scaled = scale_gait(go2, params)
+    assert scaled.swing_height == pytest.approx(k * params.swing_height)
+    assert scaled.swing_period == pytest.approx(math.sqrt(k) * params.swing_period)
+    assert scaled.step <= k * params.step + 1e-12
+    most = largest_step(go2, scaled)
+    assert scaled.step <= most + 1e-12 or scaled.step == pytest.approx(STEP_MARGIN * most)
+    stairs = GaitParams(slope=0.0, body_pitch=0.0, ground=Stairs(), body_ratio=0.67)
+    s2 = scale_gait(go2, stairs)
+    assert isinstance(s2.ground, Stairs)
+    assert s2.ground.rise == pytest.approx(k * 0.1)
+    assert s2.ground.edge_margin >= go2.foot_radius
+    plan_gait(go2, s2)  # plannable
+
+
+def test_cli_walks_go2_up_15_degrees_with_the_default_controller(tmp_path: Path) -> None:
+    """A user's first run: the built-in Go2 up the document's slope, the whole-body controller by
+    default; the measured centre of pressure stays near the planned ZMP and no foot slips."""
+    from typer.testing import CliRunner
+
+    from footfall.cli import app
+
+    res = CliRunner().invoke(
+        app, ["quadruped", "--robot", "go2", "--cycles", "2", "--no-video", "--out", str(tmp_path)]
+    )
+    assert res.exit_code == 0, res.output
+    data = json.loads((tmp_path / "quadruped.json").read_text())
+    assert data["controller"]["name"] == "wbc"
+    assert data["robot"]["name"] == "go2"
+    assert data["fell"] is False
+    assert data["distance_up_slope_m"] > 0.25
+    assert data["zmp_error_mean_m"] < 0.01
+    assert data["foot_slip_max_m"] < 0.01
+
+
+def test_cli_unknown_robot_is_an_input_error(tmp_path: Path) -> None:
+    """(the console entry point turns an InputError into its message and exit 2)"""
+    from typer.testing import CliRunner
+
+    from footfall.cli import app
+
+    res = CliRunner().invoke(
+        app, ["quadruped", "--robot", "nope", "--no-video", "--out", str(tmp_path)]
+    )
+    assert isinstance(res.exception, InputError), res.output
+    assert res.exception.field == "robot"
+    assert not (tmp_path / "quadruped.json").exists()
