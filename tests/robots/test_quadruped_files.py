@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -231,3 +232,45 @@ def test_cli_unknown_robot_is_an_input_error(tmp_path: Path) -> None:
     assert isinstance(res.exception, InputError), res.output
     assert res.exception.field == "robot"
     assert not (tmp_path / "quadruped.json").exists()
+
+
+def _urdf(path: str) -> Path:
+    from footfall.robots.file import package_file
+
+    return package_file("example-robot-data", PREFIX + path)
+
+
+def test_inspect_tells_quadrupeds_from_humanoids() -> None:
+    from footfall.robots.inspect_quadruped import looks_quadruped
+
+    assert looks_quadruped(_urdf(PATHS["go2"]), None)
+    assert not looks_quadruped(_urdf("talos_data/robots/talos_reduced.urdf"), None)
+
+
+def test_inspect_a_quadruped_that_is_not_built_in_and_walk_its_file(tmp_path: Path) -> None:
+    """A new user's path: the Unitree A1's URDF (not a built-in) inspected into a robot file,
+    which `footfall quadruped --robot` takes as it is and walks up 15 degrees."""
+    from typer.testing import CliRunner
+
+    from footfall.cli import app
+
+    urdf = _urdf("a1_description/urdf/a1.urdf")
+    res = CliRunner().invoke(app, ["robot", "inspect", str(urdf), "--out", str(tmp_path / "a1")])
+    assert res.exit_code == 0, res.output
+    robot_yaml = tmp_path / "a1" / "robot.yaml"
+    assert (tmp_path / "a1" / "robot.png").stat().st_size > 10_000
+    qf = parse_quadruped_file(robot_yaml, str(robot_yaml), robot_yaml.parent)
+    assert qf.package is not None and qf.package[0] == "example-robot-data"
+    assert qf.legs is not None and qf.legs[0] == ("FL_hip_joint", "FL_thigh_joint", "FL_calf_joint")
+    # the written file derives the same robot as the model alone
+    alone = derive_quadruped(replace(qf, legs=None, foot_radius=None, stance_height=None))
+    written = derive_quadruped(qf).robot
+    assert written.total_mass == pytest.approx(alone.robot.total_mass, rel=1e-12)
+    assert written.stance_height == pytest.approx(alone.robot.stance_height, abs=6e-4)
+    out = tmp_path / "walk"
+    args = ["quadruped", "--robot", str(robot_yaml), "--slope-deg", "15", "--cycles", "1"]
+    res = CliRunner().invoke(app, [*args, "--no-video", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    data = json.loads((out / "quadruped.json").read_text())
+    assert data["robot"]["name"] == "a1" and data["fell"] is False
+    assert data["distance_up_slope_m"] > 0.1

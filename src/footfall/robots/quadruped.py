@@ -267,6 +267,7 @@ class QuadrupedDerivation:
     knees: str
     stance_height: float
     dropped: tuple[str, ...]
+    repaired: tuple[str, ...] = ()
 
 
 def _axis_sign(axis: FloatArray, want: int, name: str) -> float:
@@ -481,7 +482,9 @@ def derive_quadruped(qf: QuadrupedFile) -> QuadrupedDerivation:
         body_inertia=_six(body_inertia),
         name=qf.name,
     )
-    return QuadrupedDerivation(robot, tuple(joints), foot_radius, knees, height, raw.dropped)
+    return QuadrupedDerivation(
+        robot, tuple(joints), foot_radius, knees, height, raw.dropped, raw.repaired
+    )
 
 
 def _knees_word(bends: set[tuple[bool, str]]) -> str:
