@@ -274,3 +274,28 @@ def test_inspect_a_quadruped_that_is_not_built_in_and_walk_its_file(tmp_path: Pa
     data = json.loads((out / "quadruped.json").read_text())
     assert data["robot"]["name"] == "a1" and data["fell"] is False
     assert data["distance_up_slope_m"] > 0.1
+
+
+def test_lateral_pushes_are_paired_and_fail_when_too_strong() -> None:
+    """The same seed pushes at the same time and side at every level; an unpushed Go2 walk
+    succeeds and a 2 m/s sideways push (32 N s on 16 kg) does not."""
+    from footfall.experiments.quadruped_pushes import (
+        PUSH_SPAN,
+        push_of_seed,
+        run_quadruped_pushes,
+        summary_lines,
+    )
+
+    assert push_of_seed(3, 0.05) == push_of_seed(3, 0.05)
+    shares = [push_of_seed(s, 0.05)[0] for s in range(20)]
+    assert all(PUSH_SPAN[0] <= v <= PUSH_SPAN[1] for v in shares)
+    assert {push_of_seed(s, 0.05)[1] for s in range(20)} == {-1.0, 1.0}
+    rows = run_quadruped_pushes("go2", 15.0, (0.0, 2.0), (0,), cycles=2)
+    mass = resolve_quadruped("go2").total_mass
+    assert [r.impulse_n_s for r in rows] == pytest.approx([0.0, 2.0 * mass])
+    assert rows[0].start_s == rows[1].start_s and rows[0].side == rows[1].side
+    assert rows[0].success and not rows[0].fell
+    assert not rows[1].success
+    text = "\n".join(summary_lines(rows))
+    assert "| 0 | 0.00 | 1/1 |" in text and "| 2 | " in text and "0/1" in text
+    assert "largest level every seed survived: 0 m/s" in text

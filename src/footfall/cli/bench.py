@@ -257,3 +257,59 @@ def bench_pushes_cmd(
     plot_protocol(result, out / "protocol.png")
     print(format_summary(result))
     console.print(f"wrote {out / 'protocol.csv'}, protocol.md, protocol.png")
+
+
+@bench_app.command("quadruped-pushes")
+def bench_quadruped_pushes_cmd(
+    robot: str = typer.Option(
+        "go2", help="A quadruped: document, go2, solo12, anymal_c or a quadruped robot file."
+    ),
+    slope_deg: float = typer.Option(15.0, help="Slope angle [deg] (the body at two thirds)."),
+    dv: str = typer.Option(
+        "0.1,0.2,0.3,0.4",
+        "--dv",
+        help="Lateral velocity changes [m/s], comma separated; each push's impulse is the "
+        "robot's mass times it [N s].",
+    ),
+    seeds: int = typer.Option(10, help="Seeds per level (0..seeds-1): push start and side."),
+    duration: float = typer.Option(0.05, help="Push length [s]."),
+    cycles: int = typer.Option(4, help="Gait cycles per walk."),
+    out: Path = typer.Option(Path("out/bench"), help="Output folder: quadruped_pushes.csv/.md."),
+) -> None:
+    """Lateral pushes on a quadruped walking up a slope with the whole-body controller: one push
+    per walk, sideways (left or right), at a seeded time in the middle half of the walk, the same
+    seeds at every level (paired). Prints and writes each level's successes (no fall, trunk
+    within 25 % of the planned distance of the plan's end) with a 95 % Wilson interval, and the
+    largest level every seed survived; exit 0 when every walk ran (a fall is a result)."""
+    from footfall.experiments.quadruped_pushes import (
+        QuadrupedPushRow,
+        rows_csv,
+        run_quadruped_pushes,
+        summary_lines,
+    )
+
+    dv_values = parse_floats("dv", dv)
+    if not dv_values or any(not v >= 0 or v != v for v in dv_values):
+        raise InputError("dv", dv, "comma-separated velocity changes >= 0 [m/s], e.g. 0.1,0.2")
+    if seeds < 1:
+        raise InputError("seeds", seeds, "an integer >= 1")
+    files = ("quadruped_pushes.csv", "quadruped_pushes.md")
+    refuse_inputs_as_outputs([robot], {"out": [out / f for f in files]})
+    from footfall.robots.quadruped import resolve_quadruped
+
+    resolve_quadruped(robot)  # an unknown robot is refused before any output
+    output_folder(out)
+    remove_outputs(out, *files)
+
+    def progress(r: QuadrupedPushRow) -> None:
+        verdict = "ok" if r.success else ("fell" if r.fell else "drifted")
+        console.print(f"dv {r.dv_m_s:g} m/s seed {r.seed} {r.side}: {verdict}")
+
+    rows = run_quadruped_pushes(
+        robot, slope_deg, tuple(dv_values), tuple(range(seeds)), duration, cycles, progress
+    )
+    lines = summary_lines(rows)
+    write_text(out / "quadruped_pushes.csv", rows_csv(rows))
+    write_text(out / "quadruped_pushes.md", "\n".join(lines) + "\n")
+    print("\n".join(lines))
+    console.print(f"wrote {out / 'quadruped_pushes.csv'}, quadruped_pushes.md")
