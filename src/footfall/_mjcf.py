@@ -54,6 +54,7 @@ class SimSettings:
         friction: sliding friction coefficient between feet and ground.
         impratio: ratio of frictional to normal constraint impedance (elliptic cone).
         armature: rotor inertia added to each joint [kg m^2] (stabilises stiff position control).
+        joint_damping: viscous damping of every joint of the generated quadruped [N m s / rad].
     """
 
     timestep: float = 0.002
@@ -63,6 +64,7 @@ class SimSettings:
     friction: float = 1.0
     impratio: float = 10.0
     armature: float = 0.05
+    joint_damping: float = 2.0
 
     def __post_init__(self) -> None:
         check_fields(
@@ -72,6 +74,9 @@ class SimSettings:
             prefix="sim.",
         )
         object.__setattr__(self, "armature", non_negative("sim.armature", self.armature))
+        object.__setattr__(
+            self, "joint_damping", non_negative("sim.joint_damping", self.joint_damping)
+        )
 
 
 def mjcf_preamble(

@@ -147,18 +147,20 @@ def stairs_xml(
 
 def robot_settings(robot: QuadrupedRobot, friction: float | None = None) -> SimSettings:
     """Physics settings for ``robot``: the defaults (made for document 001's 100 kg, 0.6 m robot)
-    scaled by its mass ``M`` and size ``k`` (its stance height over 0.6 m): rotor armature by
-    ``M k^2``, servo gains by ``M k`` (joint torques of the same posture scale so). The document's
-    robot gets the defaults."""
+    scaled by its mass ratio ``m`` and size ``k`` (its stance height over 0.6 m) as their units
+    scale at the same Froude number (times by ``sqrt(k)``): rotor armature [kg m^2] by ``m k^2``,
+    joint damping and servo damping [N m s / rad] by ``m k^1.5``, servo stiffness [N m / rad] by
+    ``m k``. The document's robot gets the defaults."""
     base = SimSettings()
     if robot.legs is not None:
-        mass = robot.total_mass / QuadrupedRobot().total_mass
+        m = robot.total_mass / QuadrupedRobot().total_mass
         k = robot.stance_height / QuadrupedRobot().stance_height
         base = replace(
             base,
-            armature=base.armature * mass * k * k,
-            kp=base.kp * mass * k,
-            kv=base.kv * mass * k,
+            armature=base.armature * m * k * k,
+            joint_damping=base.joint_damping * m * k**1.5,
+            kp=base.kp * m * k,
+            kv=base.kv * m * k**1.5,
         )
     return base if friction is None else replace(base, friction=friction)
 
@@ -252,7 +254,7 @@ def quadruped_mjcf(
         for leg in LEGS
         for k, jn in enumerate(JOINT_NAMES)
     )
-    preamble = mjcf_preamble(s, 2.0, 'solref="0.005 1"', 0)
+    preamble = mjcf_preamble(s, s.joint_damping, 'solref="0.005 1"', 0)
     half = (robot.body_length / 2, robot.body_width / 2, robot.body_height / 2)
     assets = (
         '<material name="ground" texture="grid" texrepeat="8 8" texuniform="true"/>\n'
