@@ -3,6 +3,7 @@ document 001's gait with the whole-body controller: 15 and 20 degrees up, 15 dow
 built-in quadruped scenes, the gait and the scenes' lengths scaled to each robot.
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_quadruped_robots.py [--robots go2,solo12,anymal_c] [--cycles 6]
+    OPENBLAS_NUM_THREADS=1 python benchmarks/bench_quadruped_robots.py --speed   # x real time only
 
 One walk per robot and ground (the simulation is deterministic). Success: no fall, and the trunk
 ends within 25 % of the planned distance of where the plan ends. CoP-ZMP: the measured centre of
@@ -51,11 +52,35 @@ def _row(robot_name: str, label: str, params: GaitParams, friction: float | None
     )
 
 
+def _speed(names: list[str]) -> None:
+    slope = math.radians(15.0)
+    for rep in range(2):
+        for name in names:
+            robot = resolve_quadruped(name)
+            params = scale_gait(robot, GaitParams(slope=slope, body_pitch=slope * 2 / 3, cycles=2))
+            res = simulate(plan_gait(robot, params), robot_settings(robot), controller="wbc")
+            tr = res.trace
+            steps = tr.sim_time / robot_settings(robot).timestep
+            print(
+                f"run {rep + 1} {name}: {res.metrics.realtime_factor:.1f}x real time, "
+                f"{steps / tr.wall_time:.0f} physics steps/s",
+                flush=True,
+            )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--robots", default="go2,solo12,anymal_c")
     ap.add_argument("--cycles", type=int, default=6)
+    ap.add_argument(
+        "--speed",
+        action="store_true",
+        help="only x real time: document and each robot, 2 cycles up 15 deg, twice, back to back",
+    )
     args = ap.parse_args()
+    if args.speed:
+        _speed(["document", *args.robots.split(",")])
+        return
     print(
         "| robot | ground | success | step [m] | CoP-ZMP mean / max [cm] | slip max [cm] | x RT |"
     )

@@ -66,11 +66,11 @@ class QuadrupedInspection:
                 + f"; {torque} N m"
             )
         if self.gait is not None:
-            g = self.gait
+            gp = self.gait
             out.append(
                 f"gait on {REPORT_SLOPE_DEG:g} deg (scale {gait_scale(r):.3f} of document 001's): "
-                f"step {g.step:.3f} m, swing height {g.swing_height:.3f} m, swing "
-                f"{g.swing_period:.2f} s, shift {g.shift_period:.2f} s"
+                f"step {gp.step:.3f} m, swing height {gp.swing_height:.3f} m, swing "
+                f"{gp.swing_period:.2f} s, shift {gp.shift_period:.2f} s"
             )
         else:
             out.append(f"gait on {REPORT_SLOPE_DEG:g} deg: {self.gait_note}")
