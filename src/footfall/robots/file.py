@@ -41,6 +41,7 @@ from __future__ import annotations
 import importlib.metadata
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from pydantic import Field
@@ -236,7 +237,9 @@ class RobotFile:
 
 
 # ----------------------------------------------------------------------------------- the schema
-class _PackageFile(StrictSpec):
+class PackageFileSpec(StrictSpec):
+    """A file inside an installed distribution (a robot file's ``model``)."""
+
     package: str = Field(min_length=1, max_length=200)
     path: str = Field(min_length=1, max_length=1000)
 
@@ -266,7 +269,7 @@ class _Physics(StrictSpec):
 
 class _RobotFileSpec(StrictSpec):
     name: str = Field(min_length=1, max_length=64)
-    model: str | _PackageFile
+    model: str | PackageFileSpec
     base: str | None = Field(default=None, max_length=200)
     torso: str | None = Field(default=None, max_length=200)
     legs: _Legs | None = None
@@ -313,21 +316,49 @@ def package_of(path: Path) -> tuple[str, str] | None:
     return None
 
 
+def resolve_model(
+    model: str | PackageFileSpec, base: Path | None
+) -> tuple[Path, tuple[str, str] | None]:
+    """A robot file's ``model`` entry as a path and, for a file of an installed distribution,
+    ``(distribution, path)`` (a relative path is relative to ``base``)."""
+    if isinstance(model, str):
+        path = Path(model)
+        if not path.is_absolute() and base is not None:
+            path = base / path
+        if not path.is_file():
+            raise InputError("model", model, "an existing URDF or MJCF file")
+        return path, None
+    return package_file(model.package, model.path), (model.package, model.path)
+
+
+def model_entry(model: Path, package: tuple[str, str] | None, base: Path | None) -> Any:
+    """The ``model`` entry a written robot file gives: ``package``/``path`` for a file of an
+    installed distribution, else the path (relative to ``base`` when inside it)."""
+    if package is not None:
+        return {"package": package[0], "path": package[1]}
+    if base is not None and model.resolve().is_relative_to(base.resolve()):
+        return str(model.resolve().relative_to(base.resolve()))
+    return str(model)
+
+
+def robot_file_yaml(kind: str, name: str, derived: str, data: dict[str, Any]) -> str:
+    """The text ``footfall robot inspect`` writes: a header saying which values were derived
+    from the model, then ``data`` as YAML."""
+    import yaml
+
+    head = (
+        f"# footfall {kind} of {name}, completed by `footfall robot inspect`: {derived} were\n"
+        "# derived from the model (edit to override; delete a derived key to derive it again).\n"
+    )
+    return head + yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=100)
+
+
 def parse_robot_file(text: str | Path, source: str, base: Path | None) -> RobotFile:
     """A :class:`RobotFile` from YAML text or a file path (``base``: the folder of relative model
     paths)."""
     data, loc = read_yaml(text)
     spec = validate_yaml(_RobotFileSpec, data, loc)
-    if isinstance(spec.model, str):
-        model = Path(spec.model)
-        if not model.is_absolute() and base is not None:
-            model = base / model
-        if not model.is_file():
-            raise InputError("model", spec.model, "an existing URDF or MJCF file")
-        package = None
-    else:
-        model = package_file(spec.model.package, spec.model.path)
-        package = (spec.model.package, spec.model.path)
+    model, package = resolve_model(spec.model, base)
     legs = None
     if spec.legs is not None:
         legs = LegJoints(tuple(spec.legs.left), tuple(spec.legs.right))

@@ -20,7 +20,14 @@ import numpy as np
 from footfall._io import save_figure
 from footfall.errors import InputError
 from footfall.models.biped import Side
-from footfall.robots.file import MODEL_FORMATS, RobotFile, load_robot_file, package_of
+from footfall.robots.file import (
+    MODEL_FORMATS,
+    RobotFile,
+    load_robot_file,
+    model_entry,
+    package_of,
+    robot_file_yaml,
+)
 from footfall.robots.model import RobotModel, _kinematics, straight_leg_height
 
 
@@ -149,15 +156,7 @@ def _compiled(walker: RobotModel) -> tuple[Any, Any]:
 def robot_file_text(rf: RobotFile, base: Path | None = None) -> str:
     """The YAML text of a complete robot file (model path relative to ``base`` when inside it;
     a file of an installed distribution as ``package``/``path``)."""
-    import yaml
-
-    model: Any
-    if rf.package is not None:
-        model = {"package": rf.package[0], "path": rf.package[1]}
-    elif base is not None and rf.model.resolve().is_relative_to(base.resolve()):
-        model = str(rf.model.resolve().relative_to(base.resolve()))
-    else:
-        model = str(rf.model)
+    model = model_entry(rf.model, rf.package, base)
     assert rf.legs is not None and rf.sole is not None and rf.reach is not None
     data: dict[str, Any] = {
         "name": rf.name,
@@ -176,12 +175,9 @@ def robot_file_text(rf: RobotFile, base: Path | None = None) -> str:
         "reach": [[round(x, 3), round(y, 3)] for x, y in rf.reach],
         "step_height_max": rf.step_height_max,
     }
-    head = (
-        f"# footfall robot file of {rf.name}, completed by `footfall robot inspect`: the legs,\n"
-        "# sole, pelvis height, reach and step height were derived from the model (edit to\n"
-        "# override; delete a derived key to derive it again).\n"
+    return robot_file_yaml(
+        "robot file", rf.name, "the legs, sole, pelvis height, reach and step height", data
     )
-    return head + yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=100)
 
 
 def plot_inspection(ins: Inspection, path: Path) -> Path:

@@ -22,7 +22,7 @@ from footfall.quadruped.kinematics import leg_link_points, whole_body_ik
 from footfall.quadruped.robot import LEGS
 from footfall.quadruped.scaling import gait_scale, scale_gait
 from footfall.robots.build import raw_model
-from footfall.robots.file import MODEL_FORMATS, package_of
+from footfall.robots.file import MODEL_FORMATS, model_entry, package_of, robot_file_yaml
 from footfall.robots.quadruped import (
     QuadrupedDerivation,
     QuadrupedFile,
@@ -150,15 +150,7 @@ def inspect_quadruped(
 def quadruped_file_text(qf: QuadrupedFile, base: Path | None = None) -> str:
     """The YAML text of a complete quadruped robot file (model path relative to ``base`` when
     inside it; a file of an installed distribution as ``package``/``path``)."""
-    import yaml
-
-    model: Any
-    if qf.package is not None:
-        model = {"package": qf.package[0], "path": qf.package[1]}
-    elif base is not None and qf.model.resolve().is_relative_to(base.resolve()):
-        model = str(qf.model.resolve().relative_to(base.resolve()))
-    else:
-        model = str(qf.model)
+    model = model_entry(qf.model, qf.package, base)
     assert qf.legs is not None
     data: dict[str, Any] = {
         "name": qf.name,
@@ -171,12 +163,9 @@ def quadruped_file_text(qf: QuadrupedFile, base: Path | None = None) -> str:
         **({"torque_limit": list(qf.torque_limit)} if qf.torque_limit else {}),
         "stance_height": qf.stance_height,
     }
-    head = (
-        f"# footfall quadruped robot file of {qf.name}, completed by `footfall robot inspect`: the\n"
-        "# legs, foot radius, knee bend and stance height were derived from the model (edit to\n"
-        "# override; delete a derived key to derive it again).\n"
+    return robot_file_yaml(
+        "quadruped robot file", qf.name, "the legs, foot radius, knee bend and stance height", data
     )
-    return head + yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=100)
 
 
 def plot_quadruped(ins: QuadrupedInspection, path: Path) -> Path:

@@ -52,7 +52,7 @@ from footfall._typing import FloatArray
 from footfall.errors import InputError
 from footfall.quadruped.robot import LEGS, Leg, LegGeometry, QuadrupedRobot
 from footfall.robots.build import RawModel, _body_chain, _geom_points, _hinges, raw_model
-from footfall.robots.file import MODEL_FORMATS, package_file
+from footfall.robots.file import MODEL_FORMATS, PackageFileSpec, resolve_model
 from footfall.terrain.scene import StrictSpec, read_yaml, validate_yaml
 
 #: default stance height: this share of the longest sagittal leg length
@@ -85,11 +85,6 @@ class QuadrupedFile:
         return MODEL_FORMATS[Path(self.model).suffix.lower()]
 
 
-class _PackageFile(StrictSpec):
-    package: str = Field(min_length=1, max_length=200)
-    path: str = Field(min_length=1, max_length=1000)
-
-
 class _Legs(StrictSpec):
     LF: list[str] = Field(min_length=3, max_length=3)
     RF: list[str] = Field(min_length=3, max_length=3)
@@ -100,7 +95,7 @@ class _Legs(StrictSpec):
 class _Spec(StrictSpec):
     name: str = Field(min_length=1, max_length=64)
     kind: str
-    model: str | _PackageFile
+    model: str | PackageFileSpec
     base: str | None = Field(default=None, max_length=200)
     legs: _Legs | None = None
     foot_radius: float | None = None
@@ -121,16 +116,9 @@ def parse_quadruped_file(text: str | Path, source: str, base: Path | None) -> Qu
     spec = validate_yaml(_Spec, data, loc)
     if spec.kind != "quadruped":
         raise InputError("kind", spec.kind, "quadruped")
-    if isinstance(spec.model, str):
-        model = Path(spec.model)
-        if not model.is_absolute() and base is not None:
-            model = base / model
-        if not model.is_file() or model.suffix.lower() not in MODEL_FORMATS:
-            raise InputError("model", spec.model, "an existing URDF or MJCF file")
-        package = None
-    else:
-        model = package_file(spec.model.package, spec.model.path)
-        package = (spec.model.package, spec.model.path)
+    model, package = resolve_model(spec.model, base)
+    if model.suffix.lower() not in MODEL_FORMATS:
+        raise InputError("model", str(model), "a URDF (.urdf) or MJCF (.xml, .mjcf) file")
     if spec.knees is not None and spec.knees not in KNEES:
         raise InputError("knees", spec.knees, f"one of {', '.join(KNEES)}")
     for key in ("foot_radius", "stance_height"):
