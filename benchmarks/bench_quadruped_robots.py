@@ -48,7 +48,7 @@ def _row(robot_name: str, label: str, params: GaitParams, friction: float | None
     )
     return (
         f"| {robot_name} | {label} | {'yes' if ok else 'no'}{' (fell)' if m.fell else ''} | "
-        f"{scaled.step:.3f} | {cop} | {100 * m.foot_slip_max_m:.2f} | {m.realtime_factor:.1f} |"
+        f"{scaled.step:.3f}{'' if scaled.lateral_share == 1 else f' (w {scaled.lateral_share:g})'} | {cop} | {100 * m.foot_slip_max_m:.2f} | {m.realtime_factor:.1f} |"
     )
 
 

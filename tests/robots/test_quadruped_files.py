@@ -29,7 +29,7 @@ from footfall.quadruped.gait import largest_step, plan_gait
 from footfall.quadruped.ground import Stairs
 from footfall.quadruped.kinematics import leg_fk, leg_ik, whole_body_com, whole_body_ik
 from footfall.quadruped.robot import LEGS, QuadrupedRobot
-from footfall.quadruped.scaling import STEP_MARGIN, gait_scale, scale_gait
+from footfall.quadruped.scaling import EDGE_RADII, STEP_MARGIN, gait_scale, scale_gait
 from footfall.robots.build import RawModel, raw_model
 from footfall.robots.quadruped import (
     builtin_quadruped_names,
@@ -196,8 +196,27 @@ def test_gait_scales_with_the_robot() -> None:
     s2 = scale_gait(go2, stairs)
     assert isinstance(s2.ground, Stairs)
     assert s2.ground.rise == pytest.approx(k * 0.1)
-    assert s2.ground.edge_margin >= go2.foot_radius
+    assert s2.ground.edge_margin >= EDGE_RADII * go2.foot_radius
+    assert s2.lateral_share == 1.0  # Go2's feet under vertical legs on the stairs
     plan_gait(go2, s2)  # plannable
+
+
+def test_a_wide_stance_narrows_where_the_legs_do_not_reach() -> None:
+    """ANYmal C's feet stand 0.20 m out of its ab/ad axes: on the side slope no step fits with
+    vertical legs (the planner proves it for the whole stance), with half the offset it does."""
+    from footfall.quadruped.scene import builtin_quadruped_scene
+
+    anymal = resolve_quadruped("anymal_c")
+    params = builtin_quadruped_scene("side_slope").params
+    scaled = scale_gait(anymal, params)
+    assert scaled.lateral_share == 0.5
+    assert largest_step(anymal, replace(scaled, lateral_share=1.0)) < 0.25 * scaled.step
+    plan = plan_gait(anymal, scaled)
+    feet = plan.initial_feet
+    for i, leg in enumerate(LEGS):
+        g = anymal.leg_geometry(leg)
+        # on the side slope the body stays level: the foot's y is the hip's plus half the offset
+        assert feet[i, 1] == pytest.approx(g.origin[1] + 0.5 * g.lateral, abs=1e-9)
 
 
 def test_cli_walks_go2_up_15_degrees_with_the_default_controller(tmp_path: Path) -> None:

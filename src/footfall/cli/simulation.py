@@ -214,6 +214,7 @@ def quadruped_cmd(
             "swing_height_m": params.swing_height,
             "swing_period_s": params.swing_period,
             "shift_period_s": params.shift_period,
+            "lateral_share": params.lateral_share,
         },
     }
     payload["slip_guard"] = {

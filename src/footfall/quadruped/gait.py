@@ -83,6 +83,9 @@ class GaitParams:
             ``side_slope`` must then be 0 and the body follows the local plane of its feet.
         body_ratio: with ``ground``: the body pitches by this fraction of the local plane's
             inclination (the compromise posture of fig. 7 applied locally; 0 keeps it level).
+        lateral_share: how far out of its ab/ad axis each neutral foot stands, as a share of the
+            leg's lateral offset (1: under a vertical leg; less: a narrower stance, smaller
+            body shifts over the support triangles). The document's robot has no offset.
     """
 
     slope: float
@@ -99,6 +102,7 @@ class GaitParams:
     side_slope: float = 0.0
     ground: QuadrupedGround | None = None
     body_ratio: float = BODY_RATIO
+    lateral_share: float = 1.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "step", positive("step", self.step))
@@ -119,6 +123,12 @@ class GaitParams:
         if not 0.0 <= ratio <= 1.0:
             raise InputError("body_ratio", ratio, "a fraction of the local inclination in [0, 1]")
         object.__setattr__(self, "body_ratio", ratio)
+        share = finite("lateral_share", self.lateral_share)
+        if not 0.0 <= share <= 1.0:
+            raise InputError(
+                "lateral_share", share, "a share of the legs' lateral offset in [0, 1]"
+            )
+        object.__setattr__(self, "lateral_share", share)
         if self.ground is None:
             PlaneGround(self.slope, self.side_slope)  # validates the side slope
             return
@@ -279,10 +289,10 @@ def _legs_ok(robot: QuadrupedRobot, body: FloatArray, pitch: float, feet: FloatA
     return True
 
 
-def _neutral_ok(robot: QuadrupedRobot, post: SlopePosture) -> bool:
+def _neutral_ok(robot: QuadrupedRobot, post: SlopePosture, share: float = 1.0) -> bool:
     """Neutral stance (body at its nominal place, feet at the neutral footholds) reachable."""
     body = post.body_position()
-    return _legs_ok(robot, body, post.body_pitch, post.neutral_feet(robot, body))
+    return _legs_ok(robot, body, post.body_pitch, post.neutral_feet(robot, body, share))
 
 
 def check_reachability(robot: QuadrupedRobot, params: GaitParams) -> SlopePosture:
@@ -302,7 +312,7 @@ def check_reachability(robot: QuadrupedRobot, params: GaitParams) -> SlopePostur
         post = SlopePosture(b0, params.pitch_for((0.0, math.tan(b0), 0.0)), h, params.posture)
     else:
         post = SlopePosture(params.slope, params.body_pitch, h, params.posture)
-    if _neutral_ok(robot, post):
+    if _neutral_ok(robot, post, params.lateral_share):
         body, pitch, feet = _initial_stance(robot, params, post)
         if not _legs_ok(robot, body, pitch, feet):
             fld = "side_slope" if params.ground is None else "ground"
@@ -314,13 +324,13 @@ def check_reachability(robot: QuadrupedRobot, params: GaitParams) -> SlopePostur
                 f"{robot.max_leg_length:.3f} m)",
             )
         return post
-    if not _neutral_ok(robot, SlopePosture(0.0, 0.0, h, params.posture)):
+    if not _neutral_ok(robot, SlopePosture(0.0, 0.0, h, params.posture), params.lateral_share):
         raise InputError("height", h, "a body height the legs reach on flat ground")
     lo, hi = 0.0, params.slope
     for _ in range(_BISECT_STEPS):
         mid = 0.5 * (lo + hi)
         trial = SlopePosture(mid, min(params.body_pitch, mid), h, params.posture)
-        lo, hi = (mid, hi) if _neutral_ok(robot, trial) else (lo, mid)
+        lo, hi = (mid, hi) if _neutral_ok(robot, trial, params.lateral_share) else (lo, mid)
     raise InputError(
         "slope",
         f"{math.degrees(params.slope):.2f} deg",
@@ -361,7 +371,8 @@ def _initial_stance(
     pitch = post.body_pitch
     rot = body_rotation(pitch)
     d = post.leg_direction()
-    feet = np.array([ground.drop(body + rot @ robot.stance_offset(leg), d) for leg in LEGS])
+    share = params.lateral_share
+    feet = np.array([ground.drop(body + rot @ robot.stance_offset(leg, share), d) for leg in LEGS])
     return body, pitch, feet
 
 

@@ -148,16 +148,20 @@ class SlopePosture:
         """Body centre in ``{W}`` at horizontal position (x, y), h_B above the plane, shape (3,)."""
         return np.array([x, y, x * math.tan(self.slope) + self.height])
 
-    def neutral_feet(self, robot: QuadrupedRobot, body_pos: FloatArray) -> FloatArray:
+    def neutral_feet(
+        self, robot: QuadrupedRobot, body_pos: FloatArray, lateral_share: float = 1.0
+    ) -> FloatArray:
         """Nominal foot centres for the body at ``body_pos``: each hip's ray along
-        :meth:`leg_direction` meets the foot-centre plane. Shape (4, 3) [m], ``LEGS`` order.
+        :meth:`leg_direction` meets the foot-centre plane (the hip moved out by
+        ``lateral_share`` of the leg's lateral offset, :meth:`QuadrupedRobot.stance_offset`).
+        Shape (4, 3) [m], ``LEGS`` order.
         """
         rot = body_rotation(self.body_pitch)
         d = self.leg_direction()
         n = self.slope_normal
         feet = np.empty((4, 3))
         for i, leg in enumerate(LEGS):
-            hip = body_pos + rot @ robot.stance_offset(leg)
+            hip = body_pos + rot @ robot.stance_offset(leg, lateral_share)
             # plane through the origin with normal n: n.(hip + s d) = 0
             s = -float(n @ hip) / float(n @ d)
             feet[i] = hip + s * d

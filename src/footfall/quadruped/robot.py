@@ -324,13 +324,13 @@ class QuadrupedRobot:
         sy = 0.5 * self.hip_spacing_y * (1.0 if leg.is_left else -1.0)
         return np.array([sx, sy, 0.0])
 
-    def stance_offset(self, leg: Leg) -> FloatArray:
-        """The point of ``{B}`` a vertical leg's foot lies under: the leg frame origin moved
-        sideways by the leg's lateral offset, shape (3,) [m] (the hip itself for the document's
-        robot)."""
+    def stance_offset(self, leg: Leg, share: float = 1.0) -> FloatArray:
+        """The point of ``{B}`` the neutral stance's foot lies under: the leg frame origin moved
+        sideways by ``share`` of the leg's lateral offset (1: under a vertical leg), shape (3,)
+        [m] (the hip itself for the document's robot, which has no offset)."""
         if self.legs is None:
             return self.hip_offset(leg)
-        return self.hip_offset(leg) + np.array([0.0, self.legs[leg.idx].lateral, 0.0])
+        return self.hip_offset(leg) + np.array([0.0, share * self.legs[leg.idx].lateral, 0.0])
 
     def hip_offsets(self) -> FloatArray:
         """Hip positions of all legs in ``{B}`` in ``LEGS`` order, shape (4, 3) [m]."""
