@@ -399,6 +399,49 @@ def test_verdict_wording() -> None:
     assert f"{1000 * np.mean(lower):+.2f} mm" in holds
 
 
+def test_a_comparison_of_two_modes_with_the_same_walks_is_judged_once() -> None:
+    """Where both planners have the same N in both step modes the two comparisons are the same
+    walks: one verdict line naming both modes; with another N both lines stay."""
+    lower = list(-0.005 + np.random.default_rng(4).normal(0.0, 0.0005, 12))
+    small = _pairs_with_diffs(lower)
+    equal = replace(small, mode="equal")
+    same_n = NSTEPS | {("s", "miqcqp", "equal"): 7, ("s", "kinematic", "equal"): 9}
+    (one,) = st.distinct([small, equal], same_n)
+    assert one.mode == "smallest=equal" and one.zmp_diff == small.zmp_diff
+    (line,) = st.verdict([one], same_n)
+    assert "s, smallest = equal N (miqcqp N = 7, kinematic N = 9)" in line
+    other_n = NSTEPS | {("s", "miqcqp", "equal"): 9, ("s", "kinematic", "equal"): 9}
+    both = st.distinct([small, equal], other_n)
+    assert [p.mode for p in both] == ["smallest", "equal"]
+    assert len(st.verdict(both, other_n)) == 2
+
+
+def test_fragility_curves_keep_every_mode_and_name_its_n() -> None:
+    """A curve whose walks are two modes' is drawn once and labelled with both (it used to be
+    dropped, the survivor labelled "equal N"); curves of different N stay apart, each naming N."""
+    from footfall.viz.study_plots import fragility_curves
+
+    def pts(planner: str, mode: str, n: int, wins: tuple[int, ...]) -> list[dict[str, Any]]:
+        return [
+            {"scene": "s", "planner": planner, "mode": mode, "impulse": float(i), "walks": 10,
+             "successes": k, "lo": 0.1 * k - 0.1, "hi": min(1.0, 0.1 * k + 0.1), "n_steps": n}
+            for i, k in enumerate(wins)
+        ]  # fmt: skip
+
+    points = (
+        pts("miqcqp", "equal", 11, (10, 8))
+        + pts("miqcqp", "smallest", 11, (10, 8))
+        + pts("reactive", "equal", 11, (9, 5))
+        + pts("reactive", "smallest", 11, (9, 5))
+    )
+    labels = [c["label"] for c in fragility_curves(points)]
+    assert labels == ["miqcqp (smallest = equal N = 11)", "reactive (smallest = equal N = 11)"]
+    points = pts("miqcqp", "equal", 11, (10, 8)) + pts("miqcqp", "smallest", 9, (10, 6))
+    curves = fragility_curves(points)
+    assert [c["label"] for c in curves] == ["miqcqp (equal N = 11)", "miqcqp (smallest N = 9)"]
+    assert curves[1]["rate"] == [1.0, 0.6]
+
+
 def test_zmp_significant_needs_both_the_test_and_the_interval() -> None:
     p = _pairs_with_diffs(list(-0.005 + np.linspace(-0.0005, 0.0005, 20)))
     assert p.zmp_significant

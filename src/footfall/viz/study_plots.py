@@ -22,39 +22,65 @@ def _grid(n: int) -> tuple[Any, Any]:
     return fig, axes[0]
 
 
+def fragility_curves(points: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The curves of :func:`plot_fragility`: per scene, planner and step mode, sorted by impulse,
+    with a label that names the mode and N; a curve whose walks are another mode's too (the same
+    N, so the same walks) is one curve labelled with both modes, never dropped.
+
+    Returns:
+        dicts with scene, planner, modes (list), label, impulse, rate, lo, hi (lists).
+    """
+    curves: list[dict[str, Any]] = []
+    by_walks: dict[tuple[object, ...], dict[str, Any]] = {}
+    keys = dict.fromkeys((p["scene"], p["planner"], p["mode"]) for p in points)
+    for scene, planner, mode in keys:
+        pts = sorted(
+            (p for p in points if (p["scene"], p["planner"], p["mode"]) == (scene, planner, mode)),
+            key=lambda p: p["impulse"],
+        )
+        n = pts[0].get("n_steps", 0)
+        same = (scene, planner, n, *((p["impulse"], p["walks"], p["successes"]) for p in pts))
+        if same in by_walks:
+            by_walks[same]["modes"].append(mode)
+            continue
+        curve = {
+            "scene": scene,
+            "planner": planner,
+            "modes": [mode],
+            "n_steps": n,
+            "impulse": [p["impulse"] for p in pts],
+            "rate": [p["successes"] / p["walks"] if p["walks"] else float("nan") for p in pts],
+            "lo": [p["lo"] for p in pts],
+            "hi": [p["hi"] for p in pts],
+        }
+        by_walks[same] = curve
+        curves.append(curve)
+    for c in curves:
+        order = sorted(c["modes"], key=lambda m: (m != "smallest", m))
+        n_text = f" = {c['n_steps']}" if c["n_steps"] else ""
+        c["label"] = f"{c['planner']} ({' = '.join(order)} N{n_text})"
+    return curves
+
+
 def plot_fragility(points: Sequence[dict[str, Any]], path: Path) -> Path:
-    """Success rate against push impulse with Wilson 95 % bands, one panel per scene, one line
-    per planner and step mode (solid: smallest N, dashed: equal N)."""
-    scenes = list(dict.fromkeys(p["scene"] for p in points))
+    """Success rate against push impulse with Wilson 95 % intervals (bands, and error bars so a
+    single impulse shows its interval too), one panel per scene, one line per planner and step
+    mode with its N (solid: smallest N, dashed: equal N; a curve that is both modes' walks is
+    drawn once, labelled with both)."""
+    curves = fragility_curves(points)
+    scenes = list(dict.fromkeys(c["scene"] for c in curves))
     fig, axes = _grid(len(scenes))
     for ax, scene in zip(axes, scenes, strict=False):
-        keys = list(dict.fromkeys((p["planner"], p["mode"]) for p in points if p["scene"] == scene))
-        drawn: set[tuple[object, ...]] = set()
-        for planner, mode in keys:
-            pts = sorted(
-                (
-                    p
-                    for p in points
-                    if (p["scene"], p["planner"], p["mode"]) == (scene, planner, mode)
-                ),
-                key=lambda p: p["impulse"],
-            )
-            # the same walks in both modes (the reactive planner's) are drawn once
-            same = (planner, *((p["impulse"], p["walks"], p["successes"]) for p in pts))
-            if same in drawn:
-                continue
-            drawn.add(same)
-            x = np.array([p["impulse"] for p in pts])
-            y = np.array([p["successes"] / p["walks"] if p["walks"] else np.nan for p in pts])
-            lo = np.array([p["lo"] for p in pts])
-            hi = np.array([p["hi"] for p in pts])
-            (line,) = ax.plot(
-                x, y, _STYLE.get(mode, "-"), marker="o", label=f"{planner} ({mode} N)"
-            )
+        for c in (c for c in curves if c["scene"] == scene):
+            x, y = np.array(c["impulse"]), np.array(c["rate"])
+            lo, hi = np.array(c["lo"]), np.array(c["hi"])
+            (line,) = ax.plot(x, y, _STYLE.get(c["modes"][0], "-"), marker="o", label=c["label"])
             ax.fill_between(x, lo, hi, color=line.get_color(), alpha=0.15)
+            yerr = np.vstack([np.clip(y - lo, 0, None), np.clip(hi - y, 0, None)])
+            ax.errorbar(x, y, yerr=yerr, fmt="none", ecolor=line.get_color(), capsize=3)
         ax.set_title(scene)
         ax.set_xlabel("push impulse [N s]")
-        ax.set_ylabel("success rate (95 % Wilson band)")
+        ax.set_ylabel("success rate (95 % Wilson interval)")
         ax.set_ylim(-0.02, 1.02)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)

@@ -40,8 +40,11 @@ def summarise(design: StudyDesign, rows: list[dict[str, Any]]) -> Summary:
     """The statistics of ``rows`` (the study's table)."""
     modes = list(design.steps)
     cells = stats.cells(rows, modes)
-    pairs = stats.comparisons(rows, design.scenes, modes, design.default_push, design.planners)
     n_steps = {(c.scene, c.planner, c.mode): c.n_steps for c in cells}
+    pairs = stats.distinct(
+        stats.comparisons(rows, design.scenes, modes, design.default_push, design.planners),
+        n_steps,
+    )
     errors = sum(r["error"] is not None for r in rows)
     return Summary(cells, pairs, stats.fragility(cells), stats.verdict(pairs, n_steps), errors)
 

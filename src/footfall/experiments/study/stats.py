@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -283,16 +283,50 @@ class FragilityPoint:
     successes: int
     lo: float
     hi: float
+    n_steps: int = 0
 
 
 def fragility(all_cells: Sequence[Cell]) -> list[FragilityPoint]:
     """Success against push impulse per scene, planner and mode (from :func:`cells`)."""
     return [
         FragilityPoint(
-            c.scene, c.planner, c.mode, c.impulse, c.walks, c.successes, c.success_lo, c.success_hi
+            c.scene,
+            c.planner,
+            c.mode,
+            c.impulse,
+            c.walks,
+            c.successes,
+            c.success_lo,
+            c.success_hi,
+            c.n_steps,
         )
         for c in sorted(all_cells, key=lambda c: (c.scene, c.planner, c.mode, c.impulse))
     ]
+
+
+#: how a comparison's two step modes are named when they are the same walks
+SAME_MODES = "smallest=equal"
+
+
+def distinct(pairs: Sequence[Paired], n_steps: dict[tuple[str, str, str], int]) -> list[Paired]:
+    """The comparisons, each once: where both planners have the same N in two step modes (on a
+    scene where the smallest N is the reactive planner's, say), the two comparisons are the same
+    walks; the first is kept with the modes joined by ``=`` and the other dropped, so no verdict
+    line, table row or count holds it twice."""
+    out: list[Paired] = []
+    seen: dict[tuple[object, ...], int] = {}
+    for p in pairs:
+        n_a = n_steps.get((p.scene, p.planner, p.mode))
+        n_b = n_steps.get((p.scene, p.baseline, p.mode))
+        key = (p.scene, p.planner, p.baseline, p.impulse, n_a, n_b)
+        if n_a is None or n_b is None or key not in seen:
+            seen[key] = len(out)
+            out.append(p)
+            continue
+        first = out[seen[key]]
+        if p.mode not in first.mode.split("="):
+            out[seen[key]] = replace(first, mode=f"{first.mode}={p.mode}")
+    return out
 
 
 def _mm(x: float) -> str:
@@ -301,16 +335,18 @@ def _mm(x: float) -> str:
 
 def verdict(pairs: Sequence[Paired], n_steps: dict[tuple[str, str, str], int]) -> list[str]:
     """Document 000's claim (the full-horizon planner has the smaller single-support ZMP offset)
-    judged from the paired differences, one line per scene, step mode and baseline.
+    judged from the paired differences, one line per scene, step mode and baseline (give the
+    pairs through :func:`distinct`: a comparison that is two modes' is one line).
 
     ``n_steps``: N per (scene, planner, mode), so each line says which N it holds for."""
     lines = []
     for p in pairs:
-        n_a = n_steps.get((p.scene, p.planner, p.mode))
-        n_b = n_steps.get((p.scene, p.baseline, p.mode))
+        mode = p.mode.split("=")[0]
+        n_a = n_steps.get((p.scene, p.planner, mode))
+        n_b = n_steps.get((p.scene, p.baseline, mode))
         head = (
-            f"{p.scene}, {p.mode} N ({p.planner} N = {n_a}, {p.baseline} N = {n_b}), "
-            f"push {p.impulse:g} N s"
+            f"{p.scene}, {p.mode.replace('=', ' = ')} N ({p.planner} N = {n_a}, {p.baseline} "
+            f"N = {n_b}), push {p.impulse:g} N s"
         )
         if p.pairs < 2:
             lines.append(
