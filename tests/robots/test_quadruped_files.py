@@ -318,3 +318,23 @@ def test_lateral_pushes_are_paired_and_fail_when_too_strong() -> None:
     text = "\n".join(summary_lines(rows))
     assert "| 0 | 0.00 | 1/1 |" in text and "| 2 | " in text and "0/1" in text
     assert "largest level every seed survived: 0 m/s" in text
+
+
+def test_a_robot_file_of_the_other_kind_is_refused_by_name(tmp_path: Path) -> None:
+    """A humanoid's file given to the quadruped, and a quadruped's to the humanoid walker: each
+    error names the file and says which command takes it."""
+    from importlib import resources
+
+    from footfall.robots.registry import resolve_robot_file
+
+    builtin = resources.files("footfall.robots").joinpath("builtin")
+    g1 = tmp_path / "g1.yaml"
+    g1.write_text(builtin.joinpath("g1.yaml").read_text())
+    go2 = tmp_path / "go2.yaml"
+    go2.write_text(builtin.joinpath("quadrupeds", "go2.yaml").read_text())
+    with pytest.raises(InputError) as e:
+        resolve_quadruped(g1)
+    assert e.value.field == "robot" and "kind: quadruped" in e.value.expected
+    with pytest.raises(InputError) as e:
+        resolve_robot_file(go2)
+    assert e.value.field == "robot" and "footfall quadruped --robot" in e.value.expected

@@ -88,7 +88,7 @@ def looks_quadruped(model: Path, config: Path | None) -> bool:
         if path is not None and path.suffix.lower() in (".yaml", ".yml"):
             if not path.is_file():
                 raise InputError("MODEL" if path == model else "--config", str(path), "a file")
-            return is_quadruped_file(path.read_text())
+            return is_quadruped_file(path)
     if model.suffix.lower() not in MODEL_FORMATS or not model.is_file():
         return False
     raw = raw_model(QuadrupedFile(name="probe", model=model.resolve()))

@@ -104,8 +104,9 @@ class _Spec(StrictSpec):
     stance_height: float | None = None
 
 
-def is_quadruped_file(text: str) -> bool:
-    """Whether YAML text is a quadruped robot file (``kind: quadruped``)."""
+def is_quadruped_file(text: str | Path) -> bool:
+    """Whether YAML text (or a file, read bounded) is a quadruped robot file (``kind:
+    quadruped``)."""
     data, _ = read_yaml(text)
     return isinstance(data, dict) and data.get("kind") == "quadruped"
 
@@ -159,6 +160,13 @@ def resolve_quadruped(source: str | Path) -> QuadrupedRobot:
         path = Path(source)
         if not path.is_file():
             raise InputError("robot", str(source), "an existing quadruped robot file (.yaml)")
+        if not is_quadruped_file(path):
+            raise InputError(
+                "robot",
+                str(source),
+                "a quadruped robot file (kind: quadruped; a humanoid's file goes to footfall "
+                "walk, plan or compare --robot)",
+            )
         return quadruped_robot(parse_quadruped_file(path, str(path), path.parent))
     names = builtin_quadruped_names()
     if source == "document":

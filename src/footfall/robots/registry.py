@@ -43,6 +43,15 @@ def resolve_robot_file(source: str | Path) -> RobotFile | None:
         path = Path(source)
         if not path.is_file():
             raise InputError("robot", str(source), "an existing robot file (.yaml)")
+        from footfall.robots.quadruped import is_quadruped_file
+
+        if is_quadruped_file(path):
+            raise InputError(
+                "robot",
+                str(source),
+                "a humanoid's robot file (this one is a quadruped's, kind: quadruped: "
+                "footfall quadruped --robot takes it)",
+            )
         return load_robot_file(path)
     if not isinstance(source, str):
         raise InputError("robot", source, "a robot name or a robot file (.yaml)")
