@@ -283,6 +283,8 @@ def bench_quadruped_pushes_cmd(
     largest level every seed survived; exit 0 when every walk ran (a fall is a result)."""
     from footfall.experiments.quadruped_pushes import (
         QuadrupedPushRow,
+        check_push_inputs,
+        push_walk_plan,
         rows_csv,
         run_quadruped_pushes,
         summary_lines,
@@ -295,9 +297,9 @@ def bench_quadruped_pushes_cmd(
         raise InputError("seeds", seeds, "an integer >= 1")
     files = ("quadruped_pushes.csv", "quadruped_pushes.md")
     refuse_inputs_as_outputs([robot], {"out": [out / f for f in files]})
-    from footfall.robots.quadruped import resolve_quadruped
-
-    resolve_quadruped(robot)  # an unknown robot is refused before any output
+    # every input checked (robot, slope, cycles: the walk planned) before any output is touched
+    check_push_inputs(tuple(dv_values), tuple(range(seeds)), duration)
+    push_walk_plan(robot, slope_deg, cycles)
     output_folder(out)
     remove_outputs(out, *files)
 

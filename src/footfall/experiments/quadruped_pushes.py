@@ -24,7 +24,7 @@ import numpy as np
 from footfall.errors import InputError
 from footfall.experiments.study.stats import wilson
 from footfall.quadruped import GaitParams, plan_gait
-from footfall.quadruped.gait import BODY_RATIO
+from footfall.quadruped.gait import BODY_RATIO, GaitPlan
 from footfall.quadruped.scaling import scale_gait
 from footfall.robots.quadruped import resolve_quadruped
 from footfall.sim.disturbance import Push
@@ -63,6 +63,29 @@ def push_of_seed(seed: int, duration_s: float) -> tuple[float, float]:
     return share, side
 
 
+def check_push_inputs(dvs: tuple[float, ...], seeds: tuple[int, ...], duration: float) -> None:
+    """The levels, seeds and push length, each checked (an error names the first bad one)."""
+    if not dvs or any(not (math.isfinite(v) and v >= 0.0) for v in dvs):
+        raise InputError("dv", dvs, "velocity changes >= 0 [m/s]")
+    if not seeds:
+        raise InputError("seeds", seeds, "at least one seed")
+    if not (math.isfinite(duration) and duration > 0.0):
+        raise InputError("duration", duration, "a push length > 0 [s]")
+
+
+def push_walk_plan(robot_name: str, slope_deg: float, cycles: int) -> GaitPlan:
+    """The walk every push of :func:`run_quadruped_pushes` is applied to: document 001's gait up
+    ``slope_deg`` (the body at ``BODY_RATIO`` of it), scaled to the robot."""
+    robot = resolve_quadruped(robot_name)
+    if not math.isfinite(slope_deg):
+        raise InputError("slope_deg", slope_deg, "a finite slope [deg]")
+    slope = math.radians(slope_deg)
+    params = scale_gait(
+        robot, GaitParams(slope=slope, body_pitch=BODY_RATIO * slope, cycles=cycles)
+    )
+    return plan_gait(robot, params)
+
+
 def run_quadruped_pushes(
     robot_name: str,
     slope_deg: float,
@@ -74,18 +97,9 @@ def run_quadruped_pushes(
 ) -> list[QuadrupedPushRow]:
     """Walk ``robot_name`` up ``slope_deg`` once per (level, seed) with that seed's lateral push
     (module docstring); rows in level-major order."""
-    if not dvs or any(not (math.isfinite(v) and v >= 0.0) for v in dvs):
-        raise InputError("dv", dvs, "velocity changes >= 0 [m/s]")
-    if not seeds:
-        raise InputError("seeds", seeds, "at least one seed")
-    if not (math.isfinite(duration) and duration > 0.0):
-        raise InputError("duration", duration, "a push length > 0 [s]")
+    check_push_inputs(dvs, seeds, duration)
     robot = resolve_quadruped(robot_name)
-    slope = math.radians(slope_deg)
-    params = scale_gait(
-        robot, GaitParams(slope=slope, body_pitch=BODY_RATIO * slope, cycles=cycles)
-    )
-    plan = plan_gait(robot, params)
+    plan = push_walk_plan(robot_name, slope_deg, cycles)
     settings = robot_settings(robot)
     rows = []
     for dv in dvs:
