@@ -338,3 +338,26 @@ def test_a_robot_file_of_the_other_kind_is_refused_by_name(tmp_path: Path) -> No
     with pytest.raises(InputError) as e:
         resolve_robot_file(go2)
     assert e.value.field == "robot" and "footfall quadruped --robot" in e.value.expected
+
+
+@pytest.mark.parametrize(
+    ("args", "field"),
+    [
+        (["--duration", "0"], "duration"),
+        (["--slope-deg", "nan"], "slope_deg"),
+        (["--dv", "-1"], "dv"),
+    ],
+)
+def test_push_sweep_bad_input_leaves_the_last_results(
+    tmp_path: Path, args: list[str], field: str
+) -> None:
+    from typer.testing import CliRunner
+
+    from footfall.cli import app
+
+    last = tmp_path / "quadruped_pushes.md"
+    last.write_text("the last run's table\n")
+    res = CliRunner().invoke(app, ["bench", "quadruped-pushes", *args, "--out", str(tmp_path)])
+    assert isinstance(res.exception, InputError), res.output
+    assert res.exception.field == field
+    assert last.read_text() == "the last run's table\n"
