@@ -341,6 +341,20 @@ def model_entry(model: Path, package: tuple[str, str] | None, base: Path | None)
     return str(model)
 
 
+def inspect_input_is_file(model: Path, config: Path | None) -> bool:
+    """``footfall robot inspect``'s MODEL checked: True when it is a robot file (then no
+    ``--config`` beside it); else a model file of a known format that exists."""
+    if model.suffix.lower() in (".yaml", ".yml"):
+        if config is not None:
+            raise InputError("--config", str(config), "no config with a robot file as MODEL")
+        return True
+    if model.suffix.lower() not in MODEL_FORMATS:
+        raise InputError("MODEL", str(model), "a .urdf, .xml or .mjcf model, or a robot file")
+    if not model.is_file():
+        raise InputError("MODEL", str(model), "an existing file")
+    return False
+
+
 def robot_file_yaml(kind: str, name: str, derived: str, data: dict[str, Any]) -> str:
     """The text ``footfall robot inspect`` writes: a header saying which values were derived
     from the model, then ``data`` as YAML."""

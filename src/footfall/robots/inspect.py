@@ -18,11 +18,10 @@ from typing import Any
 import numpy as np
 
 from footfall._io import save_figure
-from footfall.errors import InputError
 from footfall.models.biped import Side
 from footfall.robots.file import (
-    MODEL_FORMATS,
     RobotFile,
+    inspect_input_is_file,
     load_robot_file,
     model_entry,
     package_of,
@@ -88,15 +87,9 @@ class Inspection:
 
 
 def _robot_of(model: Path, config: Path | None, name: str | None) -> RobotFile:
-    if model.suffix.lower() in (".yaml", ".yml"):
-        if config is not None:
-            raise InputError("--config", str(config), "no config with a robot file as MODEL")
+    if inspect_input_is_file(model, config):
         rf = load_robot_file(model)
     else:
-        if model.suffix.lower() not in MODEL_FORMATS:
-            raise InputError("MODEL", str(model), "a .urdf, .xml or .mjcf model, or a robot file")
-        if not model.is_file():
-            raise InputError("MODEL", str(model), "an existing file")
         if config is not None:
             rf = replace(load_robot_file(config), model=model.resolve(), package=package_of(model))
         else:

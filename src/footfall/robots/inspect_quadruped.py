@@ -22,7 +22,13 @@ from footfall.quadruped.kinematics import leg_link_points, whole_body_ik
 from footfall.quadruped.robot import LEGS
 from footfall.quadruped.scaling import gait_scale, scale_gait
 from footfall.robots.build import raw_model
-from footfall.robots.file import MODEL_FORMATS, model_entry, package_of, robot_file_yaml
+from footfall.robots.file import (
+    MODEL_FORMATS,
+    inspect_input_is_file,
+    model_entry,
+    package_of,
+    robot_file_yaml,
+)
 from footfall.robots.quadruped import (
     QuadrupedDerivation,
     QuadrupedFile,
@@ -100,15 +106,9 @@ def looks_quadruped(model: Path, config: Path | None) -> bool:
 
 
 def _file_of(model: Path, config: Path | None, name: str | None) -> QuadrupedFile:
-    if model.suffix.lower() in (".yaml", ".yml"):
-        if config is not None:
-            raise InputError("--config", str(config), "no config with a robot file as MODEL")
+    if inspect_input_is_file(model, config):
         qf = parse_quadruped_file(model, str(model), model.parent)
     else:
-        if model.suffix.lower() not in MODEL_FORMATS:
-            raise InputError("MODEL", str(model), "a .urdf, .xml or .mjcf model, or a robot file")
-        if not model.is_file():
-            raise InputError("MODEL", str(model), "an existing file")
         if config is not None:
             qf = replace(
                 parse_quadruped_file(config, str(config), config.parent),
