@@ -299,7 +299,7 @@ def bench_quadruped_pushes_cmd(
     refuse_inputs_as_outputs([robot], {"out": [out / f for f in files]})
     # every input checked (robot, slope, cycles: the walk planned) before any output is touched
     check_push_inputs(tuple(dv_values), tuple(range(seeds)), duration)
-    push_walk_plan(robot, slope_deg, cycles)
+    plan = push_walk_plan(robot, slope_deg, cycles)
     output_folder(out)
     remove_outputs(out, *files)
 
@@ -308,7 +308,7 @@ def bench_quadruped_pushes_cmd(
         console.print(f"dv {r.dv_m_s:g} m/s seed {r.seed} {r.side}: {verdict}")
 
     rows = run_quadruped_pushes(
-        robot, slope_deg, tuple(dv_values), tuple(range(seeds)), duration, cycles, progress
+        robot, slope_deg, tuple(dv_values), tuple(range(seeds)), duration, cycles, progress, plan
     )
     lines = summary_lines(rows)
     write_text(out / "quadruped_pushes.csv", rows_csv(rows))

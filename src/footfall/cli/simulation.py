@@ -172,12 +172,9 @@ def quadruped_cmd(
             (None, None, cycles, None, None),
             "osp" if strategy is None else strategy,
         )
-        params = _slope_params(
-            slope,
-            math.degrees(doc.body_pitch),
-            (step, height, None, swing_period, shift_period),
-            doc.strategy.value,
-            scale_gait(quad, doc),
+        # the document's gait scaled to the robot; the options given replace it as they are
+        params = _with_given(
+            scale_gait(quad, doc), (step, height, None, swing_period, shift_period)
         )
         label = f"{math.degrees(params.slope):g}°/{math.degrees(params.body_pitch):g}°"
     settings = robot_settings(quad, friction)
@@ -273,7 +270,6 @@ def _slope_params(
     body_deg: float,
     gait: tuple[float | None, float | None, int | None, float | None, float | None],
     strategy: str,
-    base: Any = None,
 ) -> Any:
     """GaitParams of the document's slope from the CLI options (errors name the option)."""
     from footfall.quadruped import GaitParams, ZmpStrategy
@@ -289,12 +285,18 @@ def _slope_params(
         strat = ZmpStrategy(strategy)
     except ValueError:
         raise InputError("--strategy", strategy, "one of osp, incentre, transverse") from None
-    step, height, cycles, swing_period, shift_period = gait
     params = GaitParams(
         slope=math.radians(slope_deg), body_pitch=math.radians(body_deg), strategy=strat
     )
-    if base is not None:  # the gait already scaled to the robot: the options given replace it
-        params = base
+    return _with_given(params, gait)
+
+
+def _with_given(
+    params: Any, gait: tuple[float | None, float | None, int | None, float | None, float | None]
+) -> Any:
+    """``params`` with the gait options given (step, swing height, cycles, swing and shift
+    periods; None: not given) in their place."""
+    step, height, cycles, swing_period, shift_period = gait
     given: dict[str, Any] = {
         "step": step,
         "swing_height": height,

@@ -94,12 +94,15 @@ def run_quadruped_pushes(
     duration: float = 0.05,
     cycles: int = 4,
     progress: Callable[[QuadrupedPushRow], None] | None = None,
+    plan: GaitPlan | None = None,
 ) -> list[QuadrupedPushRow]:
     """Walk ``robot_name`` up ``slope_deg`` once per (level, seed) with that seed's lateral push
-    (module docstring); rows in level-major order."""
+    (module docstring); rows in level-major order. ``plan``: the walk of
+    :func:`push_walk_plan` when the caller has planned it already."""
     check_push_inputs(dvs, seeds, duration)
     robot = resolve_quadruped(robot_name)
-    plan = push_walk_plan(robot_name, slope_deg, cycles)
+    if plan is None:
+        plan = push_walk_plan(robot_name, slope_deg, cycles)
     settings = robot_settings(robot)
     rows = []
     for dv in dvs:

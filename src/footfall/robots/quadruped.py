@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -286,7 +286,7 @@ def _branch(geo: LegGeometry, leg: Leg, knees: str | None, height: float) -> tup
     ok = {}
     for br in (1.0, -1.0):
         try:
-            q = leg_ik(_one_leg_robot(_with_branch(geo, br), leg), target, leg)
+            q = leg_ik(_one_leg_robot(_with_branch(geo, br)), target, leg)
         except InputError:
             continue
         knee_x = _knee_x(geo, q)
@@ -326,12 +326,10 @@ def _knee_x(geo: LegGeometry, q: FloatArray) -> float:
 
 
 def _with_branch(geo: LegGeometry, branch: float) -> LegGeometry:
-    from dataclasses import replace
-
     return replace(geo, branch=branch)
 
 
-def _one_leg_robot(geo: LegGeometry, leg: Leg) -> QuadrupedRobot:
+def _one_leg_robot(geo: LegGeometry) -> QuadrupedRobot:
     """A robot of four ``geo`` legs, to run one leg's kinematics on."""
     lo, hi = geo.sagittal_lengths()
     return QuadrupedRobot(stance_height=0.5 * (lo + hi), legs=(geo,) * 4, name="probe")
