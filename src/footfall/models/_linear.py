@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import expm
 
 from footfall._typing import FloatArray
 from footfall._validate import positive
@@ -43,6 +42,9 @@ def zoh(a: FloatArray, b: FloatArray, dt: float) -> tuple[FloatArray, FloatArray
     Returns:
         ``(Ad, Bd)`` of shapes (n, n) and (n, m).
     """
+    from scipy.linalg import expm  # here: importing scipy.linalg takes 0.3 s, most users of
+    # the models (reading a plan or a scene) never discretise
+
     dt = positive("dt", dt)
     check_horizon("dt", float(np.max(np.abs(np.linalg.eigvals(a)))), dt)
     n, m = b.shape

@@ -32,7 +32,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.linalg import expm
 
 from footfall._typing import FloatArray
 from footfall._validate import finite_array, finite_vector, positive
@@ -117,6 +116,8 @@ class ALIP(LinearModel):
         m[:4, :4] = self.A
         m[:4, 4:7] = self.E
         m[4:7, 7:10] = np.eye(3)
+        from scipy.linalg import expm  # here: scipy.linalg takes 0.3 s to import
+
         e = expm(m * t_ds)
         finite_matrices("t_ds", t_ds, e)
         a_r = e[:4, :4].copy()
