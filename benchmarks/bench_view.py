@@ -17,7 +17,8 @@ Run (from the repository root; needs the ``sim`` and ``view`` extras and Debian'
    the port answers).
 3. Playback: *play* is clicked in the page; for ``--play-seconds`` the page counts, at every
    animation frame, whether the robot's pelvis moved since the last one (distinct robot poses
-   drawn per second: the playback's frame rate) and three.js's render count (frames drawn).
+   drawn per second: the playback's frame rate) and the page's count of pictures drawn.
+   ``--antialias`` 0 or 1 overrides the page's choice (multisampling off in a software WebGL).
 """
 
 from __future__ import annotations
@@ -36,17 +37,17 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 #: counts, at each animation frame, the robot poses and three.js renders the page shows
 _PLAY_PROBE = """seconds => new Promise(done => {
-  const pelvis = () => window.__viserMutable.nodeRefFromName['/robot/pelvis'];
-  const renders = () => window.__viserTestpoints.rendererInfo.render.frame;
-  const t0 = performance.now(), r0 = renders();
-  let last = pelvis().position.x, poses = 0, ticks = 0;
+  const page = window.footfall;
+  const pelvis = () => page.bodyPosition('pelvis')[0];
+  const t0 = performance.now(), r0 = page.renders;
+  let last = pelvis(), poses = 0, ticks = 0;
   function tick() {
     ticks++;
-    const x = pelvis().position.x;
+    const x = pelvis();
     if (x !== last) { poses++; last = x; }
     const dt = (performance.now() - t0) / 1000;
     if (dt < seconds) requestAnimationFrame(tick);
-    else done({poses: poses / dt, renders: (renders() - r0) / dt, raf: ticks / dt});
+    else done({poses: poses / dt, renders: (page.renders - r0) / dt, raf: ticks / dt});
   }
   requestAnimationFrame(tick);
 })"""
@@ -76,7 +77,9 @@ def _free_port() -> int:
         return int(s.getsockname()[1])
 
 
-def time_to_show(context: object, walk: Path, scene: Path) -> tuple[float, float, object, object]:
+def time_to_show(
+    context: object, walk: Path, scene: Path, query: str = ""
+) -> tuple[float, float, object, object]:
     """Seconds from starting ``footfall view`` until the port answers and until the page shows
     the whole scene; the page and the process (still serving)."""
     from footfall.viz.view.browser import wait_loaded
@@ -98,7 +101,7 @@ def time_to_show(context: object, walk: Path, scene: Path) -> tuple[float, float
                 raise RuntimeError("footfall view exited before serving") from None
             time.sleep(0.01)
     t_port = time.perf_counter() - t0
-    page.goto(f"http://127.0.0.1:{port}/")
+    page.goto(f"http://127.0.0.1:{port}/{query}")
     wait_loaded(page)
     return t_port, time.perf_counter() - t0, page, proc
 
@@ -108,6 +111,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("out/bench_view"))
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--play-seconds", type=float, default=5.0)
+    parser.add_argument("--antialias", choices=("auto", "0", "1"), default="auto")
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     walk, scene = make_data(args.out)
@@ -131,11 +135,13 @@ def main() -> None:
         proc.terminate()
         proc.wait()
         for _ in range(args.repeats):
-            t_port, t_show, page, proc = time_to_show(context, walk, scene)
+            query = "" if args.antialias == "auto" else f"?antialias={args.antialias}"
+            t_port, t_show, page, proc = time_to_show(context, walk, scene, query)
             ports.append(t_port)
             shows.append(t_show)
             page.get_by_text("play / pause").click()
             plays.append(page.evaluate(_PLAY_PROBE, args.play_seconds))
+            antialias = page.evaluate("() => window.footfall.antialias")
             page.close()
             proc.terminate()
             proc.wait()
@@ -148,7 +154,7 @@ def main() -> None:
     print(
         f"playback: {statistics.median(poses):.1f} robot poses/s drawn (min {min(poses):.1f}), "
         f"{statistics.median(renders):.1f} renders/s, animation frames "
-        f"{np.median([p['raf'] for p in plays]):.0f}/s"
+        f"{np.median([p['raf'] for p in plays]):.0f}/s (multisampling {'on' if antialias else 'off'})"
     )
 
 

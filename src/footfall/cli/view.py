@@ -41,7 +41,7 @@ def view_command(
         0.0, "--time", help="Show the recorded motion at this time [s] (the slider's start)."
     ),
 ) -> None:
-    """Serve an interactive 3-D page of a scene, plan, walk, quadruped walk or study (viser):
+    """Serve an interactive 3-D page of a scene, plan, walk, quadruped walk or study:
     terrain coloured by height, footsteps with index and side, the CoM path, the robot replayed
     with a time slider, measured CoP against planned ZMP, pushes. With --screenshot, render it
     headless into a PNG and exit."""

@@ -79,7 +79,6 @@ def browser_or_skip() -> None:
 
     try:
         import playwright.sync_api  # noqa: F401
-        import viser  # noqa: F401
 
         chromium_path()
     except (ImportError, InputError) as e:

@@ -1,14 +1,17 @@
 """The page in a real browser: Playwright drives headless Chromium (software WebGL) against a
-served walk. The counts come from the scene tree the page received (viser's client exposes it to
-tests as ``window.__viserSceneTree``), the robot's pose from the page's three.js objects."""
+served walk. Counts and poses come from the page's own state (``window.footfall``: the node names
+it drew, the vertices of a node, a body's pose as drawn), pictures from the browser's screen."""
 
 from __future__ import annotations
 
 import io
+import json
 import re
 import socket
 import subprocess
 import sys
+import urllib.error
+import urllib.request
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -34,19 +37,17 @@ FILLED_SHARE = 0.25
 MOVED = 0.3
 #: grey levels by which a pixel of the robot differs after it moved
 PIXEL_CHANGE = 30
-
-_NODE_POS = "n => { const o = window.__viserMutable.nodeRefFromName[n]; return o ? o.position.toArray() : null; }"
-
-
-_VERTICES = """n => { let count = 0;
-  window.__viserMutable.nodeRefFromName[n].traverse(o => {
-    if (o.isMesh) count += o.geometry.attributes.position.count; });
-  return count; }"""
+#: positions travel as float32 [m]
+F32 = 1e-5
 
 
 def _names(page: Any, prefix: str) -> list[str]:
-    tree = page.evaluate("() => Object.keys(window.__viserSceneTree.getState())")
-    return [n for n in tree if re.fullmatch(re.escape(prefix) + r"/\d+", n)]
+    names = page.evaluate("() => window.footfall.names")
+    return [n for n in names if re.fullmatch(re.escape(prefix) + r"/\d+", n)]
+
+
+def _body(page: Any, name: str) -> list[float]:
+    return page.evaluate("n => window.footfall.bodyPosition(n)", name)
 
 
 def _pixels(png: bytes) -> np.ndarray:
@@ -60,12 +61,21 @@ def browser() -> Iterator[Any]:
 
 
 @pytest.fixture(scope="module")
-def walk_page(walk_dir: Path, browser: Any) -> Iterator[tuple[ViewPage, Any]]:
-    served = ViewPage(load_view(walk_dir), port=0)
+def served(walk_dir: Path) -> Iterator[ViewPage]:
+    page = ViewPage(load_view(walk_dir), port=0)
     try:
-        yield served, open_page(browser, served.url)
+        yield page
     finally:
-        served.close()
+        page.close()
+
+
+@pytest.fixture
+def walk_page(served: ViewPage, browser: Any) -> Iterator[tuple[ViewPage, Any]]:
+    page = open_page(browser, served.url)
+    try:
+        yield served, page
+    finally:
+        page.close()
 
 
 def test_the_page_holds_every_region_and_footstep(walk_page: tuple[ViewPage, Any]) -> None:
@@ -78,33 +88,49 @@ def test_the_page_holds_every_region_and_footstep(walk_page: tuple[ViewPage, Any
     # in one mesh of a sole's 8 corners each
     landed = np.all(np.isfinite(data.walk.landed[: data.plan.n_steps]), axis=1).sum()
     assert landed == data.plan.n_steps
-    assert page.evaluate(_VERTICES, build.LANDED) == 8 * landed
+    assert page.evaluate("n => window.footfall.vertexCount(n)", build.LANDED) == 8 * landed
     text = page.inner_text("body")
     assert "walk of short" in text and "frame 1 /" in text
+    assert page.evaluate("() => window.footfall.frames") == len(served.t)
 
 
 def test_the_time_slider_moves_the_robot(walk_page: tuple[ViewPage, Any]) -> None:
     served, page = walk_page
+    motion = served.motion
+    assert motion is not None
+    pelvis = motion.bodies.index("pelvis")
     before_png = capture(page)
-    before = page.evaluate(_NODE_POS, "/robot/pelvis")
-    assert served.frame == 0 and before == pytest.approx(list(served.motion.pos[0, 0]), abs=1e-6)
+    before = _body(page, "pelvis")
+    assert before == pytest.approx(list(motion.pos[0, pelvis]), abs=F32)
     slider = page.get_by_role("slider")
     slider.focus()
     slider.press("End")  # the user drags the time to the end of the walk
     page.wait_for_function(
-        "([n, x]) => { const o = window.__viserMutable.nodeRefFromName[n];"
-        " return o && Math.abs(o.position.x - x) > 0.1; }",
-        arg=["/robot/pelvis", before[0]],
+        "([n, x]) => Math.abs(window.footfall.bodyPosition(n)[0] - x) > 0.1",
+        arg=["pelvis", before[0]],
     )
     last = len(served.t) - 1
-    assert served.frame == last  # the server posed the last frame ...
-    after = page.evaluate(_NODE_POS, "/robot/pelvis")
-    # ... and the page shows the pelvis where the replay has it
-    assert after == pytest.approx(list(served.motion.pos[last, 0]), abs=1e-5)
+    assert page.evaluate("() => window.footfall.frame") == last
+    # the page shows the pelvis where the replay has it at the last frame
+    after = _body(page, "pelvis")
+    assert after == pytest.approx(list(motion.pos[last, pelvis]), abs=F32)
     assert after[0] - before[0] > MOVED
     changed = np.abs(_pixels(capture(page)) - _pixels(before_png)) > PIXEL_CHANGE
     assert changed.mean() > 0.002  # the robot's picture moved too
     assert f"frame {last + 1} /" in page.inner_text("body")
+
+
+def test_between_frames_the_pose_is_interpolated(walk_page: tuple[ViewPage, Any]) -> None:
+    served, page = walk_page
+    motion = served.motion
+    assert motion is not None
+    pelvis = motion.bodies.index("pelvis")
+    f = len(served.t) // 2
+    t = 0.25 * served.t[f] + 0.75 * served.t[f + 1]
+    page.evaluate("t => window.footfall.setTime(t)", float(t))
+    expected = 0.25 * motion.pos[f, pelvis] + 0.75 * motion.pos[f + 1, pelvis]
+    assert _body(page, "pelvis") == pytest.approx(list(expected), abs=F32)
+    assert page.evaluate("() => window.footfall.frame") == f
 
 
 def test_the_picture_is_not_blank_and_the_scene_fills_it(walk_page: tuple[ViewPage, Any]) -> None:
@@ -115,23 +141,34 @@ def test_the_picture_is_not_blank_and_the_scene_fills_it(walk_page: tuple[ViewPa
     assert (np.abs(px - background) > 8).mean() > FILLED_SHARE
 
 
-def test_play_advances_frames(walk_page: tuple[ViewPage, Any]) -> None:
-    served, page = walk_page
-    served.set_frame(0)
+def test_dragging_turns_the_view(walk_page: tuple[ViewPage, Any]) -> None:
+    _, page = walk_page
+    before = _pixels(capture(page))
+    page.mouse.move(400, 400)
+    page.mouse.down()
+    page.mouse.move(520, 380, steps=5)
+    page.mouse.up()
+    after = _pixels(capture(page))
+    assert (np.abs(after - before) > PIXEL_CHANGE).mean() > 0.02
+
+
+def test_play_advances_frames_and_pause_stops(walk_page: tuple[ViewPage, Any]) -> None:
+    _, page = walk_page
     page.get_by_text("play / pause").click()
-    page.wait_for_function("() => /frame ([2-9]|\\d\\d+) \\//.test(document.body.innerText)")
+    page.wait_for_function("() => window.footfall.frame >= 2")
     page.get_by_text("play / pause").click()
-    assert served.frame > 0
+    state = page.evaluate("() => [window.footfall.playing, window.footfall.frame]")
+    assert state[0] is False and state[1] >= 2
+    assert re.search(r"frame (\d+) /", page.inner_text("body"))
 
 
 def test_a_quadruped_page_shows_its_support_polygon(quadruped_dir: Path, browser: Any) -> None:
     served = ViewPage(load_view(quadruped_dir), port=0)
     try:
         page = open_page(browser, served.url)
-        tree = page.evaluate("() => Object.keys(window.__viserSceneTree.getState())")
-        assert {"/quadruped/support", "/quadruped/cop", "/quadruped/zmp", "/robot/trunk"} <= set(
-            tree
-        )
+        names = set(page.evaluate("() => window.footfall.names"))
+        assert {"/quadruped/support", "/quadruped/cop", "/quadruped/zmp"} <= names
+        assert page.evaluate("() => window.footfall.bodyPosition('trunk')") is not None
         page.close()
     finally:
         served.close()
@@ -144,16 +181,29 @@ def test_a_study_page_shows_the_picked_trial(study_dir: Path, browser: Any) -> N
         first, second = served.data.trials
         assert first.plan is not None
         assert len(_names(page, build.FOOTSTEPS)) == first.plan.n_steps + 1
-        served.show_trial(second.key)  # what the trial picker does; this trial has no plan
-        page.wait_for_function(  # the soles are gone (their parent groups may stay, empty)
-            "() => !Object.keys(window.__viserSceneTree.getState())"
-            ".some(n => /^\\/plan\\/footsteps\\/\\d+$/.test(n))"
-        )
+        page.select_option("#trial", label=second.key)  # the user picks the second trial
+        page.wait_for_function("() => /no plan in the cache/.test(document.body.innerText)")
+        assert _names(page, build.FOOTSTEPS) == []  # this trial has no plan
         assert len(_names(page, build.REGIONS)) == 1  # the scene stays
-        assert "no plan in the cache" in page.inner_text("body")
         page.close()
     finally:
         served.close()
+
+
+def _get(url: str) -> tuple[int, Any]:
+    try:
+        with urllib.request.urlopen(url, timeout=10) as r:
+            return r.status, r.read()
+    except urllib.error.HTTPError as e:
+        return e.code, e.read()
+
+
+def test_the_server_answers_its_routes_only(served: ViewPage) -> None:
+    status, body = _get(served.url + "data.json")
+    assert status == 200 and json.loads(body)["title"] == served.data.title
+    for path in ("etc/passwd", "../pyproject.toml", "static/viewer.js", "trial/0.json"):
+        status, body = _get(served.url + path)
+        assert status == 404 and "error" in json.loads(body), path  # a walk has no trials
 
 
 def _cli(

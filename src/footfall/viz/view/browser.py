@@ -15,8 +15,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from footfall.errors import InputError
-from footfall.viz.view.serve import READY_NODE
+from footfall.errors import FootfallError, InputError
 
 #: a browser the environment names, then the usual names of a system Chromium
 BROWSER_ENV = "FOOTFALL_CHROMIUM"
@@ -38,8 +37,6 @@ CHROMIUM_ARGS = (
 )
 #: how long the page may take to receive the scene [ms]
 LOAD_TIMEOUT_MS = 60_000
-#: hides the "software WebGL" notice in pictures
-_HIDE_NOTICES = ".mantine-Notifications-root { display: none !important; }"
 
 
 def chromium_path() -> str:
@@ -82,14 +79,16 @@ def chromium() -> Iterator[Any]:
 
 
 def wait_loaded(page: Any, timeout_ms: int = LOAD_TIMEOUT_MS) -> None:
-    """Wait until the page holds the whole scene (it received the node the server adds last)
-    and has drawn it (two animation frames later)."""
+    """Wait until the page holds the whole scene and has drawn it (``window.footfall.ready``),
+    then two animation frames more; a page that failed raises its message."""
     page.wait_for_function(
-        "name => !!(window.__viserSceneTree && window.__viserSceneTree.getState()[name])",
-        arg=READY_NODE,
+        "() => !!(window.footfall && (window.footfall.ready || window.footfall.error))",
         timeout=timeout_ms,
-        polling=50,
+        polling=20,
     )
+    error = page.evaluate("() => window.footfall.error")
+    if error:
+        raise FootfallError(f"the page could not draw: {error}")
     page.evaluate(
         "() => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(() => r(0))))"
     )
@@ -107,7 +106,6 @@ def open_page(context: Any, url: str, size: tuple[int, int] = (1280, 720)) -> An
 def capture(page: Any) -> bytes:
     """The page as PNG bytes (through the DevTools protocol: Playwright's own screenshot waits
     for web fonts the page cannot fetch offline)."""
-    page.add_style_tag(content=_HIDE_NOTICES)
     page.evaluate(
         "() => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(() => r(0))))"
     )

@@ -1,9 +1,9 @@
 """The page's scene as data: pure functions from what was loaded to meshes, lines, points and
 labels with names, colours and poses, and the camera that frames them.
 
-Nothing here talks to a browser: :mod:`footfall.viz.view.page` hands these nodes to viser. Node
-names are paths (``/scene/regions/007``, ``/plan/footsteps/003``): the page's scene tree, which
-the tests read back from the browser, counts regions and footsteps by them.
+Nothing here talks to a browser: :mod:`footfall.viz.view.payload` packs these nodes for the page.
+Node names are paths (``/scene/regions/007``, ``/plan/footsteps/003``): the page lists them in
+its state, where the tests count regions and footsteps by them.
 """
 
 from __future__ import annotations
@@ -199,6 +199,49 @@ def robot_meshes(motion: RobotMotion, world: bool) -> list[tuple[int, Mesh]]:
         parent = f"/robot/{motion.bodies[body]}" if body >= 0 else "/world_geoms"
         out.append((body, merge(f"{parent}/m{k}", meshes)))
     return out
+
+
+def tube(lines: Lines, radius: float) -> Mesh:
+    """``lines`` as thin square tubes of half-width ``radius`` [m] (a line a browser draws as
+    thick as asked, at any zoom): 8 corners and 8 triangles per segment."""
+    seg = np.asarray(lines.segments, dtype=float).reshape(-1, 2, 3)
+    d = seg[:, 1] - seg[:, 0]
+    length = np.linalg.norm(d, axis=1, keepdims=True)
+    d = np.where(length > 1e-12, d / np.maximum(length, 1e-12), np.array([1.0, 0.0, 0.0]))
+    # a side vector: across the segment, horizontal unless the segment is vertical
+    helper = np.where(np.abs(d[:, 2:3]) > 0.9, np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0]))
+    a = np.cross(d, helper)
+    a /= np.linalg.norm(a, axis=1, keepdims=True)
+    b = np.cross(d, a)
+    ring = np.stack([a + b, a - b, -a - b, -a + b], axis=1) * radius  # (S, 4, 3)
+    verts = np.concatenate([seg[:, :1] + ring, seg[:, 1:] + ring], axis=1)  # (S, 8, 3)
+    side = []
+    for i in range(4):
+        j = (i + 1) % 4
+        side += [(i, j, 4 + i), (j, 4 + j, 4 + i)]
+    faces = (
+        np.array(side, dtype=np.int32)[None]
+        + 8 * np.arange(seg.shape[0], dtype=np.int32)[:, None, None]
+    )
+    return Mesh(lines.name, verts.reshape(-1, 3), faces.reshape(-1, 3), lines.rgb)
+
+
+def sphere(name: str, radius: float, rgb: tuple[int, int, int], rings: int = 6) -> Mesh:
+    """A sphere of ``radius`` [m] about the origin: ``rings`` latitude bands of ``2 rings``
+    longitude steps."""
+    lat = np.linspace(0.0, math.pi, rings + 1)
+    lon = np.linspace(0.0, 2 * math.pi, 2 * rings, endpoint=False)
+    la, lo = np.meshgrid(lat, lon, indexing="ij")
+    verts = radius * np.stack(
+        [np.sin(la) * np.cos(lo), np.sin(la) * np.sin(lo), np.cos(la)], axis=-1
+    ).reshape(-1, 3)
+    n = 2 * rings
+    faces = []
+    for i in range(rings):
+        for j in range(n):
+            a, b = i * n + j, i * n + (j + 1) % n
+            faces += [(a, a + n, b), (b, a + n, b + n)]
+    return Mesh(name, verts, np.array(faces, dtype=np.int32), rgb)
 
 
 def start_goal(scene: Scene) -> list[Label]:
