@@ -229,7 +229,7 @@ def raw_model(rf: ModelSource) -> RawModel:
     return RawModel(model, data, base, tuple(dropped), tuple(repaired))
 
 
-def _body_chain(m: Any, body: int, base: int) -> list[int]:
+def body_chain(m: Any, body: int, base: int) -> list[int]:
     """Bodies from ``base`` (excluded) down to ``body`` (included)."""
     chain = []
     while body != base:
@@ -240,7 +240,8 @@ def _body_chain(m: Any, body: int, base: int) -> list[int]:
     return chain[::-1]
 
 
-def _hinges(m: Any, bodies: list[int]) -> list[int]:
+def hinges(m: Any, bodies: list[int]) -> list[int]:
+    """The hinge joints of ``bodies``, in their order (a body's joints in the model's order)."""
     mujoco = require_mujoco()
     out = []
     for b in bodies:
@@ -252,7 +253,7 @@ def _hinges(m: Any, bodies: list[int]) -> list[int]:
 
 def _lowest_z(raw: RawModel, body: int) -> float:
     """Lowest point of ``body``'s collision geometry (its origin without any) [m]."""
-    pts = _geom_points(raw, body)
+    pts = geom_points(raw, body)
     return float(pts[:, 2].min()) if pts.size else float(raw.data.xpos[body][2])
 
 
@@ -273,14 +274,14 @@ def find_legs(raw: RawModel) -> LegJoints:
         if not cand:
             raise InputError("legs", None, f"a {side.value} leg (no body on that side)")
         low = min(cand, key=lambda b: _lowest_z(raw, b))
-        chain = _body_chain(m, low, base)
+        chain = body_chain(m, low, base)
         # the foot: the lowest body with a hinge joint on the way up
-        while chain and not _hinges(m, [chain[-1]]):
+        while chain and not hinges(m, [chain[-1]]):
             chain.pop()
         feet[side] = chain[-1] if chain else low
     out: dict[Side, tuple[str, ...]] = {}
     for side, foot in feet.items():
-        joints = _hinges(m, _body_chain(m, foot, base))
+        joints = hinges(m, body_chain(m, foot, base))
         names = [str(m.joint(j).name) for j in joints]
         if len(joints) != len(LEG_JOINT_ROLES):
             raise InputError(
@@ -326,7 +327,7 @@ def _roles(m: Any, d: Any, joints: list[int], side: Side) -> tuple[str, ...]:
 
 
 # ------------------------------------------------------------------------------- geometry -> sole
-def _geom_points(raw: RawModel, body: int, frame: int | None = None) -> FloatArray:
+def geom_points(raw: RawModel, body: int, frame: int | None = None) -> FloatArray:
     """Points (n, 3) of the collision geometry (the visual geometry without any) of ``body`` and
     of the bodies fixed to it, in the world (or in body ``frame``'s frame) [m]: mesh vertices,
     box corners, points around spheres, capsules and cylinders."""
@@ -424,7 +425,7 @@ def sole_from_geometry(raw: RawModel, foot: str, radius: float = 0.005) -> Sole:
     """
     mujoco = require_mujoco()
     b = int(mujoco.mj_name2id(raw.model, mujoco.mjtObj.mjOBJ_BODY, foot))
-    pts = _geom_points(raw, b, frame=b)
+    pts = geom_points(raw, b, frame=b)
     if pts.shape[0] == 0:
         raise InputError(
             "sole", foot, "a foot with geometry, or the sole: rectangle in the robot file"
@@ -443,10 +444,10 @@ def body_box(raw: RawModel, body: str, subtree: bool = False) -> tuple[FloatArra
     m = raw.model
     b = int(mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, body))
     if subtree:
-        parts = [_geom_points(raw, c, frame=b) for c in range(1, m.nbody) if _is_below(m, c, b)]
+        parts = [geom_points(raw, c, frame=b) for c in range(1, m.nbody) if _is_below(m, c, b)]
         pts = np.vstack([p for p in parts if p.size] or [np.zeros((0, 3))])
     else:
-        pts = _geom_points(raw, b, frame=b)
+        pts = geom_points(raw, b, frame=b)
     if pts.shape[0]:
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         return (lo + hi) / 2.0, np.maximum((hi - lo) / 2.0, 0.01)

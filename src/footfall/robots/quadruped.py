@@ -51,7 +51,7 @@ from pydantic import Field
 from footfall._typing import FloatArray
 from footfall.errors import InputError
 from footfall.quadruped.robot import LEGS, Leg, LegGeometry, QuadrupedRobot
-from footfall.robots.build import RawModel, _body_chain, _geom_points, _hinges, raw_model
+from footfall.robots.build import RawModel, body_chain, geom_points, hinges, raw_model
 from footfall.robots.file import MODEL_FORMATS, PackageFileSpec, resolve_model
 from footfall.terrain.scene import StrictSpec, read_yaml, validate_yaml
 
@@ -199,7 +199,7 @@ def find_quadruped_legs(raw: RawModel) -> tuple[tuple[str, str, str], ...]:
     lowest: dict[Leg, tuple[float, int]] = {}
     for b in below:
         rel = d.xpos[b] - d.xpos[base]
-        pts = _geom_points(raw, b)
+        pts = geom_points(raw, b)
         z = float(pts[:, 2].min()) if pts.size else float(d.xpos[b][2])
         leg = _quadrant(float(rel[0]), float(rel[1]))
         if leg not in lowest or z < lowest[leg][0] - 1e-9:
@@ -208,8 +208,8 @@ def find_quadruped_legs(raw: RawModel) -> tuple[tuple[str, str, str], ...]:
     for leg in LEGS:
         if leg not in lowest:
             raise InputError("legs", None, f"a leg in the {leg.value} quadrant (no body there)")
-        chain = _body_chain(m, lowest[leg][1], base)
-        joints = [str(m.joint(j).name) for j in _hinges(m, chain)]
+        chain = body_chain(m, lowest[leg][1], base)
+        joints = [str(m.joint(j).name) for j in hinges(m, chain)]
         if len(joints) != 3:
             raise InputError(
                 f"legs.{leg.value}",
@@ -370,7 +370,7 @@ def derive_quadruped(qf: QuadrupedFile) -> QuadrupedDerivation:
         else:
             low = min(below_knee, key=lambda b: float(d.xpos[b][2]))
             foot = d.xpos[low].copy()
-            pts = np.concatenate([_geom_points(raw, b) for b in below_knee])
+            pts = np.concatenate([geom_points(raw, b) for b in below_knee])
             radius = float(foot[2] - pts[:, 2].min()) if pts.size else float("nan")
         radii.append(radius)
         raw_legs.append((leg, names, ids, seg, foot))
@@ -494,7 +494,7 @@ def _knees_word(bends: set[tuple[bool, str]]) -> str:
 
 def _trunk_box(raw: RawModel, base: int) -> tuple[FloatArray, FloatArray]:
     """Bounding box of the base's own collision geometry (a 10 cm cube without any) [m]."""
-    pts = _geom_points(raw, base)
+    pts = geom_points(raw, base)
     origin = raw.data.xpos[base]
     if pts.size == 0:
         return origin - 0.05, origin + 0.05
