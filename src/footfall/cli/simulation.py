@@ -34,9 +34,7 @@ from footfall.cli._progress import ProgressLog
 from footfall.errors import InputError
 
 if TYPE_CHECKING:
-    from footfall.planning.plan import FootstepPlan
-    from footfall.results.walk import WalkResult
-    from footfall.sim.disturbance import Disturbance, Push
+    pass
 
 _REGION_HELP = (
     "How the MPC keeps the next footstep on the terrain: off (document 000: free; "
@@ -486,33 +484,6 @@ def compare_command(
 
 
 # --- walk ---
-def _walk_report(
-    scene_name: str,
-    planner: str,
-    robot: str,
-    plan: FootstepPlan,
-    disturbance: Disturbance,
-    pushes: tuple[Push, ...],
-    result: WalkResult,
-) -> dict[str, Any]:
-    """What ``footfall walk`` writes to ``walk.json``: the plan in brief, the disturbance and
-    the pushes it made, and the walk's :meth:`~footfall.results.walk.WalkResult.to_dict`."""
-    return {
-        "scene": scene_name,
-        "planner": planner,
-        "robot": robot,
-        "plan": {
-            "status": plan.status.value,
-            "n_steps": plan.n_steps,
-            "solve_time_s": plan.solve_time,
-            "message": plan.message,
-        },
-        "disturbance": disturbance.to_dict(),
-        "push": [p.to_dict() for p in pushes],
-        **result.to_dict(),
-    }
-
-
 @app.command("walk")
 def walk_cmd(
     scene_file: Path | None = typer.Argument(None, help="Scene YAML file (or use --scene)."),
@@ -571,6 +542,7 @@ def walk_cmd(
         os.environ.setdefault("MUJOCO_GL", "egl")
     from footfall.control.adjusters import REGION_MODES
     from footfall.planning.plan import check_planner_name
+    from footfall.results.walk import walk_report
     from footfall.sim.biped.options import WalkOptions
     from footfall.sim.biped.plans import plan_for_walk, robot_model
     from footfall.sim.biped.trial import MujocoBipedPlant
@@ -627,7 +599,7 @@ def walk_cmd(
     # what `footfall view` replays: joint positions at 30 Hz, the model, the scene, the CoP
     replay.write(out / REPLAY_FILE, biped_traces(res.trace, replay.times), scene_to_yaml(sc))
     # walk.json's "controller" (from the result) names the controller and holds its tally
-    report = _walk_report(sc.name, planner, robot, plan, disturbance, pushes, res)
+    report = walk_report(sc.name, planner, robot, plan, disturbance, pushes, res)
     write_json(out / "walk.json", report)
     plot_walk(res, sc, out / "walk.png", params=model, title=f"{sc.name}, {planner}, {robot}")
     m = res.metrics

@@ -349,3 +349,32 @@ class WalkResult:
             "video": str(self.video) if self.video else None,
             "video_note": self.video_note,
         }
+
+
+def walk_report(
+    scene_name: str,
+    planner: str,
+    robot: str,
+    plan: Any,
+    disturbance: Any,
+    pushes: tuple[Any, ...],
+    result: WalkResult,
+) -> dict[str, Any]:
+    """What a walk's folder holds as ``walk.json`` (``footfall walk``; ``footfall view`` reads
+    it): the plan in brief (a :class:`~footfall.planning.plan.FootstepPlan`), the
+    :class:`~footfall.sim.disturbance.Disturbance` and the pushes it made, and the walk's
+    :meth:`WalkResult.to_dict`."""
+    return {
+        "scene": scene_name,
+        "planner": planner,
+        "robot": robot,
+        "plan": {
+            "status": plan.status.value,
+            "n_steps": plan.n_steps,
+            "solve_time_s": plan.solve_time,
+            "message": plan.message,
+        },
+        "disturbance": disturbance.to_dict(),
+        "push": [p.to_dict() for p in pushes],
+        **result.to_dict(),
+    }

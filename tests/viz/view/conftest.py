@@ -3,6 +3,7 @@ biped and one gait cycle of the quadruped (both through the command line, as a u
 
 from __future__ import annotations
 
+import json
 import math
 import os
 from dataclasses import replace
@@ -85,3 +86,45 @@ def browser_or_skip() -> None:
         if REQUIRE_BROWSER:
             raise
         pytest.skip(f"no browser for the page tests ({e}); CI installs one")
+
+
+@pytest.fixture(scope="session")
+def mujoco_study_dir(walk_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A MuJoCo study folder as ``footfall study`` leaves it, of one trial walked by the study's
+    own runner: the 4-step plan of ``walk_dir`` on ``flat`` with seed 3's 2 N s push (servo
+    controller), its ``study.json``, its row in trials.parquet and its plan in the cache."""
+    pytest.importorskip("pyarrow")
+    from footfall.experiments.study.design import StudyDesign
+    from footfall.experiments.study.store import write_rows
+    from footfall.experiments.study.trials import Trial, run_trial, trial_key
+    from footfall.planning import load_plan
+    from footfall.planning.cache import PlanCache
+    from footfall.sim.disturbance import Disturbance
+
+    folder = tmp_path_factory.mktemp("mujoco_study")
+    design = StudyDesign(
+        name="again", simulator="mujoco", controller="servo", scenes=("flat",),
+        planners=("kinematic",), steps=("smallest",), seeds=1, push_levels=(), level_seeds=0,
+        default_push=2.0,
+    )  # fmt: skip
+    plan = load_plan(walk_dir / "plan.json")
+    trial = Trial(
+        key=trial_key("flat", "kinematic", plan.n_steps, 2.0, 3),
+        scene=builtin_scene("flat"),
+        planner="kinematic",
+        plan=plan,
+        smallest_n=True,
+        equal_n=False,
+        disturbance=Disturbance.of_seed(
+            3, impulse=2.0, duration=design.push_duration, initial_impulse=design.initial_impulse
+        ),
+        design=design,
+    )
+    row = run_trial(trial)
+    assert row["error"] is None, row["error"]
+    (folder / "study.json").write_text(
+        json.dumps({"fingerprint": design.fingerprint(), "design": design.to_dict()})
+    )
+    write_rows(folder / "trials.parquet", [row])
+    PlanCache(folder / "plans").save("b" * 64, plan, "flat")
+    return folder

@@ -190,6 +190,24 @@ def test_a_study_page_shows_the_picked_trial(study_dir: Path, browser: Any) -> N
         served.close()
 
 
+def test_a_study_trial_walks_again_in_the_page(mujoco_study_dir: Path, browser: Any) -> None:
+    served = ViewPage(load_view(mujoco_study_dir), port=0)
+    try:
+        page = open_page(browser, served.url)
+        assert page.evaluate("() => window.footfall.frames") == 0  # a study row has no motion
+        page.get_by_text("walk this trial again").click()  # the server walks it (seconds)
+        page.wait_for_function("() => window.footfall.frames > 10", timeout=300_000)
+        assert "walked again" in page.inner_text("body")
+        assert page.evaluate("() => window.footfall.bodyPosition('pelvis')") is not None
+        page.get_by_role("slider").press("End")
+        assert page.evaluate("() => window.footfall.frame") == page.evaluate(
+            "() => window.footfall.frames - 1"
+        )
+        page.close()
+    finally:
+        served.close()
+
+
 def _get(url: str) -> tuple[int, Any]:
     try:
         with urllib.request.urlopen(url, timeout=10) as r:

@@ -15,7 +15,7 @@ pytest.importorskip("trimesh")
 
 from footfall.errors import InputError
 from footfall.viz.view import build, load_view
-from footfall.viz.view.payload import page_payload, trial_payload
+from footfall.viz.view.payload import page_payload, trial_payload, trial_walk_payload
 
 #: positions travel as float32 [m]
 F32 = 1e-6
@@ -133,3 +133,34 @@ def test_a_start_time_must_be_a_time(walk_dir: Path) -> None:
     for bad in (-1.0, float("nan"), float("inf")):
         with pytest.raises(InputError, match="time"):
             page_payload(data, start=bad)
+
+
+def test_a_trial_walked_again_is_the_walk_its_row_records(mujoco_study_dir: Path) -> None:
+    from footfall.experiments.study.store import read_rows
+    from footfall.viz.view.rewalk import rewalk_trial
+
+    data = load_view(mujoco_study_dir)
+    (trial,) = data.trials
+    row = read_rows(mujoco_study_dir / "trials.parquet")[0]
+    scene = next(s for s in data.scenes if s.name == trial.scene)
+    walked, outcome = rewalk_trial(mujoco_study_dir, trial, scene)
+    # the simulator is deterministic: the same walk, number for number
+    for name in ("success", "fell", "goal_error", "zmp_offset_mean", "steps_landed"):
+        assert getattr(outcome, name) == row[name], name
+    assert walked.walk is not None and walked.walk.motion is not None
+    assert len(walked.walk.motion.t) > 10 and walked.walk.pushes
+    # and the page document of it carries the robot
+    doc = _json_roundtrip(trial_walk_payload(data, 0))
+    assert doc["robot"] is not None and "walked again" in doc["summaries"][0]
+
+
+def test_a_reduced_study_has_no_walk_to_show_again(study_dir: Path, tmp_path: Path) -> None:
+    from footfall.experiments.study.design import StudyDesign
+
+    design = StudyDesign(name="r", simulator="reduced", controller=None, scenes=("flat",))
+    (study_dir / "study.json").write_text(
+        json.dumps({"fingerprint": design.fingerprint(), "design": design.to_dict()})
+    )
+    data = load_view(study_dir)
+    with pytest.raises(InputError, match="MuJoCo study"):
+        trial_walk_payload(data, 0)

@@ -97,7 +97,9 @@ class QuadrupedTrack:
 
 @dataclass(frozen=True)
 class StudyTrial:
-    """One row of a study's table, with the plan it walked when the folder's cache has it."""
+    """One row of a study's table, with the plan it walked when the folder's cache has it, and
+    what walking it again needs: its ``seed`` (None: the row has none) and push ``impulse``
+    [N s]."""
 
     key: str
     scene: str
@@ -106,6 +108,8 @@ class StudyTrial:
     push: PushMark | None
     outcome: str
     plan: FootstepPlan | None
+    seed: int | None = None
+    impulse: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -120,6 +124,7 @@ class ViewData:
         walk, quadruped: the measurements of a walk.
         trials: a study's trials; scenes: the study's scenes by name.
         notes: what could not be shown and why.
+        folder: the study's folder (a study's trials are walked again from it).
     """
 
     kind: str
@@ -131,6 +136,7 @@ class ViewData:
     trials: tuple[StudyTrial, ...] = ()
     scenes: tuple[Scene, ...] = ()
     notes: tuple[str, ...] = ()
+    folder: Path | None = None
 
 
 def load_view(path: Path, scene: str | Path | None = None) -> ViewData:
@@ -423,8 +429,19 @@ def _load_study(folder: Path, given: Scene | None) -> ViewData:
             f"goal error {row.get('goal_error')}"
         )
         plan = plans.get((name, str(row.get("planner")), n))
+        seed = row.get("seed")
         trials.append(
-            StudyTrial(str(row.get("key")), name, str(row.get("planner")), n, push, outcome, plan)
+            StudyTrial(
+                str(row.get("key")),
+                name,
+                str(row.get("planner")),
+                n,
+                push,
+                outcome,
+                plan,
+                int(seed) if isinstance(seed, int) else None,
+                float(row.get("push_impulse") or 0.0),
+            )
         )
     if not trials:
         notes.append("the study has no finished trials yet")
@@ -437,6 +454,7 @@ def _load_study(folder: Path, given: Scene | None) -> ViewData:
         trials=tuple(trials),
         scenes=tuple(scenes.values()),
         notes=tuple(dict.fromkeys(notes)),
+        folder=folder,
     )
 
 

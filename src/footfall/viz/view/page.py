@@ -57,7 +57,11 @@ class ViewPage:
             raise InputError("show", data.title, "one call per page")
         self.payload = payload.page_payload(data, start)
         self.data = data
-        self.server.publish(self.payload, lambda i: payload.trial_payload(data, i))
+        self.server.publish(
+            self.payload,
+            lambda i: payload.trial_payload(data, i),
+            lambda i: payload.trial_walk_payload(data, i),
+        )
 
     def close(self) -> None:
         """Stop serving."""

@@ -17,7 +17,8 @@ Arrays travel as base64 of little-endian ``float32`` (positions), ``float64`` (t
   ``positions`` (F*3), NaN where it is not shown, and its ``mesh``), ``support`` (or null: the
   quadruped's support polygon per frame as ``per`` line vertices a frame).
 - ``trials``: a study's trial keys; ``outcome``: the first one's (shown). ``trial/<i>.json``
-  holds trial ``i``'s ``meshes``, ``labels`` and ``outcome``.
+  holds trial ``i``'s ``meshes``, ``labels`` and ``outcome``; ``trial/<i>/walk.json`` the page
+  document of that trial walked again (a MuJoCo study's: its robot's replay).
 """
 
 from __future__ import annotations
@@ -274,6 +275,20 @@ def trial_payload(data: ViewData, index: int) -> dict[str, Any]:
     d = _Drawing()
     outcome = _trial(d, data, data.trials[index])
     return {"meshes": d.meshes, "labels": d.labels, "outcome": outcome}
+
+
+def trial_walk_payload(data: ViewData, index: int) -> dict[str, Any]:
+    """A study trial walked again with its replay recorded (``trial/<index>/walk.json``): the
+    page document of that walk (:func:`page_payload`)."""
+    from footfall.viz.view.rewalk import rewalk_trial
+
+    if not 0 <= index < len(data.trials):
+        raise InputError("trial", index, f"a trial index in 0..{len(data.trials) - 1}")
+    if data.folder is None:
+        raise InputError("trial", index, "a study read from its folder")
+    trial = data.trials[index]
+    scene = next((s for s in data.scenes if s.name == trial.scene), None)
+    return page_payload(rewalk_trial(data.folder, trial, scene)[0])
 
 
 def _com_at(plan: Any, t: float) -> FloatArray:

@@ -3,7 +3,8 @@ is imported, so a browser loads the page (two small static files) while the file
 
 Routes: ``/`` the page, ``/viewer.js`` its script, ``/data.json`` what it draws (503 until
 :meth:`PageServer.publish` gives it; the page asks again), ``/trial/<i>.json`` a study trial's
-drawing (made when first asked). Everything else is 404. It serves files of this package only:
+drawing and ``/trial/<i>/walk.json`` its walk, walked again (each made when first asked).
+Everything else is 404. It serves files of this package only:
 nothing a request names is read from disk.
 
 This module imports nothing of numpy, footfall's models, planning or terrain.
@@ -29,7 +30,7 @@ _STATIC = {
     "/index.html": ("index.html", "text/html; charset=utf-8"),
     "/viewer.js": ("viewer.js", "text/javascript; charset=utf-8"),
 }
-_TRIAL = re.compile(r"/trial/(\d{1,9})\.json")
+_TRIAL = re.compile(r"/trial/(\d{1,9})(\.json|/walk\.json)")
 
 
 class _Server(ThreadingHTTPServer):
@@ -54,8 +55,8 @@ class PageServer:
 
     def __init__(self, host: str, port: int) -> None:
         self._data: bytes | None = None
-        self._trial: Callable[[int], Any] | None = None
-        self._trials: dict[int, bytes] = {}
+        self._routes: dict[str, Callable[[int], Any]] = {}
+        self._made: dict[tuple[str, int], bytes] = {}
         self._lock = threading.Lock()
         self.files = {route: (_static(name), kind) for route, (name, kind) in _STATIC.items()}
         server = self
@@ -86,11 +87,19 @@ class PageServer:
         """The port it listens on."""
         return int(self.httpd.server_address[1])
 
-    def publish(self, data: dict[str, Any], trial: Callable[[int], Any] | None = None) -> None:
-        """Serve ``data`` as ``data.json`` (encoded once) and ``trial(i)`` as ``trial/<i>.json``."""
+    def publish(
+        self,
+        data: dict[str, Any],
+        trial: Callable[[int], Any] | None = None,
+        trial_walk: Callable[[int], Any] | None = None,
+    ) -> None:
+        """Serve ``data`` as ``data.json`` (encoded once), ``trial(i)`` as ``trial/<i>.json``
+        and ``trial_walk(i)`` as ``trial/<i>/walk.json``."""
         body = _json(data)
+        routes = {".json": trial, "/walk.json": trial_walk}
         with self._lock:
-            self._trial, self._trials = trial, {}
+            self._routes = {k: v for k, v in routes.items() if v is not None}
+            self._made = {}
             self._data = body
 
     def respond(self, path: str) -> tuple[int, bytes, str]:
@@ -106,19 +115,20 @@ class PageServer:
                 (200, data, kind) if data is not None else (503, _json({"error": "loading"}), kind)
             )
         m = _TRIAL.fullmatch(path)
-        if m is not None and self._trial is not None:
-            i = int(m.group(1))
+        make = self._routes.get(m.group(2)) if m is not None else None
+        if m is not None and make is not None:
+            key = (m.group(2), int(m.group(1)))
             with self._lock:
-                cached = self._trials.get(i)
+                cached = self._made.get(key)
             if cached is None:
                 try:
-                    cached = _json(self._trial(i))
+                    cached = _json(make(key[1]))
                 except FootfallError as e:
                     return 404, _json({"error": str(e)}), kind
                 except Exception as e:  # the page shows it; the server goes on
                     return 500, _json({"error": f"{type(e).__name__}: {e}"}), kind
                 with self._lock:
-                    self._trials[i] = cached
+                    self._made[key] = cached
             return 200, cached, kind
         return 404, _json({"error": f"no such page: {path}"}), kind
 

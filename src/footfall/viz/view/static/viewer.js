@@ -426,6 +426,7 @@ void main() {
   $("play").addEventListener("click", togglePlay);
   $("time").addEventListener("input", (e) => setTime(parseFloat(e.target.value), true));
   $("trial").addEventListener("change", (e) => showTrial(parseInt(e.target.value, 10)));
+  $("rewalk").addEventListener("click", walkTrial);
 
   async function getJSON(url) {
     for (;;) {
@@ -440,16 +441,62 @@ void main() {
     addItems(d.meshes, group);
     addLabels(d.labels, group);
   }
+  let trialShown = 0;
   async function showTrial(i) {
     $("outcome").textContent = "loading…";
     try {
       const d = await getJSON(`trial/${i}.json`);
       clearGroup("scene");
+      setRobot(null);
       drawScene(d, "scene");
+      trialShown = i;
       $("outcome").textContent = d.outcome;
+      $("rewalk").disabled = false;
       listNames();
       requestDraw();
     } catch (err) { fail(String(err.message || err)); }
+  }
+  async function walkTrial() { // the server walks the trial again and records its replay
+    const i = trialShown;
+    $("rewalk").disabled = true;
+    $("outcome").textContent = "walking the trial again…";
+    try {
+      const d = await getJSON(`trial/${i}/walk.json`);
+      if (i !== trialShown) return; // another trial was picked meanwhile
+      clearGroup("scene");
+      drawScene(d, "scene");
+      setRobot(d.robot, 0);
+      $("outcome").textContent = d.summaries.join("; ");
+      listNames();
+      requestDraw();
+    } catch (err) {
+      $("outcome").textContent = String(err.message || err);
+    }
+  }
+  function setRobot(r, start) { // the recorded motion shown (null: none)
+    state.playing = false;
+    clearGroup("robot");
+    if (support) gl.deleteVertexArray(support.vao);
+    robot = null; markers = []; support = null; state.frames = 0;
+    $("timebox").hidden = true;
+    $("status").textContent = "no recorded motion";
+    if (!r) return;
+    robot = { bodies: r.bodies, t: array(r.t, Float64Array), pos: array(r.pos, Float32Array),
+      wxyz: array(r.wxyz, Float32Array), mats: r.bodies.map(() => new Float32Array(16)) };
+    addItems(r.meshes, "robot");
+    markers = r.markers.map((m) => ({ name: m.name, pos: array(m.positions, Float32Array) }));
+    addItems(r.markers.map((m, k) => ({ ...m.mesh, name: m.name, marker: k })), "robot");
+    if (r.support) {
+      const { vao } = upload(array(r.support.positions, Float32Array), null);
+      support = { name: r.support.name, vao, per: r.support.per, color: colour(r.support.rgb, 1) };
+    }
+    const F = robot.t.length;
+    state.frames = F;
+    if (F > 1) {
+      $("timebox").hidden = false;
+      $("time").max = robot.t[F - 1].toFixed(3);
+    }
+    setTime(start || 0);
   }
 
   async function main() {
@@ -458,27 +505,7 @@ void main() {
     home = d.camera;
     camera = cameraFrom(home);
     drawScene(d, "scene");
-    if (d.robot) {
-      const r = d.robot;
-      robot = { bodies: r.bodies, t: array(r.t, Float64Array), pos: array(r.pos, Float32Array),
-        wxyz: array(r.wxyz, Float32Array), mats: r.bodies.map(() => new Float32Array(16)) };
-      addItems(r.meshes, "robot");
-      markers = r.markers.map((m) => ({ name: m.name, pos: array(m.positions, Float32Array) }));
-      addItems(r.markers.map((m, k) => ({ ...m.mesh, name: m.name, marker: k })), "robot");
-      if (r.support) {
-        const { vao } = upload(array(r.support.positions, Float32Array), null);
-        support = { name: r.support.name, vao, per: r.support.per, color: colour(r.support.rgb, 1) };
-      }
-      const F = robot.t.length;
-      state.frames = F;
-      if (F > 1) {
-        $("timebox").hidden = false;
-        $("time").max = robot.t[F - 1].toFixed(3);
-      }
-      setTime(d.start || 0);
-    } else {
-      $("status").textContent = "no recorded motion";
-    }
+    setRobot(d.robot, d.start);
     if (d.trials.length) {
       const sel = $("trial");
       d.trials.forEach((k, i) => sel.insertAdjacentHTML("beforeend", `<option value="${i}">${inline(k)}</option>`));
