@@ -6,6 +6,7 @@ import math
 import re
 import time
 from pathlib import Path
+from typing import Any
 
 import typer
 
@@ -65,7 +66,7 @@ def view_command(
         from footfall.viz.view import load_view
         from footfall.viz.view.page import ViewPage
 
-        page = ViewPage(None, host, server=server)
+        page = ViewPage(None, host, server=server, trial_walker=_walk_trial_again)
     except BaseException:
         stop_server(server)
         raise
@@ -85,3 +86,11 @@ def view_command(
             time.sleep(1.0)
     finally:
         page.close()
+
+
+def _walk_trial_again(folder: Path, trial: Any, scene: Any, out: Path) -> Any:
+    """The study's own walker for the page's "walk this trial again" (imported when asked: the
+    simulation is not needed to show a page)."""
+    from footfall.experiments.study.rewalk import trial_walker
+
+    return trial_walker(folder, trial, scene, out)

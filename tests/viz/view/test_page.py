@@ -181,6 +181,7 @@ def test_a_study_page_shows_the_picked_trial(study_dir: Path, browser: Any) -> N
         first, second = served.data.trials
         assert first.plan is not None
         assert len(_names(page, build.FOOTSTEPS)) == first.plan.n_steps + 1
+        assert not page.get_by_text("walk this trial again").is_visible()  # no walker given
         page.select_option("#trial", label=second.key)  # the user picks the second trial
         page.wait_for_function("() => /no plan in the cache/.test(document.body.innerText)")
         assert _names(page, build.FOOTSTEPS) == []  # this trial has no plan
@@ -191,7 +192,9 @@ def test_a_study_page_shows_the_picked_trial(study_dir: Path, browser: Any) -> N
 
 
 def test_a_study_trial_walks_again_in_the_page(mujoco_study_dir: Path, browser: Any) -> None:
-    served = ViewPage(load_view(mujoco_study_dir), port=0)
+    from footfall.experiments.study.rewalk import trial_walker
+
+    served = ViewPage(load_view(mujoco_study_dir), port=0, trial_walker=trial_walker)
     try:
         page = open_page(browser, served.url)
         assert page.evaluate("() => window.footfall.frames") == 0  # a study row has no motion

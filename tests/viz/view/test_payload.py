@@ -135,23 +135,30 @@ def test_a_start_time_must_be_a_time(walk_dir: Path) -> None:
             page_payload(data, start=bad)
 
 
-def test_a_trial_walked_again_is_the_walk_its_row_records(mujoco_study_dir: Path) -> None:
+def test_a_trial_walked_again_is_the_walk_its_row_records(
+    mujoco_study_dir: Path, tmp_path: Path
+) -> None:
+    from footfall.experiments.study.rewalk import trial_walker
     from footfall.experiments.study.store import read_rows
-    from footfall.viz.view.rewalk import rewalk_trial
 
     data = load_view(mujoco_study_dir)
     (trial,) = data.trials
     row = read_rows(mujoco_study_dir / "trials.parquet")[0]
     scene = next(s for s in data.scenes if s.name == trial.scene)
-    walked, outcome = rewalk_trial(mujoco_study_dir, trial, scene)
+    outcome = trial_walker(mujoco_study_dir, trial, scene, tmp_path)
     # the simulator is deterministic: the same walk, number for number
     for name in ("success", "fell", "goal_error", "zmp_offset_mean", "steps_landed"):
         assert getattr(outcome, name) == row[name], name
+    walked = load_view(tmp_path)  # a walk's folder, as footfall walk writes it
     assert walked.walk is not None and walked.walk.motion is not None
     assert len(walked.walk.motion.t) > 10 and walked.walk.pushes
-    # and the page document of it carries the robot
-    doc = _json_roundtrip(trial_walk_payload(data, 0))
-    assert doc["robot"] is not None and "walked again" in doc["summaries"][0]
+    # and the page document of it carries the robot and says what the walk did
+    doc = _json_roundtrip(trial_walk_payload(data, 0, trial_walker))
+    assert doc["robot"] is not None
+    assert doc["summaries"] == [
+        f"walked again: success {outcome.success}, fell {outcome.fell}, goal error "
+        f"{outcome.goal_error:.4g} m, ZMP offset mean {outcome.zmp_offset_mean:.4g} m"
+    ]
 
 
 def test_a_reduced_study_has_no_walk_to_show_again(study_dir: Path, tmp_path: Path) -> None:
@@ -161,6 +168,8 @@ def test_a_reduced_study_has_no_walk_to_show_again(study_dir: Path, tmp_path: Pa
     (study_dir / "study.json").write_text(
         json.dumps({"fingerprint": design.fingerprint(), "design": design.to_dict()})
     )
+    from footfall.experiments.study.rewalk import trial_walker
+
     data = load_view(study_dir)
     with pytest.raises(InputError, match="MuJoCo study"):
-        trial_walk_payload(data, 0)
+        trial_walk_payload(data, 0, trial_walker)

@@ -20,7 +20,9 @@ from footfall.viz.view.serve import PageServer, start_server, stop_server
 class ViewPage:
     """A page served at ``http://host:port`` (port 0: any free port). The server starts at
     once, so a browser can load the page while :meth:`show` packs ``data`` (given here, it is
-    shown at once, the recorded motion at ``start`` [s])."""
+    shown at once, the recorded motion at ``start`` [s]). ``trial_walker`` walks a study's trial
+    again for the page (:func:`footfall.experiments.study.rewalk.trial_walker`; None: the page
+    cannot)."""
 
     def __init__(
         self,
@@ -29,6 +31,7 @@ class ViewPage:
         port: int = 8080,
         start: float = 0.0,
         server: PageServer | None = None,
+        trial_walker: payload.TrialWalker | None = None,
     ) -> None:
         # a server already started (:func:`~footfall.viz.view.serve.start_server`) is adopted
         self.server = server if server is not None else start_server(host, port)
@@ -36,6 +39,7 @@ class ViewPage:
         self.url = f"http://{host}:{self.port}/"
         self.data = ViewData("none", "")
         self.payload: dict[str, Any] = {}
+        self.trial_walker = trial_walker
         if data is not None:
             self.show(data, start)
 
@@ -56,11 +60,14 @@ class ViewPage:
         if self.data.kind != "none":
             raise InputError("show", data.title, "one call per page")
         self.payload = payload.page_payload(data, start)
+        # the page offers "walk this trial again" only where someone can walk it
+        self.payload["rewalk"] = bool(data.trials) and self.trial_walker is not None
         self.data = data
+        walker = self.trial_walker
         self.server.publish(
             self.payload,
             lambda i: payload.trial_payload(data, i),
-            lambda i: payload.trial_walk_payload(data, i),
+            None if walker is None else lambda i: payload.trial_walk_payload(data, i, walker),
         )
 
     def close(self) -> None:

@@ -16,7 +16,8 @@ Arrays travel as base64 of little-endian ``float32`` (positions), ``float64`` (t
   (F*B*4), ``meshes`` in their body's frame (``body``: its index), ``markers`` (a point per frame,
   ``positions`` (F*3), NaN where it is not shown, and its ``mesh``), ``support`` (or null: the
   quadruped's support polygon per frame as ``per`` line vertices a frame).
-- ``trials``: a study's trial keys; ``outcome``: the first one's (shown). ``trial/<i>.json``
+- ``trials``: a study's trial keys; ``outcome``: the first one's (shown); ``rewalk``: whether
+  the server can walk a trial again. ``trial/<i>.json``
   holds trial ``i``'s ``meshes``, ``labels`` and ``outcome``; ``trial/<i>/walk.json`` the page
   document of that trial walked again (a MuJoCo study's: its robot's replay).
 """
@@ -25,15 +26,20 @@ from __future__ import annotations
 
 import base64
 import math
-from dataclasses import dataclass, field
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from footfall._typing import FloatArray
 from footfall.errors import InputError
+from footfall.results.outcome import Outcome
+from footfall.terrain.scene import Scene
 from footfall.viz.view import build
-from footfall.viz.view.load import PushMark, StudyTrial, ViewData
+from footfall.viz.view.load import PushMark, StudyTrial, ViewData, load_view
 from footfall.viz.view.replay import Mesh, RobotMotion
 
 #: a push arrow shows this long [s] before and after the push
@@ -277,18 +283,34 @@ def trial_payload(data: ViewData, index: int) -> dict[str, Any]:
     return {"meshes": d.meshes, "labels": d.labels, "outcome": outcome}
 
 
-def trial_walk_payload(data: ViewData, index: int) -> dict[str, Any]:
-    """A study trial walked again with its replay recorded (``trial/<index>/walk.json``): the
-    page document of that walk (:func:`page_payload`)."""
-    from footfall.viz.view.rewalk import rewalk_trial
+#: walks a study trial again into a folder (scene, plan, trial, folder -> its outcome): the
+#: study's own walker, handed in by the command (the page does not import the studies)
+TrialWalker = Callable[[Path, StudyTrial, Scene, Path], Outcome]
 
+
+def trial_walk_payload(data: ViewData, index: int, walker: TrialWalker) -> dict[str, Any]:
+    """A study trial walked again with its replay recorded (``trial/<index>/walk.json``): the
+    page document of that walk (:func:`page_payload`), its summary the walk's outcome."""
     if not 0 <= index < len(data.trials):
         raise InputError("trial", index, f"a trial index in 0..{len(data.trials) - 1}")
-    if data.folder is None:
-        raise InputError("trial", index, "a study read from its folder")
     trial = data.trials[index]
     scene = next((s for s in data.scenes if s.name == trial.scene), None)
-    return page_payload(rewalk_trial(data.folder, trial, scene)[0])
+    if data.folder is None or trial.plan is None or scene is None or trial.seed is None:
+        missing = (
+            "folder" if data.folder is None else "plan" if trial.plan is None
+            else "scene" if scene is None else "seed"
+        )  # fmt: skip
+        raise InputError("trial", trial.key, f"a trial whose {missing} the study holds")
+    with tempfile.TemporaryDirectory(prefix="footfall-trial-") as tmp:
+        outcome = walker(data.folder, trial, scene, Path(tmp))
+        walked = load_view(Path(tmp))  # the scene: the one its replay.npz holds
+    assert walked.walk is not None
+    summary = (
+        f"walked again: success {outcome.success}, fell {outcome.fell}, goal error "
+        f"{outcome.goal_error:.4g} m, ZMP offset mean {outcome.zmp_offset_mean:.4g} m"
+    )
+    shown = replace(walked, title=f"{trial.key}, walked again", notes=())
+    return page_payload(replace(shown, walk=replace(walked.walk, summary=summary)))
 
 
 def _com_at(plan: Any, t: float) -> FloatArray:

@@ -510,6 +510,7 @@ void main() {
       const sel = $("trial");
       d.trials.forEach((k, i) => sel.insertAdjacentHTML("beforeend", `<option value="${i}">${inline(k)}</option>`));
       $("trialbox").hidden = false;
+      $("rewalk").hidden = !d.rewalk;
       $("outcome").textContent = d.outcome || "";
     }
     listNames();
