@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import shutil
 from pathlib import Path
@@ -103,6 +104,11 @@ def test_a_quadruped_folder_holds_feet_contacts_cop_and_zmp(quadruped_dir: Path)
     # a walk gait: three or four feet down at every instant
     assert np.all(q.contact.sum(axis=1) >= 3)
     assert np.all(np.isfinite(q.zmp))
+    report = json.loads((quadruped_dir / "quadruped.json").read_text())
+    assert data.title == f"quadruped walk of {report['robot']['name']}"
+    assert q.summary == (
+        f"distance up the slope {report['distance_up_slope_m']:.2f} m, fell {report['fell']}"
+    )
 
 
 def test_a_study_folder_lists_its_trials_with_their_plans(study_dir: Path) -> None:

@@ -381,13 +381,18 @@ def _load_quadruped_folder(folder: Path, given: Scene | None) -> ViewData:
         for k in ("cop", "zmp")
     )
     m = report.get("metrics", report)
-    summary = (
-        f"distance {m.get('distance_up_slope_m')} m, fell {m.get('fell')}"
-        if isinstance(m, dict)
-        else ""
-    )
+    summary = ""
+    if isinstance(m, dict):
+        d = m.get("distance_up_slope_m")
+        shown = f"{d:.2f}" if isinstance(d, int | float) else str(d)
+        summary = f"distance up the slope {shown} m, fell {m.get('fell')}"
     track = QuadrupedTrack(motion, feet, contact, cop, zmp, summary)
-    title = f"quadruped walk{' on ' + str(report['scene']) if report.get('scene') else ''}"
+    robot = report.get("robot")
+    name = robot.get("name") if isinstance(robot, dict) else None
+    title = (
+        f"quadruped walk{' of ' + str(name) if name else ''}"
+        f"{' on ' + str(report['scene']) if report.get('scene') else ''}"
+    )
     return ViewData("quadruped", title, quadruped=track, notes=tuple(notes))
 
 
