@@ -243,7 +243,7 @@ def page_payload(data: ViewData, start: float = 0.0) -> dict[str, Any]:
     d = _Drawing()
     outcome = ""
     if data.trials:
-        outcome = _trial(d, data, data.trials[0])
+        outcome = _trial(d, data, 0)
     else:
         _static(d, data)
     robot = _robot(d, data)
@@ -264,9 +264,18 @@ def page_payload(data: ViewData, start: float = 0.0) -> dict[str, Any]:
     }
 
 
-def _trial(d: _Drawing, data: ViewData, trial: StudyTrial) -> str:
-    """Draw a study trial (its scene, the plan it walked, its push) into ``d``; its outcome."""
-    scene = next((s for s in data.scenes if s.name == trial.scene), None)
+def _trial_at(data: ViewData, index: int) -> tuple[StudyTrial, Scene | None]:
+    """Study trial ``index`` and its scene (None: the study's scenes do not hold it)."""
+    if not 0 <= index < len(data.trials):
+        raise InputError("trial", index, f"a trial index in 0..{len(data.trials) - 1}")
+    trial = data.trials[index]
+    return trial, next((s for s in data.scenes if s.name == trial.scene), None)
+
+
+def _trial(d: _Drawing, data: ViewData, index: int) -> str:
+    """Draw study trial ``index`` (its scene, the plan it walked, its push) into ``d``; its
+    outcome."""
+    trial, scene = _trial_at(data, index)
     _static(d, ViewData("plan", trial.key, scene=scene, plan=trial.plan))
     if trial.push is not None and trial.plan is not None:
         at = _com_at(trial.plan, trial.push.start)
@@ -276,10 +285,8 @@ def _trial(d: _Drawing, data: ViewData, trial: StudyTrial) -> str:
 
 def trial_payload(data: ViewData, index: int) -> dict[str, Any]:
     """A study trial's nodes and outcome (``trial/<index>.json``)."""
-    if not 0 <= index < len(data.trials):
-        raise InputError("trial", index, f"a trial index in 0..{len(data.trials) - 1}")
     d = _Drawing()
-    outcome = _trial(d, data, data.trials[index])
+    outcome = _trial(d, data, index)
     return {"meshes": d.meshes, "labels": d.labels, "outcome": outcome}
 
 
@@ -291,10 +298,7 @@ TrialWalker = Callable[[Path, StudyTrial, Scene, Path], Outcome]
 def trial_walk_payload(data: ViewData, index: int, walker: TrialWalker) -> dict[str, Any]:
     """A study trial walked again with its replay recorded (``trial/<index>/walk.json``): the
     page document of that walk (:func:`page_payload`), its summary the walk's outcome."""
-    if not 0 <= index < len(data.trials):
-        raise InputError("trial", index, f"a trial index in 0..{len(data.trials) - 1}")
-    trial = data.trials[index]
-    scene = next((s for s in data.scenes if s.name == trial.scene), None)
+    trial, scene = _trial_at(data, index)
     if data.folder is None or trial.plan is None or scene is None or trial.seed is None:
         missing = (
             "folder" if data.folder is None else "plan" if trial.plan is None
