@@ -131,3 +131,35 @@ def from_heightmap(
         f"{h} x {w} map in {elapsed:.2f} s" + (f" ({spikes} spike cells ignored)" if spikes else "")
     )
     console.print(f"wrote {out} and {figure}")
+
+
+@terrain_app.command("generate")
+def generate(
+    family: str = typer.Option(
+        ..., help="Terrain family: discrete_steps or stairs_slope_gap (document 000's two)."
+    ),
+    seed: int = typer.Option(0, help="First family seed (each seed is one terrain)."),
+    count: int = typer.Option(1, help="Number of terrains (seeds SEED ... SEED + COUNT - 1)."),
+    out: Path = typer.Option(Path("terrains"), help="Folder for the scene files (NAME.yaml)."),
+) -> None:
+    """Terrains drawn from a seeded family shaped like one of document 000's study scenes, each
+    written as a scene file (walk it with `footfall walk FILE`). The same family and seed give
+    the same terrain; the family's ranges (lengths in m, angles in deg) are printed."""
+    from footfall.terrain import load_scene, scene_to_yaml
+    from footfall.terrain.families import MAX_SEED, family_terrain, ranges_dict
+
+    ranges = ranges_dict(family)  # checks the family's name first
+    if count < 1 or count > 10_000:
+        raise InputError("count", count, "an integer in [1, 10000]")
+    if seed < 0 or seed + count - 1 > MAX_SEED:
+        raise InputError("seed", seed, f"an integer >= 0 with SEED + COUNT - 1 <= {MAX_SEED}")
+    output_folder(out)
+    paths = []
+    for s in range(seed, seed + count):
+        scene = family_terrain(family, s)
+        text = scene_to_yaml(scene)
+        load_scene(text)  # the file must pass the scene loader's own validation
+        paths.append(write_text(out / f"{scene.name}.yaml", text))
+    console.print(f"{family} ranges: " + ", ".join(f"{k} {v}" for k, v in ranges.items()))
+    shown = ", ".join(p.name for p in paths[:3]) + (", ..." if len(paths) > 3 else "")
+    console.print(f"wrote {len(paths)} scene file(s) to {out}: {shown}")
