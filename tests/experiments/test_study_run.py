@@ -197,11 +197,15 @@ def test_adding_a_step_mode_flags_the_walks_already_in_the_folder(
     real = runner.make_plans
 
     def same_n(
-        design: StudyDesign, folder: Path, say: Any = None, monitor_for: Any = None
+        design: StudyDesign,
+        folder: Path,
+        say: Any = None,
+        monitor_for: Any = None,
+        workers: int = 1,
     ) -> list[Any]:
         # a scene where the horizon planner's smallest N is the reactive walk's N: make_plans
         # then reuses the smallest-N plan as the equal-N plan
-        out = [e for e in real(design, folder, say, monitor_for) if e.mode != "equal"]
+        out = [e for e in real(design, folder, say, monitor_for, workers) if e.mode != "equal"]
         if "equal" in design.steps:
             out += [replace(e, mode="equal", plan_time=0.0) for e in out if e.mode == "smallest"]
         return out

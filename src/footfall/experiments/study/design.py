@@ -37,7 +37,7 @@ STEP_MODES = ("smallest", "equal")
 #: controllers of the MuJoCo walker (``WalkOptions.controller``)
 CONTROLLERS = ("wbc", "servo")
 #: the studies that ship with footfall (``footfall study --builtin NAME``)
-BUILTIN_STUDIES = ("section55", "section55_reduced", "quick")
+BUILTIN_STUDIES = ("section55", "section55_reduced", "section55_terrain", "quick")
 #: largest study file accepted [bytes]
 MAX_STUDY_BYTES = 100_000
 #: most trials one study may declare (a typo like ``seeds: 2000000`` is refused, not queued)
@@ -79,6 +79,10 @@ class StudyDesign:
             ``nearby`` (or the best region within reach).
         robot: the walker (``mujoco``): ``biped`` (footfall's), a built-in robot file's name
             (``g1``, ``talos``) or a robot file (a ``.yaml`` path, relative to the study file).
+        families: terrain families (:mod:`footfall.terrain.families`) whose terrains the study
+            walks besides ``scenes`` (which may then be empty): terrain is a random factor.
+        terrains: terrains per family (family seeds ``terrain_start`` ... + terrains - 1).
+        terrain_start: first family seed.
     """
 
     name: str
@@ -101,6 +105,9 @@ class StudyDesign:
     placement_error: float = 0.0
     region_aware: str = "off"
     robot: str = "biped"
+    families: tuple[str, ...] = ()
+    terrains: int = 0
+    terrain_start: int = 0
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.strip():
@@ -120,7 +127,22 @@ class StudyDesign:
             if self.simulator == "mujoco" and v != 0.0:
                 raise InputError(name, v, "0 with simulator mujoco (a reduced-order option)")
             object.__setattr__(self, name, v)
-        object.__setattr__(self, "scenes", _scenes(self.scenes))
+        from footfall.terrain.families import MAX_SEED, family_names
+
+        fam = self.families
+        if isinstance(fam, str) or not isinstance(fam, list | tuple):
+            raise InputError("families", fam, f"a list of: {', '.join(family_names())}")
+        object.__setattr__(self, "families", _names("families", fam, family_names()) if fam else ())
+        for name, lo in (("terrains", 1 if fam else 0), ("terrain_start", 0)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < lo:
+                raise InputError(name, v, f"an integer >= {lo}")
+            object.__setattr__(self, name, int(v))
+        if not fam and self.terrains:
+            raise InputError("terrains", self.terrains, "0 without families (or name families)")
+        if self.terrain_start + self.terrains - 1 > MAX_SEED:
+            raise InputError("terrain_start", self.terrain_start, f"family seeds <= {MAX_SEED}")
+        object.__setattr__(self, "scenes", _scenes(self.scenes, allow_empty=bool(fam)))
         object.__setattr__(self, "planners", _names("planners", self.planners, PLANNERS))
         object.__setattr__(self, "steps", _names("steps", self.steps, STEP_MODES))
         if self.level_steps is None:
@@ -191,7 +213,11 @@ class StudyDesign:
         )
         if "reactive" in self.planners:
             per_scene += sum(len(self.seeds_at(i, "goal")) for i in self.impulses())
-        return len(self.scenes) * per_scene
+        return (len(self.scenes) + len(self.families) * self.terrains) * per_scene
+
+    def terrain_seeds(self) -> range:
+        """The family seeds of the study's terrains (the same in every family)."""
+        return range(self.terrain_start, self.terrain_start + self.terrains)
 
     def fingerprint(self) -> dict[str, Any]:
         """The fields that change what a trial computes (a folder's trials are reused only by a
@@ -222,11 +248,18 @@ class StudyDesign:
         return out
 
 
-def _scenes(value: object) -> tuple[str, ...]:
-    """Scene entries: built-in names or paths of existing files, each once."""
+def _scenes(value: object, allow_empty: bool = False) -> tuple[str, ...]:
+    """Scene entries: built-in names or paths of existing files, each once (none only with
+    ``allow_empty``: a study of terrain families)."""
     builtin = builtin_scene_names()
-    if isinstance(value, str) or not isinstance(value, list | tuple) or not value:
-        raise InputError("scenes", value, f"a non-empty list of: {', '.join(builtin)} or files")
+    if (
+        isinstance(value, str)
+        or not isinstance(value, list | tuple)
+        or (not value and not allow_empty)
+    ):
+        raise InputError(
+            "scenes", value, f"a non-empty list of: {', '.join(builtin)} or files (or families)"
+        )
     out: list[str] = []
     for i, v in enumerate(value):
         if not isinstance(v, str) or not (v in builtin or Path(v).is_file()):

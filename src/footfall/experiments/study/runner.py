@@ -110,30 +110,72 @@ def _planner(design: StudyDesign, folder: Path) -> Planner:
 
 
 def design_scenes(design: StudyDesign) -> dict[str, Scene]:
-    """The study's scenes by name (built-in or read from their files)."""
+    """The study's scenes by name: its ``scenes`` (built-in or read from their files), then the
+    terrains of its ``families`` (:func:`~footfall.terrain.families.family_terrain`)."""
+    from footfall.terrain.families import family_terrain
+
     scenes: dict[str, Scene] = {}
-    for entry in design.scenes:
-        scene = resolve_scene(entry)
-        if scene.name in scenes:
-            raise InputError("scenes", entry, f"scenes with distinct names ({scene.name!r} twice)")
-        scenes[scene.name] = scene
+    generated = (
+        family_terrain(f, seed) for f in design.families for seed in design.terrain_seeds()
+    )
+    for entry in (*(resolve_scene(e) for e in design.scenes), *generated):
+        if entry.name in scenes:
+            raise InputError(
+                "scenes", entry.name, f"scenes with distinct names ({entry.name!r} twice)"
+            )
+        scenes[entry.name] = entry
     return scenes
 
 
-def make_plans(
+def terrain_family(design: StudyDesign) -> dict[str, str]:
+    """The family of each of the study's generated terrains, by scene name."""
+    from footfall.terrain.families import terrain_name
+
+    return {terrain_name(f, s): f for f in design.families for s in design.terrain_seeds()}
+
+
+#: where a study keeps the scene file of each generated terrain (``DIR/terrains/NAME.yaml``)
+TERRAIN_FOLDER = "terrains"
+
+
+def write_terrains(design: StudyDesign, folder: Path) -> int:
+    """Write the scene file of every generated terrain of ``design`` into ``folder/terrains`` (so
+    any trial can be replayed with ``footfall walk``); a file that already says the same is left
+    as it is. Returns the number of files written."""
+    from footfall._io import write_text
+    from footfall.terrain.scene import scene_to_yaml
+
+    names = terrain_family(design)
+    if not names:
+        return 0
+    where = Path(folder) / TERRAIN_FOLDER
+    where.mkdir(parents=True, exist_ok=True)
+    written = 0
+    scenes = design_scenes(design)
+    for name in names:
+        text = scene_to_yaml(scenes[name])
+        path = where / f"{name}.yaml"
+        if path.is_file() and path.read_text() == text:
+            continue
+        write_text(path, text)
+        written += 1
+    return written
+
+
+def _scene_plans(
     design: StudyDesign,
     folder: Path,
+    scene: Scene,
     say: Callable[[str], None] | None = None,
     monitor_for: MonitorFactory | None = None,
 ) -> list[PlanEntry]:
-    """Every plan the study walks (see the module docstring), planned or read from the cache.
-
-    ``say`` hears one line per plan; ``monitor_for(title)`` gives the monitor of a smallest-N
-    search (``footfall plan``'s progress lines)."""
+    """The plans of one scene: the reactive walk (its N is the equal N), then each horizon
+    planner at its smallest N and at the equal N (the smallest-N plan serves both when its N is
+    the equal N)."""
     plan = _planner(design, folder)
     out: list[PlanEntry] = []
 
-    def timed(scene: Scene, planner: str, n: int | None, mode: str) -> PlanEntry:
+    def timed(planner: str, n: int | None, mode: str) -> PlanEntry:
         title = f"{scene.name} / {planner} ({mode} N{'' if n is None else f' = {n}'})"
         if say:
             say(f"planning {title}")
@@ -146,30 +188,76 @@ def make_plans(
             say(f"  {p.status.value}, N = {n_txt}, {entry.plan_time:.1f} s")
         return entry
 
-    for scene in design_scenes(design).values():
-        name = scene.name
-        reactive = None
-        if "reactive" in design.planners or "equal" in design.steps:
-            reactive = timed(scene, "reactive", None, "goal")
-            if "reactive" in design.planners:
-                out.append(reactive)
-        n_equal = reactive.plan.n_steps if reactive and reactive.plan.has_solution else None
-        for planner in design.planners:
-            if planner == "reactive":
-                continue
-            smallest = None
-            if "smallest" in design.steps:
-                smallest = timed(scene, planner, None, "smallest")
-                out.append(smallest)
-            if "equal" in design.steps:
-                if n_equal is None:  # no reactive walk, no equal N: the report says so
-                    if say:
-                        say(f"  {name} / {planner}: no equal-N plan (the reactive planner failed)")
-                elif smallest and smallest.plan.has_solution and smallest.plan.n_steps == n_equal:
-                    out.append(PlanEntry(name, planner, "equal", smallest.plan, 0.0))
-                else:
-                    out.append(timed(scene, planner, n_equal, "equal"))
+    name = scene.name
+    reactive = None
+    if "reactive" in design.planners or "equal" in design.steps:
+        reactive = timed("reactive", None, "goal")
+        if "reactive" in design.planners:
+            out.append(reactive)
+    n_equal = reactive.plan.n_steps if reactive and reactive.plan.has_solution else None
+    for planner in design.planners:
+        if planner == "reactive":
+            continue
+        smallest = None
+        if "smallest" in design.steps:
+            smallest = timed(planner, None, "smallest")
+            out.append(smallest)
+        if "equal" in design.steps:
+            if n_equal is None:  # no reactive walk, no equal N: the report says so
+                if say:
+                    say(f"  {name} / {planner}: no equal-N plan (the reactive planner failed)")
+            elif smallest and smallest.plan.has_solution and smallest.plan.n_steps == n_equal:
+                out.append(PlanEntry(name, planner, "equal", smallest.plan, 0.0))
+            else:
+                out.append(timed(planner, n_equal, "equal"))
     return out
+
+
+def _scene_plans_task(design: StudyDesign, folder: Path, scene: Scene) -> list[PlanEntry]:
+    """:func:`_scene_plans` in a worker process (no progress lines, no monitor)."""
+    return _scene_plans(design, folder, scene)
+
+
+def make_plans(
+    design: StudyDesign,
+    folder: Path,
+    say: Callable[[str], None] | None = None,
+    monitor_for: MonitorFactory | None = None,
+    workers: int = 1,
+) -> list[PlanEntry]:
+    """Every plan the study walks (see the module docstring), planned or read from the cache.
+
+    ``say`` hears one line per plan; ``monitor_for(title)`` gives the monitor of a smallest-N
+    search (``footfall plan``'s progress lines). With ``workers > 1`` the scenes are planned in
+    that many processes (each plan on one thread, so the plans and their cache keys are those of
+    one worker); ``say`` then hears a line per plan as its scene finishes, and no monitor."""
+    scenes = list(design_scenes(design).values())
+    if workers <= 1 or len(scenes) <= 1:
+        return [e for sc in scenes for e in _scene_plans(design, folder, sc, say, monitor_for)]
+    import multiprocessing as mp
+    import os
+    from concurrent.futures import ProcessPoolExecutor
+
+    from footfall._process import die_with_parent
+
+    by_scene: list[list[PlanEntry]] = []
+    with ProcessPoolExecutor(
+        min(workers, len(scenes)),
+        mp_context=mp.get_context("spawn"),
+        initializer=die_with_parent,
+        initargs=(os.getpid(),),
+    ) as pool:
+        n = len(scenes)
+        for entries in pool.map(_scene_plans_task, [design] * n, [folder] * n, scenes):
+            by_scene.append(entries)
+            for e in entries:
+                if say:
+                    n_txt = e.plan.n_steps if e.plan.has_solution else "-"
+                    say(
+                        f"planned {e.scene} / {e.planner} ({e.mode} N): {e.plan.status.value}, "
+                        f"N = {n_txt}, {e.plan_time:.1f} s"
+                    )
+    return [e for entries in by_scene for e in entries]
 
 
 def make_trials(design: StudyDesign, plans: list[PlanEntry]) -> list[Trial]:
@@ -358,6 +446,7 @@ def run_study(
     progress: Callable[[int, int, dict[str, Any]], None] | None = None,
     limit: int | None = None,
     monitor_for: MonitorFactory | None = None,
+    plan_workers: int = 1,
 ) -> StudyRun:
     """Plan, then walk every trial of ``design`` not yet in ``out`` (resumable, see above).
 
@@ -370,11 +459,13 @@ def run_study(
         limit: run at most this many new walks (then stop as if interrupted; for tests and
             for spreading a study over several sessions).
         monitor_for: progress of the smallest-N searches (:func:`make_plans`).
+        plan_workers: processes that make the plans (:func:`make_plans`), on this machine.
     """
     execute([], executor, workers, address)  # validates the arguments before any planning
     out = Path(out)
     store = TrialStore(out, design)
-    plans = make_plans(design, out / "plans", say, monitor_for)
+    write_terrains(design, out)
+    plans = make_plans(design, out / "plans", say, monitor_for, plan_workers)
     trials = make_trials(design, plans)
     digests: dict[int, str] = {}  # one digest per plan object, not per trial
     for t in trials:
