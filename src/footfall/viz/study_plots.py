@@ -134,3 +134,44 @@ def plot_paired(pairs: Sequence[dict[str, Any]], path: Path) -> Path:
     ax.set_xlabel("paired difference of the mean single-support ZMP offset [mm] (95 % CI)")
     ax.grid(alpha=0.3, axis="x")
     return save(fig, path)
+
+
+def plot_terrain_paired(pairs: Sequence[dict[str, Any]], path: Path) -> Path:
+    """The tested quantity of a family study: per family, step mode and baseline, the mean over
+    terrains of the per-terrain paired ZMP-offset difference (planner - baseline) with its
+    cluster-bootstrap 95 % CI (filled), and the same on the terrains whose plans are all proven
+    (open, below it); each row names its sample (terrains T, seed pairs n)."""
+    fig, ax = plt.subplots(figsize=(8, 0.6 * max(3, len(pairs)) + 1), constrained_layout=True)
+    labels = []
+    for i, p in enumerate(pairs):
+        for k, (prefix, style, dy) in enumerate((("", "o", -0.12), ("proven_", "s", 0.12))):
+            d, lo, hi = (1000 * p[prefix + key] for key in ("diff", "lo", "hi"))
+            if not np.isfinite(d):
+                continue
+            xerr = [[max(0.0, d - lo)], [max(0.0, hi - d)]] if np.isfinite(lo) else None
+            ax.errorbar(
+                [d],
+                [i + dy],
+                xerr=xerr,
+                fmt=style,
+                mfc="C0" if k == 0 else "white",
+                color="C0",
+                capsize=3,
+                label=(
+                    ("all terrains" if k == 0 else "terrains with proven plans") if i == 0 else None
+                ),
+            )
+        labels.append(
+            f"{p['family']} {p['mode']} N: {p['planner']} - {p['baseline']}\n"
+            f"T = {p['terrains']} (proven {p['proven_terrains']}), n = {p['pairs']}"
+        )
+    ax.axvline(0.0, color="k", lw=0.8)
+    ax.set_yticks(range(len(labels)), labels, fontsize=7)
+    ax.invert_yaxis()
+    ax.set_xlabel(
+        "mean over terrains of the paired ZMP-offset difference [mm] (cluster bootstrap 95 % CI)"
+    )
+    ax.grid(alpha=0.3, axis="x")
+    if pairs:
+        ax.legend(fontsize=7, loc="best")
+    return save(fig, path)

@@ -208,6 +208,21 @@ class Paired:
         )
 
 
+def zmp_differences(
+    a: dict[int, dict[str, Any]], b: dict[int, dict[str, Any]], seeds: Sequence[int]
+) -> list[float]:
+    """The paired differences ``a - b`` of the mean ZMP offset over ``seeds`` (rows by seed),
+    on the seeds where both walks succeeded with a finite offset."""
+    return [
+        a[s]["zmp_offset_mean"] - b[s]["zmp_offset_mean"]
+        for s in seeds
+        if a[s]["success"]
+        and b[s]["success"]
+        and math.isfinite(a[s]["zmp_offset_mean"])
+        and math.isfinite(b[s]["zmp_offset_mean"])
+    ]
+
+
 def paired(
     rows: Sequence[dict[str, Any]],
     scene: str,
@@ -221,14 +236,7 @@ def paired(
     a = {r["seed"]: r for r in sel if r["planner"] == planner}
     b = {r["seed"]: r for r in sel if r["planner"] == baseline}
     both = sorted(set(a) & set(b))
-    d = [
-        a[s]["zmp_offset_mean"] - b[s]["zmp_offset_mean"]
-        for s in both
-        if a[s]["success"]
-        and b[s]["success"]
-        and math.isfinite(a[s]["zmp_offset_mean"])
-        and math.isfinite(b[s]["zmp_offset_mean"])
-    ]
+    d = zmp_differences(a, b, both)
     m, lo, hi = mean_ci(d)
     only_a = sum(bool(a[s]["success"]) and not b[s]["success"] for s in both)
     only_b = sum(bool(b[s]["success"]) and not a[s]["success"] for s in both)
