@@ -208,6 +208,17 @@ def _named_scene(name: str, notes: list[str]) -> Scene | None:
     return None
 
 
+def _study_scene(folder: Path, name: str, notes: list[str]) -> Scene | None:
+    """A study's scene: a generated terrain's scene file in ``folder/terrains`` (its name is a
+    family terrain's, so never a path), else :func:`_named_scene`."""
+    from footfall.terrain.families import family_of
+
+    path = folder / "terrains" / f"{name}.yaml"
+    if family_of(name) is not None and path.is_file():
+        return load_scene(path)
+    return _named_scene(name, notes)
+
+
 def _load_plan_file(path: Path, given: Scene | None) -> ViewData:
     notes: list[str] = []
     data = read_json_file(path, "plan file")
@@ -414,7 +425,7 @@ def _load_study(folder: Path, given: Scene | None) -> ViewData:
     for row in rows:
         name = str(row.get("scene") or "")
         if name not in scenes:
-            sc = given if given is not None else _named_scene(name, notes)
+            sc = given if given is not None else _study_scene(folder, name, notes)
             if sc is not None:
                 scenes[name] = sc
         n = int(row.get("n_steps") or 0)
