@@ -146,3 +146,16 @@ def test_max_trials_counts_the_terrains() -> None:
     d = study_from_dict(DESIGN | {"terrains": 7, "scenes": ["flat"]})
     # (1 scene + 2 families x 7 terrains) x (1 horizon planner + the reactive) x 2 seeds
     assert d.max_trials() == (1 + 2 * 7) * 2 * 2
+
+
+def test_summary_json_gives_every_plans_status_and_gap(study: tuple[Any, Path, Any]) -> None:
+    design, out, run = study
+    write_report(out, design, run.rows, run.plans, ["header"])
+    data = json.loads((out / "summary.json").read_text())
+    by = {(p["scene"], p["planner"], p["mode"]): p for p in data["plans"]}
+    assert len(by) == len(run.plans)
+    for e in run.plans:
+        p = by[(e.scene, e.planner, e.mode)]
+        assert p["status"] == e.plan.status.value
+        gap = e.plan.gap
+        assert p["gap"] == (gap if math.isfinite(gap) else None)

@@ -15,6 +15,7 @@ skipped, so an interrupted study resumes where it stopped. A row names the plan 
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import AbstractContextManager, nullcontext
@@ -70,6 +71,8 @@ class PlanEntry:
             "status": self.plan.status.value,
             "n_steps": int(self.plan.n_steps) if self.plan.has_solution else None,
             "objective": self.plan.objective if self.plan.has_solution else None,
+            # relative gap of incumbent and bound (0: proven; None: no bound, e.g. reactive)
+            "gap": self.plan.gap if math.isfinite(self.plan.gap) else None,
             "solve_time": self.plan.solve_time,
             "plan_time": self.plan_time,
             "message": self.plan.message,
