@@ -27,6 +27,7 @@ from footfall.experiments.study import store as store_mod
 from footfall.experiments.study.design import MAX_TRIALS, study_from_dict
 from footfall.experiments.study.store import TrialStore, read_rows
 from footfall.experiments.study.trials import normalise_row
+from tests.experiments.rows import study_row
 
 Z95 = 1.959963984540054  # standard normal quantile at 0.975
 
@@ -281,38 +282,7 @@ def test_wilcoxon_p_matches_scipy() -> None:
     assert math.isnan(st.wilcoxon_p([]))
 
 
-def _row(
-    planner: str,
-    seed: int,
-    success: bool,
-    zmp: float,
-    *,
-    scene: str = "s",
-    impulse: float = 3.0,
-    smallest: bool = True,
-    equal: bool = False,
-    error: str | None = None,
-    n_steps: int = 7,
-) -> dict[str, Any]:
-    return normalise_row(
-        {
-            "key": f"{scene}|{planner}|N={n_steps}|J={impulse:g}|seed={seed}|{smallest}{equal}",
-            "scene": scene,
-            "planner": planner,
-            "n_steps": n_steps,
-            "smallest_n": smallest,
-            "equal_n": equal,
-            "push_impulse": impulse,
-            "seed": seed,
-            "simulator": "reduced",
-            "success": None if error else success,
-            "fell": None if error else not success,
-            "zmp_offset_mean": None if error else zmp,
-            "zmp_offset_max": None if error else 2 * zmp,
-            "footstep_error_mean": None if error else 0.001,
-            "error": error,
-        }
-    )
+_row = study_row
 
 
 def _paired_rows() -> list[dict[str, Any]]:

@@ -22,47 +22,16 @@ from footfall.experiments.study.terrain_stats import (
     terrain_paired,
     variance_split,
 )
-from footfall.experiments.study.trials import normalise_row
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import FootstepPlan
 from footfall.solvers.base import SolveStatus
+from tests.experiments.rows import study_row
 
 T = [f"discrete_steps-t{i:04d}" for i in range(8)]
 OTHER_FAMILY = "stairs_slope_gap-t0000"
 
 
-def _row(
-    planner: str,
-    seed: int,
-    success: bool,
-    zmp: float,
-    *,
-    scene: str,
-    impulse: float = 3.0,
-    smallest: bool = True,
-    equal: bool = False,
-    error: str | None = None,
-    n_steps: int = 7,
-) -> dict[str, Any]:
-    return normalise_row(
-        {
-            "key": f"{scene}|{planner}|N={n_steps}|J={impulse:g}|seed={seed}|{smallest}{equal}",
-            "scene": scene,
-            "planner": planner,
-            "n_steps": n_steps,
-            "smallest_n": smallest,
-            "equal_n": equal,
-            "push_impulse": impulse,
-            "seed": seed,
-            "simulator": "reduced",
-            "success": None if error else success,
-            "fell": None if error else not success,
-            "zmp_offset_mean": None if error else zmp,
-            "zmp_offset_max": None if error else 2 * zmp,
-            "footstep_error_mean": None if error else 0.001,
-            "error": error,
-        }
-    )
+_row = study_row
 
 
 def _bca(values: list[float]) -> tuple[float, float]:
