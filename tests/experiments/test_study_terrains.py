@@ -159,3 +159,23 @@ def test_summary_json_gives_every_plans_status_and_gap(study: tuple[Any, Path, A
         assert p["status"] == e.plan.status.value
         gap = e.plan.gap
         assert p["gap"] == (gap if math.isfinite(gap) else None)
+
+
+def test_the_shipped_terrain_study_is_served_by_its_own_plans(tmp_path: Path) -> None:
+    """The plans shipped with benchmarks/study/section55_terrain serve its terrains (a change of
+    a generator or of the plan cache key would silently re-plan and re-walk the study)."""
+    import shutil
+
+    from footfall.experiments.study.design import load_study
+    from footfall.experiments.study.runner import _planner
+
+    shipped = Path(__file__).parents[2] / "benchmarks" / "study" / "section55_terrain"
+    design = load_study(shipped / "study.yaml")
+    shutil.copytree(shipped / "plans", tmp_path / "plans")
+    plan_for = _planner(design, tmp_path / "plans")
+    for family in design.families:
+        scene = family_terrain(family, 0)
+        assert (shipped / "terrains" / f"{scene.name}.yaml").read_text() == scene_to_yaml(scene)
+        for planner in design.planners:
+            plan = plan_for(scene, planner, None, None)
+            assert "loaded from cache" in plan.message, (scene.name, planner, plan.message)
