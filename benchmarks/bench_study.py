@@ -12,6 +12,7 @@ Each executor walks the same study into its own fresh folder (the plans are copi
 from __future__ import annotations
 
 import argparse
+import math
 import shutil
 import tempfile
 import time
@@ -20,6 +21,19 @@ from pathlib import Path
 from footfall.experiments.study import run_study
 from footfall.experiments.study.design import StudyDesign
 from footfall.experiments.study.trials import RUN_DEPENDENT
+
+
+def _comparable(rows: list[dict]) -> list[dict]:
+    """Rows without the run-dependent columns, NaN replaced by a marker: NaN != NaN, so a row
+    with an unset number (a walk that did not fall has no fall time) never equalled itself."""
+    return [
+        {
+            k: "nan" if isinstance(v, float) and math.isnan(v) else v
+            for k, v in r.items()
+            if k not in RUN_DEPENDENT
+        }
+        for r in rows
+    ]
 
 
 def main() -> None:
@@ -61,9 +75,7 @@ def main() -> None:
             )
     base_rate, base_rows = results[("local", 1)]
     for key, (rate, rows) in results.items():
-        same = [{k: v for k, v in r.items() if k not in RUN_DEPENDENT} for r in rows] == [
-            {k: v for k, v in r.items() if k not in RUN_DEPENDENT} for r in base_rows
-        ]
+        same = _comparable(rows) == _comparable(base_rows)
         print(
             f"{key[0]} x{key[1]}: {rate / base_rate:.2f}x local x1; rows equal to local x1: {same}"
         )
