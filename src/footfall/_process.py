@@ -22,6 +22,21 @@ from typing import Any
 _PR_SET_PDEATHSIG = 1
 
 
+def spawn_pool(workers: int) -> Any:
+    """A ``ProcessPoolExecutor`` of ``workers`` spawned processes (each imports numpy afresh, so
+    it reads single-threaded BLAS from the environment), each dying with this process even when
+    it is killed (:func:`die_with_parent`)."""
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(
+        workers,
+        mp_context=mp.get_context("spawn"),
+        initializer=die_with_parent,
+        initargs=(os.getpid(),),
+    )
+
+
 def die_with_parent(parent_pid: int) -> bool:
     """In a child process: have the kernel kill this process (SIGKILL) as soon as its parent
     ``parent_pid`` dies; exit at once if it has died already. Returns whether the kernel will

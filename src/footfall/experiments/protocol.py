@@ -280,19 +280,12 @@ def _walks(
         for case, d in jobs:
             yield case, _walk_case(*args, case, d)
         return
-    import multiprocessing as mp
-    import os
-    from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+    from concurrent.futures import FIRST_COMPLETED, Future, wait
 
-    from footfall._process import die_with_parent
+    from footfall._process import spawn_pool
 
     # spawn, as the study runner: each worker dies with this process, even killed
-    pool = ProcessPoolExecutor(
-        min(workers, len(jobs)),
-        mp_context=mp.get_context("spawn"),
-        initializer=die_with_parent,
-        initargs=(os.getpid(),),
-    )
+    pool = spawn_pool(min(workers, len(jobs)))
     try:
         running: dict[Future[dict[str, Any]], PushCase] = {
             pool.submit(_walk_case, *args, case, d): case for case, d in jobs

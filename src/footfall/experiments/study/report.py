@@ -11,7 +11,7 @@ from typing import Any
 from footfall._io import atomic_open, write_json, write_text
 from footfall.experiments.study import stats, terrain_stats
 from footfall.experiments.study.design import StudyDesign
-from footfall.experiments.study.runner import PlanEntry, terrain_family
+from footfall.experiments.study.runner import PlanEntry, design_families, terrain_family
 
 
 @dataclass(frozen=True)
@@ -72,7 +72,7 @@ def summarise(
         n_steps,
     )
     errors = sum(r["error"] is not None for r in rows)
-    families = {f: [t for t, g in generated.items() if g == f] for f in design.families}
+    families = design_families(design)
     terrain_pairs = terrain_stats.family_comparisons(
         rows, families, plan_infos(plans or []), modes, design.default_push, design.planners
     )
@@ -195,8 +195,7 @@ def family_markdown(design: StudyDesign, summary: Summary, plans: list[PlanEntry
     comparisons with the terrain as the unit, and their verdict."""
     from footfall.terrain.families import ranges_dict
 
-    generated = terrain_family(design)
-    families = {f: [t for t, g in generated.items() if g == f] for f in design.families}
+    families = design_families(design)
     seeds = design.seeds_at(design.default_push)
     md = [
         "## Across terrain: the terrain is the unit",

@@ -137,6 +137,12 @@ def terrain_family(design: StudyDesign) -> dict[str, str]:
     return {terrain_name(f, s): f for f in design.families for s in design.terrain_seeds()}
 
 
+def design_families(design: StudyDesign) -> dict[str, list[str]]:
+    """The scene names of the study's generated terrains, by family."""
+    names = terrain_family(design)
+    return {f: [t for t, g in names.items() if g == f] for f in design.families}
+
+
 #: where a study keeps the scene file of each generated terrain (``DIR/terrains/NAME.yaml``)
 TERRAIN_FOLDER = "terrains"
 
@@ -216,11 +222,6 @@ def _scene_plans(
     return out
 
 
-def _scene_plans_task(design: StudyDesign, folder: Path, scene: Scene) -> list[PlanEntry]:
-    """:func:`_scene_plans` in a worker process (no progress lines, no monitor)."""
-    return _scene_plans(design, folder, scene)
-
-
 def make_plans(
     design: StudyDesign,
     folder: Path,
@@ -237,21 +238,13 @@ def make_plans(
     scenes = list(design_scenes(design).values())
     if workers <= 1 or len(scenes) <= 1:
         return [e for sc in scenes for e in _scene_plans(design, folder, sc, say, monitor_for)]
-    import multiprocessing as mp
-    import os
-    from concurrent.futures import ProcessPoolExecutor
-
-    from footfall._process import die_with_parent
+    from footfall._process import spawn_pool
 
     by_scene: list[list[PlanEntry]] = []
-    with ProcessPoolExecutor(
-        min(workers, len(scenes)),
-        mp_context=mp.get_context("spawn"),
-        initializer=die_with_parent,
-        initargs=(os.getpid(),),
-    ) as pool:
+    with spawn_pool(min(workers, len(scenes))) as pool:
         n = len(scenes)
-        for entries in pool.map(_scene_plans_task, [design] * n, [folder] * n, scenes):
+        # in a worker: no progress lines, no monitor (say and monitor_for keep their None)
+        for entries in pool.map(_scene_plans, [design] * n, [folder] * n, scenes):
             by_scene.append(entries)
             for e in entries:
                 if say:
@@ -314,20 +307,13 @@ def _local(trials: list[Trial], workers: int) -> Iterator[dict[str, Any]]:
         for t in trials[1:]:
             yield run_trial(t)
         return
-    import multiprocessing as mp
-    import os
-    from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+    from concurrent.futures import FIRST_COMPLETED, Future, wait
 
-    from footfall._process import die_with_parent
+    from footfall._process import spawn_pool
 
     # spawn: children import numpy afresh (single-threaded BLAS from the environment); each dies
     # with this process, even killed (kill -9 leaves no clean-up to run)
-    pool = ProcessPoolExecutor(
-        workers,
-        mp_context=mp.get_context("spawn"),
-        initializer=die_with_parent,
-        initargs=(os.getpid(),),
-    )
+    pool = spawn_pool(workers)
     try:
         todo = iter(trials[1:])
         running: set[Future[dict[str, Any]]] = set()
