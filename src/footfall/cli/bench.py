@@ -35,10 +35,31 @@ def bench_plan_cmd(
     gap: float = typer.Option(1e-3, help="Relative optimality gap of both."),
     fast_only: bool = typer.Option(False, help="Skip the direct model."),
     fast_threads: int = typer.Option(2, help="Worker processes of the fast planner."),
-    out: Path = typer.Option(Path("out/bench"), help="Output folder for bench_plan.json/.md."),
+    horizon: int = typer.Option(
+        0,
+        help="Short-horizon mode: plan H footsteps per control tick from the measured ALIP "
+        "state (footfall.planning.HorizonPlanner) along each scene's walk and report the "
+        "latency distribution; 0: the full-horizon table.",
+    ),
+    ticks: int = typer.Option(20, help="Short-horizon mode: solves per single support."),
+    push: float = typer.Option(
+        0.3,
+        help="Short-horizon mode: largest velocity change [m/s] given to the CoM at the start "
+        "of each step (random direction, seeded by --seeds).",
+    ),
+    out: Path = typer.Option(
+        Path("out/bench"), help="Output folder for bench_plan.json/.md (bench_horizon.json/.md)."
+    ),
 ) -> None:
-    """Direct SCIP model vs the fast planner on the same instances: a table of times and gaps."""
+    """Direct SCIP model vs the fast planner on the same instances: a table of times and gaps.
+
+    With --horizon H: the short-horizon MIQP's latency per tick (warm-started, cold, and SCIP on
+    the same problem at the first tick of every step) along each scene's walk."""
     from footfall.experiments.bench import bench_plan, format_table, rows_to_dict
+
+    if horizon:
+        _bench_horizon(horizon, ticks, push, scenes, seeds, gap, fast_only, time_limit_direct, out)
+        return
 
     def ints(field: str, text: str) -> list[int]:
         vals = parse_floats(field, text)
@@ -73,6 +94,52 @@ def bench_plan_cmd(
     remove_outputs(out, "bench_plan.json", "bench_plan.md")  # no file of another run beside ours
     write_json(out / "bench_plan.json", {"runs": rows_to_dict(rows)})
     write_text(out / "bench_plan.md", table + "\n")
+    print(table)
+
+
+def _bench_horizon(
+    horizon: int,
+    ticks: int,
+    push: float,
+    scenes: str,
+    seeds: str,
+    gap: float,
+    fast_only: bool,
+    scip_limit: float,
+    out: Path,
+) -> None:
+    from footfall.experiments.bench_horizon import (
+        DEFAULT_SCENES,
+        bench_horizon,
+        bench_to_dict,
+        check_bench_args,
+        format_horizon_table,
+    )
+
+    if not 1 <= horizon <= 10:
+        raise InputError("horizon", horizon, "a number of footsteps in 1..10 (0: off)")
+    seed_vals = parse_floats("seeds", seeds)
+    if not seed_vals or any(v != int(v) or v < 0 for v in seed_vals):
+        raise InputError("seeds", seeds, "comma-separated integers >= 0, e.g. 0,1,2")
+    if not scip_limit > 0.0:
+        raise InputError("time_limit_direct", scip_limit, "a time > 0 [s]")
+    names = [s.strip() for s in scenes.split(",") if s.strip()] or list(DEFAULT_SCENES)
+    check_bench_args(names, horizon, ticks, push, gap)
+    output_folder(out)
+    bench = bench_horizon(
+        scenes=names,
+        seeds=[int(v) for v in seed_vals],
+        horizon=horizon,
+        ticks=ticks,
+        push=push,
+        gap=gap,
+        scip=not fast_only,
+        scip_time_limit=scip_limit,
+    )
+    table = format_horizon_table(bench)
+    remove_outputs(out, "bench_horizon.json", "bench_horizon.md")
+    write_json(out / "bench_horizon.json", bench_to_dict(bench))
+    write_text(out / "bench_horizon.md", table + "\n")
     print(table)
 
 

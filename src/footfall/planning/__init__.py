@@ -6,6 +6,8 @@
 - :func:`plan_kinematic`, :func:`plan_reactive` — the two baselines; :func:`make_plan` dispatches
   by name and :func:`plan_min_steps` searches the smallest N (from the lower bound of
   :func:`reachable_steps_bound`, reporting to a :class:`SearchMonitor`).
+- :class:`HorizonPlanner` — the short-horizon MIQP for the control loop (H = 3 footsteps from the
+  measured ALIP state, exact, warm-started); :func:`horizon_input` makes a tick's input from a plan.
 - :func:`check_plan` — an independent constraint checker; :func:`load_plan` reads a saved
   ``plan.json`` back.
 """
@@ -19,6 +21,14 @@ from footfall.planning.lip_walk import LipWalk, LipWalkParams, lip_walk, optimal
 if TYPE_CHECKING:
     from footfall.planning.bounds import StepsBound, reachable_steps_bound
     from footfall.planning.check import CheckReport, Violation, check_plan
+    from footfall.planning.horizon import (
+        HorizonInput,
+        HorizonOptions,
+        HorizonPlanner,
+        HorizonSolution,
+        horizon_input,
+        horizon_problem,
+    )
     from footfall.planning.kinematic import plan_kinematic
     from footfall.planning.lip_examples import example as lip_example
     from footfall.planning.miqcqp import FootstepProblem, build_footstep_problem, plan_footsteps
@@ -35,6 +45,12 @@ _WHERE = {
     "CheckReport": ("footfall.planning.check", "CheckReport"),
     "Violation": ("footfall.planning.check", "Violation"),
     "check_plan": ("footfall.planning.check", "check_plan"),
+    "HorizonInput": ("footfall.planning.horizon", "HorizonInput"),
+    "HorizonOptions": ("footfall.planning.horizon", "HorizonOptions"),
+    "HorizonPlanner": ("footfall.planning.horizon", "HorizonPlanner"),
+    "HorizonSolution": ("footfall.planning.horizon", "HorizonSolution"),
+    "horizon_input": ("footfall.planning.horizon", "horizon_input"),
+    "horizon_problem": ("footfall.planning.horizon", "horizon_problem"),
     "plan_kinematic": ("footfall.planning.kinematic", "plan_kinematic"),
     "lip_example": ("footfall.planning.lip_examples", "example"),
     "FootstepProblem": ("footfall.planning.miqcqp", "FootstepProblem"),
@@ -56,6 +72,10 @@ __all__ = [
     "CheckReport",
     "FootstepPlan",
     "FootstepProblem",
+    "HorizonInput",
+    "HorizonOptions",
+    "HorizonPlanner",
+    "HorizonSolution",
     "LipWalk",
     "LipWalkParams",
     "PlannerOptions",
@@ -65,6 +85,8 @@ __all__ = [
     "Violation",
     "build_footstep_problem",
     "check_plan",
+    "horizon_input",
+    "horizon_problem",
     "lip_example",
     "lip_walk",
     "load_plan",
