@@ -318,6 +318,8 @@ class HorizonPlanner:
                 )
             )
         self._names = [r.name for r in self.regions]
+        self._lo = np.array([r.lo for r in self.regions])  # (R, 3) region boxes
+        self._hi = np.array([r.hi for r in self.regions])
         self._box = scene.terrain.bounds()
 
     # ---------------------------------------------------------------- indices
@@ -478,22 +480,14 @@ class HorizonPlanner:
         every point within ``j`` reach radii and ``j`` step heights of p_0 (conservative: no
         region a feasible plan uses is left out)."""
         p0 = inp.stance_foot
-        radius = self.robot.reach.radius
+        reach = np.array([self.robot.reach.radius] * 2 + [self.robot.step_height_max])
         out: list[list[int]] = []
         for j in range(1, self.h + 1):
-            lo = np.array(
-                [p0[0] - j * radius, p0[1] - j * radius, p0[2] - j * self.robot.step_height_max]
+            lo, hi = p0 - j * reach, p0 + j * reach
+            meets = np.all(self._lo <= hi + _BOX_TOL, axis=1) & np.all(
+                self._hi >= lo - _BOX_TOL, axis=1
             )
-            hi = np.array(
-                [p0[0] + j * radius, p0[1] + j * radius, p0[2] + j * self.robot.step_height_max]
-            )
-            out.append(
-                [
-                    r
-                    for r, reg in enumerate(self.regions)
-                    if np.all(reg.lo <= hi + _BOX_TOL) and np.all(reg.hi >= lo - _BOX_TOL)
-                ]
-            )
+            out.append(np.flatnonzero(meets).tolist())
         return out
 
     # ---------------------------------------------------------------- node QP
