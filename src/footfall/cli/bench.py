@@ -47,8 +47,18 @@ def bench_plan_cmd(
         help="Short-horizon mode: largest velocity change [m/s] given to the CoM at the start "
         "of each step (random direction, seeded by --seeds).",
     ),
+    suite: Path | None = typer.Option(
+        None,
+        help="Instance-suite mode: solve every instance of the suite folder (its suite.json, "
+        "e.g. benchmarks/suite) with --solver and compare with its certified optimum.",
+    ),
+    solver: str = typer.Option("bnb", help="Instance-suite mode: the backend (bnb, scip, gurobi)."),
+    instances: str = typer.Option(
+        "", help="Instance-suite mode: instance names to solve, comma separated (default all)."
+    ),
     out: Path = typer.Option(
-        Path("out/bench"), help="Output folder for bench_plan.json/.md (bench_horizon.json/.md)."
+        Path("out/bench"),
+        help="Output folder for bench_plan.json/.md (bench_horizon.json/.md, bench_suite.json/.md).",
     ),
 ) -> None:
     """Direct SCIP model vs the fast planner on the same instances: a table of times and gaps.
@@ -57,6 +67,11 @@ def bench_plan_cmd(
     the same problem at the first tick of every step) along each scene's walk."""
     from footfall.experiments.bench import bench_plan, format_table, rows_to_dict
 
+    if suite is not None and horizon:
+        raise InputError("suite", str(suite), "either --suite or --horizon, not both")
+    if suite is not None:
+        _bench_suite(suite, solver, instances, time_limit_fast, fast_threads, out)
+        return
     if horizon:
         _bench_horizon(horizon, ticks, push, scenes, seeds, gap, fast_only, time_limit_direct, out)
         return
@@ -95,6 +110,54 @@ def bench_plan_cmd(
     write_json(out / "bench_plan.json", {"runs": rows_to_dict(rows)})
     write_text(out / "bench_plan.md", table + "\n")
     print(table)
+
+
+def _bench_suite(
+    folder: Path, solver: str, instances: str, time_limit: float, threads: int, out: Path
+) -> None:
+    from footfall.experiments.suite import (
+        format_suite_table,
+        load_suite,
+        run_suite,
+        suite_runs_to_dict,
+    )
+    from footfall.solvers import KNOWN_BACKENDS
+
+    if solver not in KNOWN_BACKENDS:
+        raise InputError("solver", solver, f"one of {', '.join(KNOWN_BACKENDS)}")
+    if not time_limit > 0.0:
+        raise InputError("time_limit_fast", time_limit, "a time > 0 [s]")
+    refuse_inputs_as_outputs(
+        [folder / "suite.json"], {"out": [out / "bench_suite.json", out / "bench_suite.md"]}
+    )
+    gap, known = load_suite(folder)  # a bad suite is refused before anything is written
+    names = [n.strip() for n in instances.split(",") if n.strip()]
+    known_names = {i.name for i in known}
+    for n in names:
+        if n not in known_names:
+            raise InputError("instances", n, "names of the suite's instances")
+    output_folder(out)
+    runs = run_suite(
+        folder,
+        solver=solver,
+        time_limit=time_limit,
+        threads=_threads(threads),
+        names=names,
+        progress=lambda r: console.print(
+            f"{r.name} {r.solver}: {r.status} {r.time:.2f} s "
+            f"({'agrees' if r.agrees else 'DISAGREES'} with the certificate)"
+        ),
+    )
+    table = format_suite_table(runs)
+    remove_outputs(out, "bench_suite.json", "bench_suite.md")
+    write_json(
+        out / "bench_suite.json",
+        {"suite": str(folder), "gap": gap, "runs": suite_runs_to_dict(runs)},
+    )
+    write_text(out / "bench_suite.md", table + "\n")
+    print(table)
+    if not all(r.agrees for r in runs):
+        raise typer.Exit(1)
 
 
 def _bench_horizon(
