@@ -141,7 +141,7 @@ def check_solution(planner: HorizonPlanner, inp: HorizonInput, sol: HorizonSolut
     prev = np.asarray(inp.stance_foot, dtype=float)
     for j in range(h):
         p = steps[j]
-        region = planner.scene.terrain[sol.regions[j]]
+        region = planner.terrain[sol.regions[j]]
         if not region.contains(p, tol=1e-6):
             bad.append(f"footstep {j + 1} {p} is not in {sol.regions[j]}")
         q = _rot(float(inp.headings[j])).T @ (p - prev)[:2]
@@ -310,7 +310,7 @@ def test_warm_start_never_changes_the_optimum(stones_tick: Tick) -> None:
     # (the root is solved first, then the warm leaf: two QPs)
     worse = ("start_pad", "start_pad", "start_pad")
     assert worse != cold.regions
-    leaf = HorizonPlanner(planner.scene, planner.robot, HorizonOptions(node_limit=2))
+    leaf = HorizonPlanner(planner.terrain, planner.robot, HorizonOptions(node_limit=2))
     first = leaf.solve(inp, warm=worse)
     assert first.warm_used and first.regions == worse
     assert first.objective > cold.objective * (1 + gap)  # truly suboptimal
@@ -373,7 +373,7 @@ def test_no_region_within_reach_is_infeasible(foot: list[float], nodes: int) -> 
 
 def test_node_limit_is_not_optimal_and_reports_an_honest_gap(stones_tick: Tick) -> None:
     planner, inp, cold = stones_tick
-    one = HorizonPlanner(planner.scene, planner.robot, HorizonOptions(node_limit=1))
+    one = HorizonPlanner(planner.terrain, planner.robot, HorizonOptions(node_limit=1))
     sol = one.solve(inp)
     # the root relaxation alone: no footsteps, its bound is a valid lower bound
     assert sol.status == "node_limit" and not sol.has_solution
@@ -382,7 +382,7 @@ def test_node_limit_is_not_optimal_and_reports_an_honest_gap(stones_tick: Tick) 
     assert math.isfinite(sol.bound) and sol.bound <= cold.objective
     # with a (suboptimal) warm leaf and room for it (the root, then the leaf): an incumbent,
     # not claimed optimal, gap from its numbers
-    two = HorizonPlanner(planner.scene, planner.robot, HorizonOptions(node_limit=2))
+    two = HorizonPlanner(planner.terrain, planner.robot, HorizonOptions(node_limit=2))
     warm = two.solve(inp, warm=("start_pad", "start_pad", "start_pad"))
     assert warm.status == "node_limit" and warm.has_solution
     assert warm.nodes == 2 and warm.warm_used
@@ -395,14 +395,14 @@ def test_node_limit_is_not_optimal_and_reports_an_honest_gap(stones_tick: Tick) 
 def test_node_limit_bounds_the_qp_solves(stones_tick: Tick) -> None:
     planner, inp, cold = stones_tick
     for limit in (1, 2, 3):
-        lim = HorizonPlanner(planner.scene, planner.robot, HorizonOptions(node_limit=limit))
+        lim = HorizonPlanner(planner.terrain, planner.robot, HorizonOptions(node_limit=limit))
         assert lim.solve(inp).nodes <= limit
         assert lim.solve(inp, warm=cold.regions).nodes <= limit
 
 
 def test_reported_bound_is_a_lower_bound_with_a_loose_gap(stones_tick: Tick) -> None:
     planner, inp, cold = stones_tick
-    loose = HorizonPlanner(planner.scene, planner.robot, HorizonOptions(gap=0.1))
+    loose = HorizonPlanner(planner.terrain, planner.robot, HorizonOptions(gap=0.1))
     sol = loose.solve(inp, warm=("stone1", "stone2", "stone2"))
     assert sol.status == "optimal"
     assert sol.objective <= cold.objective * 1.1  # within the gap, as claimed
@@ -412,7 +412,9 @@ def test_reported_bound_is_a_lower_bound_with_a_loose_gap(stones_tick: Tick) -> 
 def test_solve_time_is_read_from_the_injected_clock(stones_tick: Tick) -> None:
     planner, inp, _ = stones_tick
     reads = iter([0.0, 0.25])  # a third read would raise StopIteration
-    timed = HorizonPlanner(planner.scene, planner.robot, planner.options, clock=lambda: next(reads))
+    timed = HorizonPlanner(
+        planner.terrain, planner.robot, planner.options, clock=lambda: next(reads)
+    )
     sol = timed.solve(inp)
     assert sol.status == "optimal"
     assert sol.solve_time == 0.25

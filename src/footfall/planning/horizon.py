@@ -63,6 +63,7 @@ from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import FootstepPlan, PlannerWeights
 from footfall.solvers.problem import MIQCQP, ProblemBuilder
 from footfall.terrain.scene import Scene
+from footfall.terrain.terrain import Terrain
 
 #: facets of the regular polygon inscribed in the torque ball ||u|| <= U_max (eq. 5.12d)
 TORQUE_SIDES = 8
@@ -268,7 +269,8 @@ class HorizonPlanner:
     Build it once; :meth:`solve` then takes one tick's :class:`HorizonInput`.
 
     Args:
-        scene: the terrain (its regions) and, unless ``robot`` is given, the robot.
+        scene: a scene (its regions and, unless ``robot`` is given, its robot) or a bare
+            :class:`~footfall.terrain.terrain.Terrain` with ``robot``.
         robot: the biped's parameters (reach, T_ss, T_ds, K, U_max, ...).
         options: horizon, weights, gap, node limit.
         clock: the clock that times a solve (``time.perf_counter``; tests inject their own).
@@ -276,14 +278,20 @@ class HorizonPlanner:
 
     def __init__(
         self,
-        scene: Scene,
+        scene: Scene | Terrain,
         robot: BipedParams | None = None,
         options: HorizonOptions | None = None,
         clock: Callable[[], float] = time.perf_counter,
     ) -> None:
-        if not isinstance(scene, Scene):
-            raise InputError("scene", scene, "a footfall.terrain.Scene")
-        robot = scene.robot if robot is None else robot
+        if isinstance(scene, Scene):
+            terrain = scene.terrain
+            robot = scene.robot if robot is None else robot
+        elif isinstance(scene, Terrain):
+            terrain = scene
+            if robot is None:
+                raise InputError("robot", robot, "the robot's parameters with a bare terrain")
+        else:
+            raise InputError("scene", scene, "a footfall.terrain.Scene or Terrain")
         if not isinstance(robot, BipedParams):
             raise InputError("robot", robot, "a footfall.models.BipedParams")
         options = HorizonOptions() if options is None else options
@@ -292,7 +300,7 @@ class HorizonPlanner:
         import daqp  # a dependency; imported here so that reading plans does not need it
 
         self._daqp = daqp
-        self.scene, self.robot, self.options, self.clock = scene, robot, options, clock
+        self.terrain, self.robot, self.options, self.clock = terrain, robot, options, clock
         self.h = options.horizon
         self.blocks = robot.n_nodes - 1
         self.nu = 2 * self.h * self.blocks
@@ -303,7 +311,7 @@ class HorizonPlanner:
         self._ar, self._br = alip.reset_map(robot.t_ds)
         self._first: tuple[float, FloatArray, FloatArray] = (robot.node_dt, self._ad, self._bd)
         self.regions: list[_Region] = []
-        for region in scene.terrain:
+        for region in terrain:
             a_poly, b_poly = region.halfspaces()
             v3 = region.vertices3d
             self.regions.append(
@@ -320,7 +328,7 @@ class HorizonPlanner:
         self._names = [r.name for r in self.regions]
         self._lo = np.array([r.lo for r in self.regions])  # (R, 3) region boxes
         self._hi = np.array([r.hi for r in self.regions])
-        self._box = scene.terrain.bounds()
+        self._box = terrain.bounds()
 
     # ---------------------------------------------------------------- indices
     def u_index(self, step: int, block: int) -> int:
@@ -807,7 +815,7 @@ def horizon_problem(planner: HorizonPlanner, inp: HorizonInput) -> MIQCQP:
     alip = rb.alip()
     b = ProblemBuilder()
     u = b.add_vars("u", (h, blocks, 2), lb=-rb.u_max, ub=rb.u_max)
-    lo_box, hi_box = planner.scene.terrain.bounds()
+    lo_box, hi_box = planner.terrain.bounds()
     p = b.add_vars("p", (h, 3), lb=lo_box, ub=hi_box)
     x = b.add_vars("x", (h, blocks + 1, 4))
     x_final = b.add_vars("x_final", (4,))
@@ -883,7 +891,7 @@ def horizon_problem(planner: HorizonPlanner, inp: HorizonInput) -> MIQCQP:
             )
             b.add_square({int(p[j, k]): 1.0}, float(inp.footsteps_ref[j, k]), opt.track, "track")
         side = side.other
-    terrain = list(planner.scene.terrain)
+    terrain = list(planner.terrain)
     hreg = b.add_binaries("H", (h, len(terrain)))
     for j in range(h):
         b.add_eq({int(v): 1.0 for v in hreg[j]}, 1.0, f"5.12j one region {j}")

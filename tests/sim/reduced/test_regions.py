@@ -5,6 +5,7 @@ metrics)."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -49,6 +50,8 @@ def test_region_aware_needs_the_python_engine_and_the_regions(stones) -> None:  
         SimOptions(region_aware="planned", engine="compiled")
     with pytest.raises(InputError, match="region_aware"):
         SimOptions(region_aware="everywhere")
+    with pytest.raises(InputError, match="engine"):
+        SimOptions(region_aware="horizon", engine="compiled")
     with pytest.raises(InputError, match="regions"):
         simulate(plan, SimOptions(region_aware="planned"))
     res = simulate(first_steps(plan, 2), SimOptions(region_aware="planned"), regions=regions)
@@ -62,7 +65,7 @@ def test_a_sideways_push_leaves_the_stones_free_but_not_region_aware(stones) -> 
     assert off, "the push must send a free footstep off its stone"
     assert free.metrics.footsteps_off_regions == len(off)
     assert set(free.metrics.region_changes) >= set(off)
-    for mode in ("planned", "nearby"):
+    for mode in ("planned", "nearby", "horizon"):
         res = simulate(plan, SimOptions(pushes=(PUSH,), region_aware=mode), regions=regions)
         assert _off_stones(res.footsteps, regions) == []
         assert res.metrics.footsteps_off_regions == 0
@@ -71,3 +74,31 @@ def test_a_sideways_push_leaves_the_stones_free_but_not_region_aware(stones) -> 
             d = np.abs(res.footsteps[j, :2] - plan.footsteps[j, :2])
             sole_half = np.array([plan.robot.foot_length, plan.robot.foot_width]) / 2
             assert np.all(d <= STONE_HALF - sole_half + 1e-9), (mode, j)
+
+
+def test_horizon_mode_asks_the_short_horizon_miqp_and_keeps_the_feet_on_the_stones() -> None:
+    """narrow_stones_gap with a 10 N s push to the left: with ``horizon`` the region of every
+    next footstep comes from the 3-footstep MIQP (its solves counted; the plan's region only in
+    the last three phases), and every landed footstep stands on a stone (shapely)."""
+    from footfall.sim.reduced import regions as reduced_regions
+
+    scene = builtin_scene("narrow_stones_gap")
+    plan = plan_reactive(scene)
+    regions = tuple(scene.terrain)
+    made: list[reduced_regions.RegionFeet] = []
+    orig = reduced_regions.RegionFeet.__post_init__
+
+    def spy(self: reduced_regions.RegionFeet) -> None:
+        orig(self)
+        made.append(self)
+
+    push = Push.horizontal(1.05, 10.0, np.pi / 2, 0.1)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(reduced_regions.RegionFeet, "__post_init__", spy)
+        res = simulate(plan, SimOptions(pushes=(push,), region_aware="horizon"), regions=regions)
+    assert len(made) == 1 and not res.metrics.fell
+    # a solve at the first tick of every phase with three footsteps ahead, and every 10 ticks
+    ticks = round(plan.robot.t_ss * 500.0)
+    assert made[0].horizon_solves == (plan.n_steps - 3 + 1) * math.ceil(ticks / 10)
+    assert _off_stones(res.footsteps, regions) == []
+    assert res.metrics.footsteps_off_regions == 0

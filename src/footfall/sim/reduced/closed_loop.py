@@ -74,7 +74,7 @@ from footfall.models.biped import BipedParams
 from footfall.planning.plan import FootstepPlan
 from footfall.results.reduced import SimMetrics, SimResult
 from footfall.sim.disturbance import Push
-from footfall.sim.reduced.regions import RegionFeet, region_metrics
+from footfall.sim.reduced.regions import HORIZON_MODE, RegionFeet, region_metrics
 from footfall.terrain.region import Region
 
 #: ways to run the loop (:attr:`SimOptions.engine`)
@@ -83,6 +83,11 @@ ENGINES = ("auto", "compiled", "python")
 
 #: highest MPC rate [Hz]: the loop stores a sample per tick, so memory grows with the rate
 MAX_CONTROL_RATE = 10_000.0
+
+
+#: region modes of this loop: the walker's, and ``horizon`` (the short-horizon MIQP picks the
+#: region of the next footstep, :mod:`footfall.sim.reduced.regions`)
+SIM_REGION_MODES = (*REGION_MODES, HORIZON_MODE)
 
 
 @dataclass(frozen=True)
@@ -111,8 +116,10 @@ class SimOptions:
             and the solver is ``newton``).
         region_aware: ``off`` (document 000: the MPC moves the footstep freely), ``planned``
             or ``nearby``: the footstep is kept in its planned region inset by the sole, or in
-            the best region within reach (:mod:`footfall.sim.reduced.regions`; needs the scene's
-            regions, runs the python engine).
+            the best region within reach; ``horizon``: in the region that the short-horizon
+            MIQP (:class:`footfall.planning.HorizonPlanner`, 3 footsteps from the measured state)
+            chooses, re-solved every ``HORIZON_EVERY`` ticks (:mod:`footfall.sim.reduced.regions`;
+            every mode but ``off`` needs the scene's regions and runs the python engine).
     """
 
     control_rate: float = 500.0
@@ -164,8 +171,10 @@ class SimOptions:
             raise InputError("solver", self.solver, f"one of {', '.join(SOLVERS)}")
         if self.engine not in ENGINES:
             raise InputError("engine", self.engine, f"one of {', '.join(ENGINES)}")
-        if self.region_aware not in REGION_MODES:
-            raise InputError("region_aware", self.region_aware, f"one of {', '.join(REGION_MODES)}")
+        if self.region_aware not in SIM_REGION_MODES:
+            raise InputError(
+                "region_aware", self.region_aware, f"one of {', '.join(SIM_REGION_MODES)}"
+            )
         if self.engine == "compiled" and self.region_aware != "off":
             raise InputError(
                 "engine",

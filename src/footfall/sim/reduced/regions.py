@@ -2,8 +2,12 @@
 
 Document 000's MPC (eq. 5.19) moves the next footstep freely; with ``SimOptions.region_aware``
 the reduced-order loop instead solves it with the footstep kept in its planned region inset by
-the sole (``planned``) or in the best region within reach (``nearby``), through
-:class:`footfall.control.region_mpc.RegionMPC`. The loop then runs in Python (the compiled
+the sole (``planned``), in the best region within reach (``nearby``), or in the region that the
+short-horizon footstep MIQP chooses for it looking three footsteps ahead from the measured state
+(``horizon``: :class:`footfall.planning.HorizonPlanner`, re-solved every ``HORIZON_EVERY`` ticks
+and at a phase's first tick, warm-started from its last regions), through
+:class:`footfall.control.region_mpc.RegionMPC`. Near the end of the plan, where fewer than three
+footsteps are left, ``horizon`` keeps the planned region. The loop then runs in Python (the compiled
 kernel has no region rows). The region metrics (footsteps landed off every region, region
 changes) are computed for any run given the scene's regions.
 """
@@ -12,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -21,7 +26,12 @@ from footfall.control.mpc import MPC, MPCSolution
 from footfall.control.region_mpc import RegionMPC, RegionRows, region_rows, regions_in_reach
 from footfall.planning.plan import FootstepPlan
 from footfall.terrain.region import Region
-from footfall.terrain.terrain import region_of
+from footfall.terrain.terrain import Terrain, region_of
+
+#: the region mode that asks the short-horizon MIQP
+HORIZON_MODE = "horizon"
+#: ticks between two short-horizon solves in ``horizon`` mode (10 at 500 Hz: 50 Hz)
+HORIZON_EVERY = 10
 
 
 @dataclass
@@ -45,6 +55,9 @@ class RegionFeet:
     foot_length: float
     foot_width: float
     choices: dict[int, str] = field(default_factory=dict)
+    #: ``horizon`` mode: the short-horizon solves made and the ticks whose choice differed from
+    #: the plan's region
+    horizon_solves: int = 0
     _nearby: dict[int, tuple[str, ...]] = field(default_factory=dict, repr=False)
     _rows: dict[tuple[int, str], RegionRows] = field(default_factory=dict, repr=False)
 
@@ -55,6 +68,40 @@ class RegionFeet:
         self._robot = replace(
             self.plan.robot, foot_length=self.foot_length, foot_width=self.foot_width
         )
+        self._horizon: Any = None
+        self._horizon_last: Any = None
+        self._horizon_pick: dict[int, str] = {}
+        if self.mode == HORIZON_MODE:
+            from footfall.planning.horizon import HorizonPlanner
+
+            self._horizon = HorizonPlanner(Terrain(tuple(self.regions)), self.plan.robot)
+
+    def _horizon_region(self, i: int, k: int, theta: FloatArray, stance: FloatArray) -> str | None:
+        """The region the short-horizon MIQP puts footstep ``i + 1`` in (None: keep the plan's).
+
+        Solved at a phase's first tick and every ``HORIZON_EVERY`` ticks from the measured state
+        ``theta[:4]``; between solves the last choice holds."""
+        from footfall.planning.horizon import horizon_input
+
+        h = self._horizon.h
+        if i + h > self.plan.n_steps:
+            return None
+        if k % HORIZON_EVERY and i in self._horizon_pick:
+            return self._horizon_pick[i]
+        ticks = self.mpc.model.n_ticks
+        time_left = (ticks - k) * self.mpc.model.control_dt
+        foot = np.array([stance[0], stance[1], float(self.plan.footsteps[i][2])])
+        inp = horizon_input(self.plan, i, time_left, np.asarray(theta[:4], dtype=float), h)
+        inp = replace(inp, stance_foot=foot)
+        last = self._horizon_last
+        warm = None if last is None else last.next_regions(stepped=k == 0)
+        sol = self._horizon.solve(inp, warm=warm)
+        self.horizon_solves += 1
+        self._horizon_last = sol if sol.has_solution else None
+        if not sol.has_solution:
+            return self._horizon_pick.get(i)
+        self._horizon_pick[i] = sol.regions[0]
+        return sol.regions[0]
 
     def solve(
         self, i: int, k: int, theta: FloatArray, stance: FloatArray, p_ref: FloatArray
@@ -63,6 +110,8 @@ class RegionFeet:
         plan = self.plan
         planned = plan.regions[i + 1]
         first = self.choices.get(i) or planned
+        if self.mode == HORIZON_MODE:
+            first = self._horizon_region(i, k, theta, stance) or first
         names = [first]
         if self.mode == "nearby":
             if i not in self._nearby:
