@@ -49,12 +49,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--times", default="0.9,1.05,1.2,1.35", help="push start times [s]")
     ap.add_argument("--directions", default="0,90,180,270", help="push directions [deg]")
     ap.add_argument("--out", type=Path, default=Path("out/horizon_loop"))
+    ap.add_argument("--summary-only", action="store_true", help="re-summarise OUT/walks.json")
     args = ap.parse_args(argv)
     impulses = [float(v) for v in args.impulses.split(",")]
     times = [float(v) for v in args.times.split(",")]
     dirs = [float(v) for v in args.directions.split(",")]
-    rows = []
-    for name in args.scenes.split(","):
+    rows: list[dict] = []  # type: ignore[type-arg]
+    if args.summary_only:
+        rows = json.loads((args.out / "walks.json").read_text())
+    for name in [] if args.summary_only else args.scenes.split(","):
         scene = builtin_scene(name)
         plan = plan_reactive(scene)
         regions = tuple(scene.terrain)
@@ -79,7 +82,8 @@ def main(argv: list[str] | None = None) -> int:
                 )
                 print(json.dumps(rows[-1]), flush=True)
     args.out.mkdir(parents=True, exist_ok=True)
-    (args.out / "walks.json").write_text(json.dumps(rows, indent=1) + "\n")
+    if not args.summary_only:
+        (args.out / "walks.json").write_text(json.dumps(rows, indent=1) + "\n")
     lines = [
         "| scene | impulse [N s] | " + " | ".join(f"{m}: no fall (95 % CI)" for m in MODES) + " |",
         "|---|---|" + "---|" * len(MODES),
@@ -105,6 +109,22 @@ def main(argv: list[str] | None = None) -> int:
                     f"{name} {imp:g} N s: {a} alone survived {a_only}, {b} alone {b_only} "
                     f"(sign test p = {p:.3g})"
                 )
+    # pooled over scenes and impulses: the unit is (scene, impulse, time, direction)
+    by = {
+        m: {(r["scene"], r["impulse"], r["time"], r["direction"]): not r["fell"] for r in rows
+            if r["mode"] == m}
+        for m in MODES
+    }  # fmt: skip
+    for a, b in (("horizon", "planned"), ("horizon", "nearby"), ("nearby", "planned")):
+        a_only = sum(by[a][c] and not by[b][c] for c in by[a])
+        b_only = sum(by[b][c] and not by[a][c] for c in by[a])
+        p = binomtest(a_only, a_only + b_only).pvalue if a_only + b_only else 1.0
+        n = len(by[a])
+        pairs.append(
+            f"all {n} conditions: {a} {sum(by[a].values())}/{n} survived, {b} "
+            f"{sum(by[b].values())}/{n}; {a} alone {a_only}, {b} alone {b_only} "
+            f"(sign test p = {p:.3g})"
+        )
     text = "\n".join(lines) + "\n\n" + "\n".join(pairs) + "\n"
     (args.out / "summary.md").write_text(text)
     print(text)
