@@ -127,7 +127,12 @@ def main(argv: list[str] | None = None) -> int:
                           "| scip", scip["status"], scip["objective"], scip["time_s"],
                           flush=True)  # fmt: skip
                 rec = done[name]
-                if rec["scip"].get("model") != "direct" and rec["scip"]["status"] != "optimal":
+                if "model" not in rec["scip"] and rec["scip"]["status"] != "infeasible":
+                    # an earlier build's SCIP result through plan_footsteps: past its checks
+                    # (which only ever answer "infeasible") it hands the whole model to SCIP
+                    # unchanged, the direct solve
+                    rec["scip"]["model"] = "direct"
+                if rec["scip"].get("model") != "direct":
                     # an earlier build took SCIP's infeasibility through plan_footsteps' checks
                     rec["scip"] = _solve(scene, n, "scip", args.scip_limit)
                     with log.open("a") as fh:

@@ -632,7 +632,9 @@ def test_make_suite_output_reads_and_runs(tmp_path: Path) -> None:
     assert (inst.name, inst.status, inst.n_steps) == ("corridor-00-n05", "optimal", 5)
     assert (inst.heading_segments, inst.region_margin) == (HEADING_SEGMENTS, 0.0)
     assert inst.objective == bnb["objective"]  # the lower of the two
-    assert inst.certificate == {"bnb": bnb, "scip": scip}
+    # a record without "model" that is not a proof of infeasibility is labelled: past
+    # plan_footsteps' checks SCIP got the whole model
+    assert inst.certificate == {"bnb": bnb, "scip": {**scip, "model": "direct"}}
     assert (tmp_path / inst.scene).read_text() == scene_to_yaml(scene)
     (run,) = run_suite(tmp_path, threads=1)
     assert run.agrees and run.status == "optimal"
@@ -642,3 +644,52 @@ def test_make_suite_output_reads_and_runs(tmp_path: Path) -> None:
         entry = _entry("corridor-00-n05", "corridor", 0, 5, "open", objective, bound)
         (run,) = run_suite(_write_suite(tmp_path / f"open{agrees}", [entry]), threads=1)
         assert (run.status, run.certified, run.agrees) == ("optimal", "open", agrees)
+
+
+# --- the shipped suite --------------------------------------------------------------------------
+SHIPPED = ROOT / "benchmarks" / "suite"
+
+
+def test_the_shipped_suite_is_whole_and_its_certificates_hold_together() -> None:
+    """benchmarks/suite: at least 30 certified instances in eight families; every scene file is
+    the family generator's terrain; every certificate is two proven results that agree (the
+    suite's rule recomputed here from the solvers' records, not read from ``status``)."""
+    from footfall.terrain.suite_families import SUITE_FAMILIES
+
+    gap, instances = load_suite(SHIPPED)
+    certified = [i for i in instances if i.status in ("optimal", "infeasible")]
+    assert len(certified) >= 30
+    assert {i.family for i in instances} == set(SUITE_FAMILIES)
+    for inst in instances:
+        text = (SHIPPED / inst.scene).read_text(encoding="utf-8")
+        assert text == scene_to_yaml(suite_terrain(inst.family, inst.seed)), inst.name
+        bnb, scip = inst.certificate["bnb"], inst.certificate["scip"]
+        assert scip["model"] == "direct", inst.name
+        if inst.status == "infeasible":
+            assert bnb["status"] == scip["status"] == "infeasible", inst.name
+        elif inst.status == "optimal":
+            assert bnb["status"] == scip["status"] == "optimal", inst.name
+            a, b = bnb["objective"], scip["objective"]
+            assert abs(a - b) <= 2 * gap * min(abs(a), abs(b)) + 1e-9, inst.name
+            assert inst.objective == min(a, b)
+        else:  # open: not two agreeing proofs
+            assert not bnb["status"] == scip["status"] == "infeasible", inst.name
+            if bnb["status"] == scip["status"] == "optimal":
+                a, b = bnb["objective"], scip["objective"]
+                assert abs(a - b) > 2 * gap * min(abs(a), abs(b)) + 1e-9, inst.name
+
+
+def test_the_shipped_suite_solves_to_its_certificates() -> None:
+    """The quickest certified instance of every family, solved again by bnb, agrees."""
+    _, instances = load_suite(SHIPPED)
+    quickest: dict[str, Any] = {}
+    for inst in instances:
+        if inst.status == "open":
+            continue
+        t = inst.certificate["bnb"]["time_s"] or 0.0
+        if inst.family not in quickest or t < quickest[inst.family][0]:
+            quickest[inst.family] = (t, inst.name)
+    names = [name for _, name in quickest.values()]
+    runs = run_suite(SHIPPED, solver="bnb", threads=1, names=names)
+    assert len(runs) == len(quickest)
+    assert all(r.agrees for r in runs), [r for r in runs if not r.agrees]
