@@ -25,21 +25,12 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import binomtest
 
+from footfall.experiments.study.stats import wilson
 from footfall.planning.reactive import plan_reactive
 from footfall.sim import Push, SimOptions, simulate
 from footfall.terrain import builtin_scene
 
 MODES = ("planned", "nearby", "horizon")
-
-
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    if n == 0:
-        return (math.nan, math.nan)
-    p = k / n
-    den = 1 + z * z / n
-    mid = (p + z * z / (2 * n)) / den
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
-    return (mid - half, mid + half)
 
 
 def main(argv: list[str] | None = None) -> int:

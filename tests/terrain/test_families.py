@@ -24,6 +24,7 @@ from footfall.terrain.families import (
 )
 from footfall.terrain.region import Region
 from footfall.terrain.scene import Scene, load_scene, scene_to_dict, scene_to_yaml
+from tests.terrain.shapes import level, rect
 
 FAMILIES = ("discrete_steps", "stairs_slope_gap")
 SEEDS = range(40)
@@ -34,27 +35,11 @@ DRAW = 0.0005 + 1e-9
 DIFF = 0.001 + 1e-9
 
 
-def _rect(r: Region) -> tuple[float, float, float, float]:
-    """(x_min, x_max, y_min, y_max) of a region that is an axis-aligned rectangle in plan view."""
-    v = np.asarray(r.vertices)
-    assert v.shape == (4, 2), r.name
-    xs, ys = sorted(set(v[:, 0].tolist())), sorted(set(v[:, 1].tolist()))
-    assert len(xs) == 2 and len(ys) == 2, f"{r.name} is not an axis-aligned rectangle"
-    return xs[0], xs[1], ys[0], ys[1]
-
-
-def _flat_height(r: Region) -> float:
-    """The height of a level region: every corner at the same z."""
-    z = np.asarray(r.vertices3d)[:, 2]
-    assert np.all(z == z[0]), f"{r.name} is not level: {z}"
-    return float(z[0])
-
-
 def _inside(p: Any, r: Region) -> bool:
     """A point on a level rectangle, by hand."""
-    x0, x1, y0, y1 = _rect(r)
+    x0, x1, y0, y1 = rect(r)
     x, y, z = (float(c) for c in p)
-    return x0 <= x <= x1 and y0 <= y <= y1 and abs(z - _flat_height(r)) <= 1e-12
+    return x0 <= x <= x1 and y0 <= y <= y1 and abs(z - level(r)) <= 1e-12
 
 
 def _within(value: float, rng: tuple[float, float], slack: float) -> bool:
@@ -119,8 +104,8 @@ def test_discrete_steps_geometry(seed: int) -> None:
         "goal_floor",
     ]
     assert r.blocks[0] <= n <= r.blocks[1]
-    rects = [_rect(g) for g in regions]
-    heights = [_flat_height(g) for g in regions]
+    rects = [rect(g) for g in regions]
+    heights = [level(g) for g in regions]
     assert heights[0] == 0.0 and heights[-1] == 0.0
     for k in range(1, n + 1):
         x0, x1, y0, y1 = rects[k]
@@ -168,7 +153,7 @@ def test_stairs_slope_gap_geometry(seed: int) -> None:
     ]
     # the slope: its angle from the 3-D corners at its two ends
     slope = by["slope"]
-    sx0, sx1, _, _ = _rect(slope)
+    sx0, sx1, _, _ = rect(slope)
     corners = np.asarray(slope.vertices3d)
     low = corners[corners[:, 0] == sx0]
     high = corners[corners[:, 0] == sx1]
@@ -179,19 +164,19 @@ def test_stairs_slope_gap_geometry(seed: int) -> None:
     assert _within(angle, r.slope_angle, 0.05), angle
     assert _within(sx1 - sx0, r.slope_length, DRAW)
     assert abs(z_low) <= 1e-9  # it starts at the floor...
-    top = _flat_height(by["top"])
+    top = level(by["top"])
     assert abs(z_high - top) <= 1e-9  # ...and ends at the top landing
     # the stairs: from the top to the ledge in equal risers
     steps = ["top", *(f"stair{k}" for k in range(1, n_stairs + 1)), "ledge"]
-    heights = np.array([_flat_height(by[s]) for s in steps])
-    assert heights[-1] == 0.0 and _flat_height(by["landing"]) == 0.0
+    heights = np.array([level(by[s]) for s in steps])
+    assert heights[-1] == 0.0 and level(by["landing"]) == 0.0
     risers = -np.diff(heights)
     assert np.all(risers > 0)
     assert np.all(risers <= r.riser[1] + 1e-4), risers
     # each stored height is rounded to 0.1 mm, so each riser is within 0.1 mm of the mean one
     assert np.max(np.abs(risers - top / len(risers))) <= 1e-4 + 1e-12, risers
     # lengths along x
-    rects = [_rect(g) for g in regions]
+    rects = [rect(g) for g in regions]
     assert _within(rects[2][1] - rects[2][0], r.top_length, DRAW)
     for k in range(3, 3 + n_stairs):
         assert _within(rects[k][1] - rects[k][0], r.tread, DRAW), (k, rects[k])

@@ -26,6 +26,7 @@ from footfall.terrain.suite_families import (
     instance_terrain_name,
     suite_terrain,
 )
+from tests.terrain.shapes import level, rect
 
 FAMILIES = tuple(SUITE_FAMILIES)
 SEEDS = range(6)
@@ -43,22 +44,6 @@ MICRO = 1e-5
 @cache
 def _scene(family: str, seed: int) -> Scene:
     return suite_terrain(family, seed)
-
-
-def _rect(r: Region) -> tuple[float, float, float, float]:
-    """(x_min, x_max, y_min, y_max) of a region that is an axis-aligned rectangle in plan view."""
-    v = np.asarray(r.vertices)
-    assert v.shape == (4, 2), r.name
-    xs, ys = sorted(set(v[:, 0].tolist())), sorted(set(v[:, 1].tolist()))
-    assert len(xs) == 2 and len(ys) == 2, f"{r.name} is not an axis-aligned rectangle"
-    return xs[0], xs[1], ys[0], ys[1]
-
-
-def _level(r: Region) -> float:
-    """The height of a level region: every corner at the same z."""
-    z = np.asarray(r.vertices3d)[:, 2]
-    assert np.ptp(z) <= 1e-12, f"{r.name} is not level: {z}"
-    return float(z[0])
 
 
 def _tilt_deg(r: Region) -> tuple[float, float, float]:
@@ -226,7 +211,7 @@ def test_stones(seed: int) -> None:
 
     scene = _scene("stones", seed)
     assert scene.terrain.names == ["start", "stone1", "stone2", "stone3", "stone4", "goal"]
-    heights = [_level(r) for r in scene.terrain]
+    heights = [level(r, 1e-12) for r in scene.terrain]
     assert heights[0] == 0.0
     assert all(abs(b - a) <= 0.10 + 1e-12 for a, b in pairwise(heights))
     for r in _numbered(scene, "stone"):
@@ -253,15 +238,15 @@ def test_cinder_blocks(seed: int) -> None:
     expected = [f"block{i + 1}{s}" for i in range(cols) for s in "rl"]
     assert names == ["start_floor", *expected, "goal_floor"]
     floor, goal = scene.terrain["start_floor"], scene.terrain["goal_floor"]
-    assert _level(floor) == 0.0 and _level(goal) == 0.0
-    edge = _rect(floor)[1]
+    assert level(floor, 1e-12) == 0.0 and level(goal, 1e-12) == 0.0
+    edge = rect(floor)[1]
     max_tilt = math.degrees(
         math.atan(math.hypot(math.tan(math.radians(10)), math.tan(math.radians(10))))
     )
     for i in range(cols):
         right, left = scene.terrain[f"block{i + 1}r"], scene.terrain[f"block{i + 1}l"]
-        rx0, rx1, ry0, ry1 = _rect(right)
-        lx0, lx1, ly0, ly1 = _rect(left)
+        rx0, rx1, ry0, ry1 = rect(right)
+        lx0, lx1, ly0, ly1 = rect(left)
         assert (rx0, rx1) == (lx0, lx1)  # one column
         assert _within(rx0 - edge, 0.03, 0.06, DIFF)  # gap along x to the previous column
         assert _within(rx1 - rx0, 0.28, 0.34, DIFF)
@@ -275,7 +260,7 @@ def test_cinder_blocks(seed: int) -> None:
             centre_z = float(block.height_at([(rx0 + rx1) / 2, (y0 + y1) / 2]))
             assert _within(centre_z, 0.0, 0.12, DRAW + MICRO), block.name
         edge = rx1
-    assert _within(_rect(goal)[0] - edge, 0.03, 0.06, DIFF)
+    assert _within(rect(goal)[0] - edge, 0.03, 0.06, DIFF)
     # the terrain is not flat: some block is tilted by more than a degree
     assert max(_tilt_deg(r)[2] for r in scene.terrain) > 1.0
 
@@ -291,7 +276,7 @@ def test_stairs(seed: int, up: bool) -> None:
     assert 2 <= len(steps) <= 4
     assert scene.terrain.names == ["floor", *(r.name for r in steps), "landing"]
     regions = list(scene.terrain)
-    heights = [_level(r) for r in regions]
+    heights = [level(r, 1e-12) for r in regions]
     assert heights[0] == 0.0
     risers = np.diff(heights[:-1])
     assert np.ptp(risers) <= 2e-6  # equal risers
@@ -301,7 +286,7 @@ def test_stairs(seed: int, up: bool) -> None:
     assert heights[-1] == heights[-2]  # the landing continues the top (bottom) step
     assert f"{abs(riser) * 1000:.0f} mm risers" in scene.description
     assert f"{len(steps)} stairs {'up' if up else 'down'}" in scene.description
-    rects = [_rect(r) for r in regions]
+    rects = [rect(r) for r in regions]
     widths = {round(y1 - y0, 9) for _, _, y0, y1 in rects}
     assert len(widths) == 1 and _within(widths.pop(), 0.7, 1.0, 2 * DRAW)
     for (_, x1, _, _), (x0, _, _, _) in pairwise(rects):
@@ -359,7 +344,7 @@ def test_spiral_stairs(seed: int) -> None:
     assert f"turning {'left' if left else 'right'}" in scene.description
     # walking +x from the origin, a left turn has its centre on the left (+y)
     assert (centres[0][1] > 0) == left
-    heights = [_level(r) for r in regions]
+    heights = [level(r, 1e-12) for r in regions]
     assert heights[0] == 0.0
     rises = np.diff(heights)
     assert np.ptp(rises) <= 2e-6 and _within(float(rises[0]), 0.05, 0.10, DRAW)
@@ -386,15 +371,15 @@ def test_gaps(seed: int) -> None:
     assert 2 <= len(pieces) <= 3
     assert scene.terrain.names == ["start_floor", *(r.name for r in pieces), "goal_floor"]
     regions = list(scene.terrain)
-    assert _level(regions[0]) == 0.0 and _level(regions[-1]) == 0.0
-    rects = [_rect(r) for r in regions]
+    assert level(regions[0], 1e-12) == 0.0 and level(regions[-1], 1e-12) == 0.0
+    rects = [rect(r) for r in regions]
     for (_, x1, _, _), (x0, _, _, _) in pairwise(rects):
         assert _within(x0 - x1, 0.08, 0.18, DIFF), (x1, x0)
     for r, (x0, x1, y0, y1) in zip(pieces, rects[1:-1], strict=True):
         assert _within(x1 - x0, 0.30, 0.40, DIFF)
         assert abs((y1 - y0) - 0.6) <= 1e-9
         assert _within((y0 + y1) / 2, -0.10, 0.10, DRAW)
-        assert _within(_level(r), -0.05, 0.05, DRAW)
+        assert _within(level(r, 1e-12), -0.05, 0.05, DRAW)
     # the start feet on the start floor, the goal on the goal floor
     assert scene.terrain.region_of(scene.goal.position) == "goal_floor"
 
@@ -405,10 +390,10 @@ def test_corridor(seed: int) -> None:
     0.4-0.7 m to the left or right, with the goal heading along the second leg."""
     scene = _scene("corridor", seed)
     assert scene.terrain.names == ["leg1", "corner", "leg2"]
-    assert all(_level(r) == 0.0 for r in scene.terrain)
-    ax0, ax1, ay0, ay1 = _rect(scene.terrain["leg1"])
-    cx0, cx1, cy0, cy1 = _rect(scene.terrain["corner"])
-    bx0, bx1, by0, by1 = _rect(scene.terrain["leg2"])
+    assert all(level(r, 1e-12) == 0.0 for r in scene.terrain)
+    ax0, ax1, ay0, ay1 = rect(scene.terrain["leg1"])
+    cx0, cx1, cy0, cy1 = rect(scene.terrain["corner"])
+    bx0, bx1, by0, by1 = rect(scene.terrain["leg2"])
     w = ay1 - ay0
     assert _within(w, 0.45, 0.70, DRAW)
     assert abs(ay0 + ay1) <= 1e-9  # centred on the feet
@@ -437,22 +422,22 @@ def test_ramps(seed: int) -> None:
     scene = _scene("ramps", seed)
     assert scene.terrain.names == ["start_floor", "ramp1", "ramp2", "goal_floor"]
     regions = list(scene.terrain)
-    assert _level(regions[0]) == 0.0
-    _level(regions[-1])
+    assert level(regions[0], 1e-12) == 0.0
+    level(regions[-1], 1e-12)
     for r in regions[1:3]:
-        x0, x1, y0, y1 = _rect(r)
+        x0, x1, y0, y1 = rect(r)
         assert _within(x1 - x0, 0.4, 0.6, DIFF)
         assert (y0, y1) == (-0.5, 0.5)
         pitch, roll, _ = _tilt_deg(r)
         assert _within(abs(pitch), 5.0, 12.0, ANGLE), (r.name, pitch)
         assert abs(roll) <= 6.0 + ANGLE, (r.name, roll)
     for r0, r1 in pairwise(regions):
-        x1, x0 = _rect(r0)[1], _rect(r1)[0]
+        x1, x0 = rect(r0)[1], rect(r1)[0]
         assert abs(x0 - x1) <= 1e-9, (r0.name, r1.name)
         z0, z1 = float(r0.height_at([x1, 0.0])), float(r1.height_at([x0, 0.0]))
         assert abs(z0 - z1) <= MICRO, (r0.name, r1.name, z0, z1)
     goal = np.asarray(scene.goal.position)
-    assert scene.terrain.region_of(goal) == "goal_floor" and goal[2] == _level(regions[-1])
+    assert scene.terrain.region_of(goal) == "goal_floor" and goal[2] == level(regions[-1], 1e-12)
 
 
 def test_families_are_the_documented_eight() -> None:

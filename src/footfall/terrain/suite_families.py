@@ -24,7 +24,7 @@ import numpy as np
 
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
-from footfall.terrain.families import MAX_SEED, START_HALF_STANCE, _box, _draw
+from footfall.terrain.families import START_HALF_STANCE, _box, _draw, _seed
 from footfall.terrain.region import Region
 from footfall.terrain.scene import (
     Goal,
@@ -35,16 +35,6 @@ from footfall.terrain.scene import (
     scene_to_yaml,
 )
 from footfall.terrain.terrain import Terrain
-
-
-def _seed(seed: object) -> int:
-    if (
-        isinstance(seed, bool)
-        or not isinstance(seed, int | np.integer)
-        or not 0 <= seed <= MAX_SEED
-    ):
-        raise InputError("seed", seed, f"an integer in [0, {MAX_SEED}]")
-    return int(seed)
 
 
 def _start() -> Start:
