@@ -241,13 +241,6 @@ class _Region:
 
 
 @dataclass
-class _Node:
-    bound: float
-    assigned: tuple[int, ...]
-    z: FloatArray
-
-
-@dataclass
 class _Qp:
     """The condensed problem of one call: cost ``1/2 z^T H z + f^T z + c`` and the rows that do not
     depend on the regions (``lo <= A z <= hi``; ``eq`` marks equalities)."""
