@@ -7,8 +7,8 @@ short-horizon footstep MIQP chooses for it looking three footsteps ahead from th
 (``horizon``: :class:`footfall.planning.HorizonPlanner`, re-solved every ``HORIZON_EVERY`` ticks
 and at a phase's first tick, warm-started from its last regions), through
 :class:`footfall.control.region_mpc.RegionMPC`. Near the end of the plan, where fewer than three
-footsteps are left, ``horizon`` keeps the planned region. The loop then runs in Python (the compiled
-kernel has no region rows). The region metrics (footsteps landed off every region, region
+footsteps are left, ``horizon`` keeps the planned region. The loop then runs in Python (the
+compiled kernel has no region rows). The region metrics (footsteps landed off every region, region
 changes) are computed for any run given the scene's regions.
 """
 
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -27,6 +27,9 @@ from footfall.control.region_mpc import RegionMPC, RegionRows, region_rows, regi
 from footfall.planning.plan import FootstepPlan
 from footfall.terrain.region import Region
 from footfall.terrain.terrain import Terrain, region_of
+
+if TYPE_CHECKING:
+    from footfall.planning.horizon import HorizonPlanner, HorizonSolution
 
 #: the region mode that asks the short-horizon MIQP
 HORIZON_MODE = "horizon"
@@ -55,8 +58,7 @@ class RegionFeet:
     foot_length: float
     foot_width: float
     choices: dict[int, str] = field(default_factory=dict)
-    #: ``horizon`` mode: the short-horizon solves made and the ticks whose choice differed from
-    #: the plan's region
+    #: ``horizon`` mode: the short-horizon solves made
     horizon_solves: int = 0
     _nearby: dict[int, tuple[str, ...]] = field(default_factory=dict, repr=False)
     _rows: dict[tuple[int, str], RegionRows] = field(default_factory=dict, repr=False)
@@ -68,8 +70,8 @@ class RegionFeet:
         self._robot = replace(
             self.plan.robot, foot_length=self.foot_length, foot_width=self.foot_width
         )
-        self._horizon: Any = None
-        self._horizon_last: Any = None
+        self._horizon: HorizonPlanner | None = None
+        self._horizon_last: HorizonSolution | None = None
         self._horizon_pick: dict[int, str] = {}
         if self.mode == HORIZON_MODE:
             from footfall.planning.horizon import HorizonPlanner
@@ -83,6 +85,7 @@ class RegionFeet:
         ``theta[:4]``; between solves the last choice holds."""
         from footfall.planning.horizon import horizon_input
 
+        assert self._horizon is not None  # horizon mode only
         h = self._horizon.h
         if i + h > self.plan.n_steps:
             return None
