@@ -64,7 +64,9 @@ def bench_plan_cmd(
     """Direct SCIP model vs the fast planner on the same instances: a table of times and gaps.
 
     With --horizon H: the short-horizon MIQP's latency per tick (warm-started, cold, and SCIP on
-    the same problem at the first tick of every step) along each scene's walk."""
+    the same problem at the first tick of every step) along each scene's walk. With --suite DIR:
+    every instance of the suite solved by --solver at the suite's own gap, each result compared
+    with its certificate (exit 1 when one disagrees)."""
     from footfall.experiments.bench import bench_plan, format_table, rows_to_dict
 
     if suite is not None and horizon:
