@@ -61,6 +61,7 @@ from footfall._validate import finite, finite_array, positive
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import FootstepPlan, PlannerWeights
+from footfall.solvers.base import relative_gap
 from footfall.solvers.problem import MIQCQP, ProblemBuilder
 from footfall.terrain.scene import Scene
 from footfall.terrain.terrain import Terrain
@@ -674,7 +675,7 @@ class HorizonPlanner:
                 t0,
                 msg,
             )
-        gap = _gap(inc_obj, bound)
+        gap = relative_gap(inc_obj, bound)
         if limit_hit:
             status, msg = (
                 "node_limit",
@@ -693,7 +694,7 @@ class HorizonPlanner:
         """True when a node of ``bound`` cannot improve ``inc`` by more than the relative gap."""
         if not math.isfinite(inc):
             return False
-        return bound >= inc or _gap(inc, bound) <= gap
+        return bound >= inc or relative_gap(inc, bound) <= gap
 
     def _distance(self, r: int, z: FloatArray | None, step: int) -> float:
         """How far the relaxed footstep ``step`` lies outside region ``r`` (child order)."""
@@ -729,7 +730,7 @@ class HorizonPlanner:
             steps = z[self.nu :].reshape(h, 3).copy()
             torques = z[: self.nu].reshape(h, self.blocks, 2).copy()
             final = qp.terminal[:, :nz] @ z + qp.terminal[:, nz]
-            gap = _gap(objective, bound)
+            gap = relative_gap(objective, bound)
         return HorizonSolution(
             status=status,
             footsteps=steps,
@@ -744,17 +745,6 @@ class HorizonPlanner:
             solve_time=self.clock() - t0,
             message=message,
         )
-
-
-def _gap(objective: float, bound: float) -> float:
-    """SCIP's relative gap ``(objective - bound) / min(|objective|, |bound|)``."""
-    if not (math.isfinite(objective) and math.isfinite(bound)):
-        return math.inf
-    diff = max(objective - bound, 0.0)
-    if diff == 0.0:
-        return 0.0
-    den = min(abs(objective), abs(bound))
-    return diff / den if den > 0.0 else math.inf
 
 
 def horizon_input(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
@@ -13,6 +14,17 @@ from numpy.typing import NDArray
 from footfall._validate import non_negative, positive
 from footfall.errors import InputError
 from footfall.solvers.settings import BnbSettings
+
+
+def relative_gap(objective: float, bound: float) -> float:
+    """SCIP's relative gap ``(objective - bound) / min(|objective|, |bound|)`` of a minimisation:
+    0 when the bound reaches the objective, inf without an objective or with a zero denominator."""
+    if not math.isfinite(objective):
+        return math.inf
+    if objective <= bound:
+        return 0.0
+    denom = min(abs(objective), abs(bound))
+    return math.inf if denom == 0.0 else (objective - bound) / denom
 
 
 class SolveStatus(str, Enum):

@@ -19,7 +19,13 @@ from typing import Any
 import numpy as np
 
 from footfall._typing import FloatArray
-from footfall.solvers.base import SolveProgress, SolverOptions, SolverResult, SolveStatus
+from footfall.solvers.base import (
+    SolveProgress,
+    SolverOptions,
+    SolverResult,
+    SolveStatus,
+    relative_gap,
+)
 from footfall.solvers.bnb import probing
 from footfall.solvers.bnb.branching import _branch, _choice, _dive, _finish, _Node, _root_allowed
 from footfall.solvers.bnb.model import _Structure
@@ -144,12 +150,7 @@ class _Search:
     # ---------------------------------------------------------------------------------- search
     def gap_of(self, bound: float) -> float:
         """Relative gap of the incumbent against ``bound`` (SCIP's definition)."""
-        if not math.isfinite(self.inc_obj):
-            return math.inf
-        if self.inc_obj <= bound:
-            return 0.0
-        denom = min(abs(self.inc_obj), abs(bound))
-        return math.inf if denom == 0.0 else (self.inc_obj - bound) / denom
+        return relative_gap(self.inc_obj, bound)
 
     def evaluate(
         self,
