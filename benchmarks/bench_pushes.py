@@ -5,6 +5,11 @@ Run (from the repository root, about 10-20 minutes on 2 cores)::
     OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_pushes.py \\
         --controllers wbc,servo --impulses 4,6,8,10,12,15 --seeds 10 --seed-start 0 --out out/pushes
 
+``--region-aware planned,horizon`` walks every case once per region mode of the walker's MPC
+(:attr:`footfall.sim.biped.options.WalkOptions.region_aware`) and adds a paired comparison of each
+mode against the first: walks that only one mode survived, and the exact two-sided sign test
+(McNemar's exact test) on them.
+
 Every walk follows the scene's miqcqp plan (``plan_for_walk``, cached in ``OUT/plans``) with one
 horizontal push of ``impulse`` N s over 0.1 s, its direction, step and phase drawn from the seed
 (:meth:`footfall.sim.disturbance.Disturbance.of_seed`, the draw of ``footfall walk --seed`` and
@@ -52,7 +57,7 @@ def crossing(levels: list[float], rates: list[float], level: float = 0.5) -> str
     return f"> {levels[-1]:g}"
 
 
-def _walk(job: tuple[str, str, float, int, str]) -> dict[str, object]:
+def _walk(job: tuple[str, str, str, float, int, str]) -> dict[str, object]:
     from footfall.sim.biped.options import WalkOptions
     from footfall.sim.biped.plans import plan_for_walk
     from footfall.sim.biped.trial import MujocoBipedPlant
@@ -60,14 +65,15 @@ def _walk(job: tuple[str, str, float, int, str]) -> dict[str, object]:
     from footfall.sim.trial import run_trial
     from footfall.terrain.scene import builtin_scene
 
-    scene_name, controller, impulse, seed, cache = job
+    scene_name, controller, region, impulse, seed, cache = job
     scene = builtin_scene(scene_name)
     plan = plan_for_walk(scene, "miqcqp", SCENES[scene_name], 600.0, Path(cache))
-    plant = MujocoBipedPlant(WalkOptions(controller=controller))
+    plant = MujocoBipedPlant(WalkOptions(controller=controller, region_aware=region))
     out = run_trial(plant, scene, plan, Disturbance.of_seed(seed, impulse=impulse))
     return {
         "scene": scene_name,
         "controller": controller,
+        "region_aware": region,
         "impulse_Ns": impulse,
         "seed": seed,
         "success": out.success,
@@ -79,10 +85,36 @@ def _walk(job: tuple[str, str, float, int, str]) -> dict[str, object]:
     }
 
 
+def _paired(rows: list[dict[str, object]], modes: list[str]) -> None:
+    """Each region mode against the first, paired by (scene, controller, impulse, seed): the
+    walks only one of the two survived and the exact two-sided sign test on them."""
+    from scipy.stats import binomtest
+
+    ok = {
+        (r["scene"], r["controller"], r["impulse_Ns"], r["seed"], r["region_aware"]): bool(
+            r["success"]
+        )
+        for r in rows
+    }
+    keys = sorted({k[:4] for k in ok}, key=str)
+    print(f"\n| mode vs {modes[0]} | pairs | both | only {modes[0]} | only mode | p (sign test) |")
+    print("|---|---|---|---|---|---|")
+    for mode in modes[1:]:
+        a = [ok[(*k, modes[0])] for k in keys]
+        b = [ok[(*k, mode)] for k in keys]
+        only_a = sum(x and not y for x, y in zip(a, b, strict=True))
+        only_b = sum(y and not x for x, y in zip(a, b, strict=True))
+        both = sum(x and y for x, y in zip(a, b, strict=True))
+        n = only_a + only_b
+        p = binomtest(only_b, n).pvalue if n else 1.0
+        print(f"| {mode} | {len(keys)} | {both} | {only_a} | {only_b} | {p:.3g} |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--controllers", default="wbc,servo")
     ap.add_argument("--scenes", default=",".join(SCENES))
+    ap.add_argument("--region-aware", default="planned", help="region modes, comma-separated")
     ap.add_argument("--impulses", default="4,6,8,10,12,15", help="push impulses [N s]")
     ap.add_argument("--seeds", type=int, default=10, help="walks per scene, controller, impulse")
     ap.add_argument("--seed-start", type=int, default=0, help="first seed (held-out seeds)")
@@ -92,40 +124,53 @@ def main() -> None:
     levels = sorted(float(x) for x in a.impulses.split(","))
     scenes = a.scenes.split(",")
     controllers = a.controllers.split(",")
+    modes = a.region_aware.split(",")
+    variants = [(ctl, mode) for ctl in controllers for mode in modes]
     a.out.mkdir(parents=True, exist_ok=True)
     cache = str(a.out / "plans")
     jobs = [
-        (sc, ctl, imp, seed, cache)
+        (sc, ctl, mode, imp, seed, cache)
         for sc in scenes
-        for ctl in controllers
+        for ctl, mode in variants
         for imp in levels
         for seed in range(a.seed_start, a.seed_start + a.seeds)
     ]
     # plan once per scene before the pool (the cache then serves every worker)
     for sc in scenes:
-        _walk((sc, controllers[0], levels[0], 0, cache))
+        _walk((sc, controllers[0], modes[0], levels[0], 0, cache))
     with Pool(a.workers) as pool:
         rows = pool.map(_walk, jobs, chunksize=1)
     with (a.out / "pushes.csv").open("w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    print("| scene | controller | " + " | ".join(f"{x:g} N s" for x in levels) + " | 50 % at |")
-    print("|---|---|" + "---|" * len(levels) + "---|")
+    print(
+        "| scene | controller | region mode | "
+        + " | ".join(f"{x:g} N s" for x in levels)
+        + " | 50 % at |"
+    )
+    print("|---|---|---|" + "---|" * len(levels) + "---|")
     for sc in scenes:
-        for ctl in controllers:
+        for ctl, mode in variants:
             cells, rates = [], []
             for imp in levels:
                 rs = [
                     r
                     for r in rows
-                    if (r["scene"], r["controller"], r["impulse_Ns"]) == (sc, ctl, imp)
+                    if (r["scene"], r["controller"], r["region_aware"], r["impulse_Ns"])
+                    == (sc, ctl, mode, imp)
                 ]
                 k = sum(bool(r["success"]) for r in rs)
                 lo, hi = wilson(k, len(rs))
                 rates.append(k / len(rs))
                 cells.append(f"{k}/{len(rs)} [{100 * lo:.0f}-{100 * hi:.0f} %]")
-            print(f"| {sc} | {ctl} | " + " | ".join(cells) + f" | {crossing(levels, rates)} N s |")
+            print(
+                f"| {sc} | {ctl} | {mode} | "
+                + " | ".join(cells)
+                + f" | {crossing(levels, rates)} N s |"
+            )
+    if len(modes) > 1:
+        _paired(rows, modes)
     wall = sum(float(r["wall_s"]) for r in rows)
     sim = sum(float(r["sim_s"]) for r in rows)
     print(f"\n{len(rows)} walks, {sim / wall:.1f}x real time per walk (mean over workers)")

@@ -39,9 +39,8 @@ if TYPE_CHECKING:
 _REGION_HELP = (
     "How the MPC keeps the next footstep on the terrain: off (document 000: free; "
     "the MuJoCo walker keeps a uniform margin inside the planned region), planned (in the planned "
-    "region inset by the sole, same QP), nearby (or the best region within reach); the "
-    "reduced-order loop also takes horizon (the region that the 3-footstep MIQP from the "
-    "measured state chooses)."
+    "region inset by the sole, same QP), nearby (or the best region within reach), horizon "
+    "(the region that the 3-footstep MIQP from the measured state chooses, re-solved at 50 Hz)."
 )
 
 

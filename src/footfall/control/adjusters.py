@@ -18,6 +18,7 @@ import numpy as np
 
 from footfall._geometry import inset_polygon, project_to_polygon, rot2
 from footfall._typing import FloatArray
+from footfall.control.horizon_regions import HORIZON_MODE, HorizonRegions
 from footfall.control.mpc import MPC, MPCWeights, build_mpc
 from footfall.control.region_mpc import RegionMPC, RegionRows, region_rows, regions_in_reach
 from footfall.errors import InputError
@@ -38,7 +39,7 @@ SOLE_TORQUE_SHARE = 0.9
 #: boundary (the first lateral step of the reactive plan lies on it), so no margin
 REACH_MARGIN = 0.0
 #: ways the MPC adjuster keeps the footstep on the terrain (:attr:`MPCAdjuster.region_aware`)
-REGION_MODES = ("off", "planned", "nearby")
+REGION_MODES = ("off", "planned", "nearby", HORIZON_MODE)
 #: another region is chosen over the preferred one when its eq. (5.19a) cost is lower by more
 #: than this: the cost of a 10 cm footstep deviation at the default W (MPCWeights.w = 10)
 SWITCH_MARGIN = 0.1
@@ -376,7 +377,11 @@ class MPCAdjuster(PlanFollower):
             ``nearby``: as ``planned``, and when that region has no footstep the sole fits, or
             another region within reach (its polygon meets the reach trapezoid of the stance
             foot, its height within ``step_height_max``) costs less by ``switch_margin``, the
-            footstep goes there. :attr:`choices` records each phase's decision.
+            footstep goes there; ``horizon``: as ``planned``, in the region the short-horizon
+            footstep MIQP chooses from the measured state, three footsteps ahead
+            (:class:`footfall.control.horizon_regions.HorizonRegions`, 50 Hz; the last choice,
+            else the plan's region, where it has none). :attr:`choices` records each phase's
+            decision.
         landing_margin: extra inset [m] of the regions beyond the sole (``region_aware``).
         switch_margin: cost margin of a region switch (``nearby``).
     """
@@ -410,6 +415,10 @@ class MPCAdjuster(PlanFollower):
         mdl = build_mpc(self.plan.robot, self.weights, self.control_dt, None, self.torque_limits)
         self.mpc = MPC(mdl)
         self.region_mpc = RegionMPC(self.mpc)
+        self.horizon: HorizonRegions | None = None
+        if self.region_aware == HORIZON_MODE:
+            regions = tuple(self.regions.values())
+            self.horizon = HorizonRegions(self.plan, regions, mdl.control_dt)
 
     def update(
         self, t: float, state: FloatArray, stance: FloatArray, phase: int
@@ -436,7 +445,7 @@ class MPCAdjuster(PlanFollower):
         if phase in self._frozen and self.hold_frozen:
             return self._frozen[phase], self._frozen_torque[phase]
         if self.region_aware != "off" and phase not in self._frozen:
-            target, u = self._region_aware(t, phase, args, rot, stance, ref_next)
+            target, u = self._region_aware(t, phase, args, rot, state, stance, ref_next)
             target = self._maybe_freeze(t, phase, target)
             if phase in self._frozen:
                 self._frozen_torque[phase] = u
@@ -466,15 +475,22 @@ class MPCAdjuster(PlanFollower):
         phase: int,
         args: tuple[int, FloatArray, FloatArray, FloatArray, FloatArray],
         rot: FloatArray,
+        state: FloatArray,
         stance: FloatArray,
         ref_next: FloatArray,
     ) -> tuple[FloatArray, FloatArray]:
-        """Footstep and torque of the region-aware MPC (``region_aware`` planned / nearby)."""
+        """Footstep and torque of the region-aware MPC (``region_aware`` planned / nearby /
+        horizon); ``state`` (4,) is the measured ALIP state, ``args`` the MPC's in the stance
+        heading's frame."""
         plan = self.plan
         k_s, x_r, ps_r, pr_r, xn_r = args
         planned = plan.regions[phase + 1]
         first = self.choices[phase].region if phase in self.choices else planned
         first = first or planned
+        if self.horizon is not None:
+            mdl = self.mpc.model
+            time_left = (mdl.n_ticks - k_s) * mdl.control_dt
+            first = self.horizon.choose(phase, k_s, time_left, state, stance) or first
         names = [first]
         if self.region_aware == "nearby":
             names += [n for n in self._regions_nearby(phase, stance) if n != first]

@@ -58,6 +58,45 @@ def test_region_aware_walk_keeps_every_footstep_on_a_stone() -> None:
     assert 0.0 < m.correction_m.max < 0.1
 
 
+def test_horizon_mode_walks_the_stones_asking_the_short_horizon_miqp() -> None:
+    """``horizon``: the next footstep's region comes from the 3-footstep MIQP (its solves counted
+    by a spy: at least one per phase with three footsteps ahead), the walk with a 2 N s push
+    reaches the goal and every landed sole centre is on a stone (shapely)."""
+    from footfall.control import horizon_regions
+
+    scene = builtin_scene("stepping_stones")
+    plan = load_plan(PLAN, scene)
+    calls: list[int] = []
+    orig = horizon_regions.HorizonRegions.choose
+
+    def spy(self: horizon_regions.HorizonRegions, phase: int, *args: object) -> str | None:
+        before = self.solves
+        out = orig(self, phase, *args)  # type: ignore[arg-type]
+        if self.solves > before:
+            calls.append(phase)
+        return out
+
+    opts = WalkOptions(region_aware="horizon")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(horizon_regions.HorizonRegions, "choose", spy)
+        outcome = run_trial(
+            MujocoBipedPlant(opts), scene, plan, Disturbance.of_seed(0, impulse=2.0)
+        )
+    m = outcome.detail.metrics
+    assert not m.fell and m.reached_goal
+    # every phase with three footsteps of the walker's plan (stopping steps included) ahead asked
+    n = plan.n_steps + opts.stop_steps
+    assert set(calls) == set(range(n - 3 + 1))
+    landed = outcome.detail.trace.landed[~np.isnan(outcome.detail.trace.landed[:, 0])]
+    for p in landed:
+        assert any(
+            Polygon(r.vertices).covers(Point(p[:2]))
+            and abs(float(r.height_at(p[:2])) - p[2]) <= ON_SURFACE_TOL
+            for r in scene.terrain.regions
+        ), p
+    assert m.footsteps_off_regions == 0
+
+
 def test_bad_region_mode_names_the_field() -> None:
     from footfall.errors import InputError
 

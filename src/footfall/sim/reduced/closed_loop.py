@@ -74,7 +74,7 @@ from footfall.models.biped import BipedParams
 from footfall.planning.plan import FootstepPlan
 from footfall.results.reduced import SimMetrics, SimResult
 from footfall.sim.disturbance import Push
-from footfall.sim.reduced.regions import HORIZON_MODE, RegionFeet, region_metrics
+from footfall.sim.reduced.regions import RegionFeet, region_metrics
 from footfall.terrain.region import Region
 
 #: ways to run the loop (:attr:`SimOptions.engine`)
@@ -85,9 +85,8 @@ ENGINES = ("auto", "compiled", "python")
 MAX_CONTROL_RATE = 10_000.0
 
 
-#: region modes of this loop: the walker's, and ``horizon`` (the short-horizon MIQP picks the
-#: region of the next footstep, :mod:`footfall.sim.reduced.regions`)
-SIM_REGION_MODES = (*REGION_MODES, HORIZON_MODE)
+#: region modes of this loop: the MuJoCo walker's (:data:`footfall.control.adjusters.REGION_MODES`)
+SIM_REGION_MODES = REGION_MODES
 
 
 @dataclass(frozen=True)
@@ -118,7 +117,7 @@ class SimOptions:
             or ``nearby``: the footstep is kept in its planned region inset by the sole, or in
             the best region within reach; ``horizon``: in the region that the short-horizon
             MIQP (:class:`footfall.planning.HorizonPlanner`, 3 footsteps from the measured state)
-            chooses, re-solved every ``HORIZON_EVERY`` ticks (:mod:`footfall.sim.reduced.regions`;
+            chooses, re-solved at 50 Hz (:mod:`footfall.control.horizon_regions`;
             every mode but ``off`` needs the scene's regions and runs the python engine).
     """
 

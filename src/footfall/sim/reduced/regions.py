@@ -4,8 +4,8 @@ Document 000's MPC (eq. 5.19) moves the next footstep freely; with ``SimOptions.
 the reduced-order loop instead solves it with the footstep kept in its planned region inset by
 the sole (``planned``), in the best region within reach (``nearby``), or in the region that the
 short-horizon footstep MIQP chooses for it looking three footsteps ahead from the measured state
-(``horizon``: :class:`footfall.planning.HorizonPlanner`, re-solved every ``HORIZON_EVERY`` ticks
-and at a phase's first tick, warm-started from its last regions), through
+(``horizon``: :class:`footfall.control.horizon_regions.HorizonRegions`, re-solved at 50 Hz and at
+a phase's first tick, warm-started from its last regions), through
 :class:`footfall.control.region_mpc.RegionMPC`. Near the end of the plan, where fewer than three
 footsteps are left, ``horizon`` keeps the planned region. The loop then runs in Python (the
 compiled kernel has no region rows). The region metrics (footsteps landed off every region, region
@@ -16,25 +16,17 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from footfall._typing import FloatArray
 from footfall.control.adjusters import SWITCH_MARGIN
+from footfall.control.horizon_regions import HORIZON_MODE, HorizonRegions
 from footfall.control.mpc import MPC, MPCSolution
 from footfall.control.region_mpc import RegionMPC, RegionRows, region_rows, regions_in_reach
 from footfall.planning.plan import FootstepPlan
 from footfall.terrain.region import Region
-from footfall.terrain.terrain import Terrain, region_of
-
-if TYPE_CHECKING:
-    from footfall.planning.horizon import HorizonPlanner, HorizonSolution
-
-#: the region mode that asks the short-horizon MIQP
-HORIZON_MODE = "horizon"
-#: ticks between two short-horizon solves in ``horizon`` mode (10 at 500 Hz: 50 Hz)
-HORIZON_EVERY = 10
+from footfall.terrain.terrain import region_of
 
 
 @dataclass
@@ -44,7 +36,7 @@ class RegionFeet:
     Attributes:
         plan: the plan walked.
         regions: the scene's regions.
-        mode: ``planned`` or ``nearby``.
+        mode: ``planned``, ``nearby`` or ``horizon``.
         mpc: the loop's MPC (its counters and warm starts are shared).
         foot_length: sole length [m] of the inset.
         foot_width: sole width [m].
@@ -58,8 +50,6 @@ class RegionFeet:
     foot_length: float
     foot_width: float
     choices: dict[int, str] = field(default_factory=dict)
-    #: ``horizon`` mode: the short-horizon solves made
-    horizon_solves: int = 0
     _nearby: dict[int, tuple[str, ...]] = field(default_factory=dict, repr=False)
     _rows: dict[tuple[int, str], RegionRows] = field(default_factory=dict, repr=False)
 
@@ -70,41 +60,16 @@ class RegionFeet:
         self._robot = replace(
             self.plan.robot, foot_length=self.foot_length, foot_width=self.foot_width
         )
-        self._horizon: HorizonPlanner | None = None
-        self._horizon_last: HorizonSolution | None = None
-        self._horizon_pick: dict[int, str] = {}
-        if self.mode == HORIZON_MODE:
-            from footfall.planning.horizon import HorizonPlanner
+        self._horizon = (
+            HorizonRegions(self.plan, self.regions, self.mpc.model.control_dt)
+            if self.mode == HORIZON_MODE
+            else None
+        )
 
-            self._horizon = HorizonPlanner(Terrain(tuple(self.regions)), self.plan.robot)
-
-    def _horizon_region(self, i: int, k: int, theta: FloatArray, stance: FloatArray) -> str | None:
-        """The region the short-horizon MIQP puts footstep ``i + 1`` in (None: keep the plan's).
-
-        Solved at a phase's first tick and every ``HORIZON_EVERY`` ticks from the measured state
-        ``theta[:4]``; between solves the last choice holds."""
-        from footfall.planning.horizon import horizon_input
-
-        assert self._horizon is not None  # horizon mode only
-        h = self._horizon.h
-        if i + h > self.plan.n_steps:
-            return None
-        if k % HORIZON_EVERY and i in self._horizon_pick:
-            return self._horizon_pick[i]
-        ticks = self.mpc.model.n_ticks
-        time_left = (ticks - k) * self.mpc.model.control_dt
-        foot = np.array([stance[0], stance[1], float(self.plan.footsteps[i][2])])
-        inp = horizon_input(self.plan, i, time_left, np.asarray(theta[:4], dtype=float), h)
-        inp = replace(inp, stance_foot=foot)
-        last = self._horizon_last
-        warm = None if last is None else last.next_regions(stepped=k == 0)
-        sol = self._horizon.solve(inp, warm=warm)
-        self.horizon_solves += 1
-        self._horizon_last = sol if sol.has_solution else None
-        if not sol.has_solution:
-            return self._horizon_pick.get(i)
-        self._horizon_pick[i] = sol.regions[0]
-        return sol.regions[0]
+    @property
+    def horizon_solves(self) -> int:
+        """``horizon`` mode: the short-horizon solves made (0 in the other modes)."""
+        return 0 if self._horizon is None else self._horizon.solves
 
     def solve(
         self, i: int, k: int, theta: FloatArray, stance: FloatArray, p_ref: FloatArray
@@ -113,8 +78,11 @@ class RegionFeet:
         plan = self.plan
         planned = plan.regions[i + 1]
         first = self.choices.get(i) or planned
-        if self.mode == HORIZON_MODE:
-            first = self._horizon_region(i, k, theta, stance) or first
+        if self._horizon is not None:
+            model = self.mpc.model
+            foot = np.array([stance[0], stance[1], float(plan.footsteps[i][2])])
+            time_left = (model.n_ticks - k) * model.control_dt
+            first = self._horizon.choose(i, k, time_left, theta[:4], foot) or first
         names = [first]
         if self.mode == "nearby":
             if i not in self._nearby:
