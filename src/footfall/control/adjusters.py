@@ -400,6 +400,7 @@ class MPCAdjuster(PlanFollower):
     choices: dict[int, RegionChoice] = field(default_factory=dict, repr=False)
     _frozen_torque: dict[int, FloatArray] = field(default_factory=dict, repr=False)
     _nearby: dict[int, tuple[str, ...]] = field(default_factory=dict, repr=False)
+    _frames: dict[int, tuple[FloatArray, FloatArray]] = field(default_factory=dict, repr=False)
     _row_cache: dict[tuple[int, str], tuple[FloatArray, RegionRows]] = field(
         default_factory=dict, repr=False
     )
@@ -432,8 +433,7 @@ class MPCAdjuster(PlanFollower):
         # Solve in the stance foot's heading frame: the ALIP and the cost are isotropic, so this
         # changes nothing but the orientation of the torque ellipse, whose long axis must lie
         # along the sole.
-        rot = rot2(float(plan.headings[phase]))
-        rot4 = np.kron(np.eye(2), rot)
+        rot, rot4 = self._stance_frame(phase)
         region = self.regions.get(plan.regions[phase + 1])
         args = (
             k_s,
@@ -468,6 +468,16 @@ class MPCAdjuster(PlanFollower):
         if phase in self._frozen:
             self._frozen_torque[phase] = u
         return target, u
+
+    def _stance_frame(self, phase: int) -> tuple[FloatArray, FloatArray]:
+        """The stance heading's rotation (2, 2) of ``phase`` and its ALIP-state form (4, 4)
+        (``kron(I_2, rot)``: positions and momenta turn alike), made once per phase."""
+        hit = self._frames.get(phase)
+        if hit is None:
+            rot = rot2(float(self.plan.headings[phase]))
+            hit = (rot, np.kron(np.eye(2), rot))
+            self._frames[phase] = hit
+        return hit
 
     def _region_aware(
         self,

@@ -50,6 +50,10 @@ class SwingState:
     apex_for: FloatArray = field(default_factory=lambda: np.zeros(3))
     #: the target (3,) [m] the swing path heads for (rate-limited toward the MPC's footstep)
     target: FloatArray = field(default_factory=lambda: np.zeros(3))
+    #: the landing sole's rotation (3, 3): on the next footstep's plane, along its heading
+    rot1: FloatArray = field(default_factory=lambda: np.eye(3))
+    #: ``rot1`` pitched for the heel strike, the swing's end orientation (3, 3)
+    rot1_strike: FloatArray = field(default_factory=lambda: np.eye(3))
 
 
 @dataclass

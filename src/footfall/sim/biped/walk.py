@@ -357,6 +357,9 @@ class BipedWalk:
         )
         swing.apex_for = np.array(target, dtype=float)
         swing.target = np.array(target, dtype=float)
+        # the landing orientation depends on the phase only: once per step, not per tick
+        swing.rot1 = foot_rotation(self.normals[i + 1], plan.headings[i + 1])
+        swing.rot1_strike = swing.rot1 @ pitch_about_y(-self.opts.heel_strike)
 
     def _limit_target(self, nxt: FloatArray) -> FloatArray:
         """Move the swing target toward the MPC's footstep ``nxt`` (3,) [m] by at most
@@ -431,12 +434,11 @@ class BipedWalk:
         pos, s_h = swing_reference(
             tau, swing.start, nxt, swing.apex, swing.rise, swing.descend, stance, gap
         )
-        rot1 = foot_rotation(self.normals[i + 1], plan.headings[i + 1])
-        rot = blend_rot(swing.rot0, rot1 @ pitch_about_y(-opts.heel_strike), s_h)
+        rot = blend_rot(swing.rot0, swing.rot1_strike, s_h)
         targets = {stance_side: (stance, feet.rot[stance_side]), swing_side: (pos, rot)}
         yaw = float(plan.headings[i] + (plan.headings[i + 1] - plan.headings[i]) * 0.5 * s_h)
         if tp + self.dt >= self.t_ss - 1e-9:
-            feet.rot[swing_side] = rot1
+            feet.rot[swing_side] = swing.rot1
         return targets, yaw
 
     def _double_support(self, i: int, stance: FloatArray) -> tuple[FloatArray, SolePoses, float]:
