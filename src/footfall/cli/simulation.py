@@ -544,7 +544,8 @@ def walk_cmd(
     from footfall.control.adjusters import REGION_MODES
     from footfall.planning.plan import check_planner_name
     from footfall.results.walk import walk_report
-    from footfall.sim.biped.options import WalkOptions
+    from footfall.sim.biped.model import planner_params
+    from footfall.sim.biped.options import WalkOptions, check_start_soles
     from footfall.sim.biped.plans import plan_for_walk, robot_model
     from footfall.sim.biped.trial import MujocoBipedPlant
     from footfall.sim.replay import REPLAY_FILE, ReplayRecorder, biped_traces
@@ -563,6 +564,8 @@ def walk_cmd(
     )
     model = robot_model(robot)
     sc = resolve_scene_arguments(scene_file, scene)
+    # before planning: a start the robot cannot stand on is refused now, not after minutes
+    check_start_soles(sc, planner_params(model, base=sc.robot))
     files = ("plan.json", "walk.json", "walk.png", "walk.mp4", REPLAY_FILE)
     logs = [log_json] if log_json else []
     refuse_inputs_as_outputs(

@@ -702,6 +702,7 @@ def random_stepping_stones(
     min_gap: float = 0.03,
     forward_min: float = 0.10,
     margin: float = 0.02,
+    pad_ahead: float = 0.05,
 ) -> Scene:
     """Seeded random stepping-stone scene, reachable by construction (for benchmarks).
 
@@ -723,13 +724,23 @@ def random_stepping_stones(
         min_gap: smallest distance between non-overlapping regions [m].
         forward_min: smallest forward component of a step [m] (keeps the chain moving on).
         margin: distance of the sampled step from the trapezoid edges [m].
+        pad_ahead: how far the start pad reaches ahead of the start feet [m]. The default
+            0.05 m keeps the first stone within one step for the planner's benchmarks, but
+            leaves the front of a 0.2 m sole over the edge: a walker standing on its soles
+            needs at least half its sole length (:func:`footfall.sim.biped.options.
+            check_start_soles`).
     """
     robot = _check_stones(seed, n_regions, robot, max_turn, max_rise)
+    if not (math.isfinite(pad_ahead) and 0.0 < pad_ahead <= 0.5):
+        raise InputError("pad_ahead", pad_ahead, "a distance in (0, 0.5] m")
     rng = np.random.default_rng(int(seed))
     half_w = robot.stance_width / 2
     left, right = np.array([0.0, half_w, 0.0]), np.array([0.0, -half_w, 0.0])
-    # The pad ends just ahead of the feet so that the first stone can be within one step.
-    regions = [Region.from_height("start", 0.0, _rect(np.array([-0.2, 0.0]), 0.5, 0.7, 0.0))]
+    # The pad ends just ahead of the feet (pad_ahead) so that the first stone can be within one
+    # step; its back edge stays at x = -0.45 (written so that the default's numbers are exact)
+    grow = pad_ahead - 0.05
+    pad = _rect(np.array([-0.2 + grow / 2, 0.0]), 0.5 + grow, 0.7, 0.0)
+    regions = [Region.from_height("start", 0.0, pad)]
     point, side, psi, z = right[:2].copy(), Side.RIGHT, 0.0, 0.0
     goal: Goal | None = None
     for k in range(int(n_regions) - 1):

@@ -29,6 +29,7 @@ from footfall.sim.biped.references import ds_propagator  # noqa: E402
 from footfall.sim.biped.walk import walk  # noqa: E402
 from footfall.sim.disturbance import Push  # noqa: E402
 from footfall.terrain import Goal, Region, builtin_scene  # noqa: E402
+from tests.cli import error_line, footfall  # noqa: E402
 
 #: exact arithmetic of the CoP formula
 COP_TOL = 1e-12
@@ -565,3 +566,48 @@ def test_a_plan_for_another_robot_is_refused_unless_asked_for() -> None:
     taller = replace(planner_params(base=scene.robot), com_height=0.80)
     with pytest.raises(InputError, match=r"plan\.robot\.com_height"):
         walk(scene, make_plan(scene, "reactive", robot=taller))
+
+
+# a start pad that ends 0.05 m ahead of the feet, as the planner benchmark's stepping stones: the
+# box biped's 0.2 m sole overhangs it by 0.1 - 0.05 = 0.05 m (a hand count)
+SHORT_PAD = """
+name: short_pad
+description: the start pad ends 5 cm ahead of the feet
+start: {left: [0, 0.1, 0], right: [0, -0.1, 0], heading: 0, stance: right}
+goal: {position: [1.0, 0, 0], heading: 0}
+regions:
+  - {name: start, height: 0.0, vertices: [[-0.45, -0.35], [0.05, -0.35], [0.05, 0.35], [-0.45, 0.35]]}
+  - {name: goal, height: 0.0, vertices: [[0.25, -0.35], [1.5, -0.35], [1.5, 0.35], [0.25, 0.35]]}
+"""
+
+
+def test_a_start_sole_over_the_pad_edge_is_refused(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """The walker stands on whole soles: a start foot whose sole overhangs every region by more
+    than START_OVERHANG_TOL is refused with the overhang (API: before the walk; CLI: exit 2
+    before any planning, nothing written); 1 cm of overhang is accepted."""
+    from footfall.models.biped import BipedParams
+    from footfall.sim.biped.options import START_OVERHANG_TOL, check_start_soles
+    from footfall.terrain import load_scene
+
+    path = tmp_path / "short_pad.yaml"
+    path.write_text(SHORT_PAD)
+    scene = load_scene(path)
+    robot = BipedParams()
+    assert robot.foot_length == pytest.approx(0.2)
+    with pytest.raises(InputError, match=r"scene\.start\.left.*0\.050 m beyond") as err:
+        check_start_soles(scene, robot)
+    assert err.value.field == "scene.start.left"
+    # a sole 8 cm long overhangs by 0.04 - 0.05 < 0: accepted; 0.12 m long: 0.01 m, at the limit
+    check_start_soles(scene, replace(robot, foot_length=0.08))
+    check_start_soles(scene, replace(robot, foot_length=0.1 + 2 * START_OVERHANG_TOL - 1e-9))
+    with pytest.raises(InputError):
+        check_start_soles(scene, replace(robot, foot_length=0.1 + 2 * START_OVERHANG_TOL + 1e-3))
+    # every built-in scene's start is accepted
+    for name in ("flat_long", "discrete_steps", "stairs_slope_gap", "stepping_stones"):
+        check_start_soles(builtin_scene(name), robot)
+
+    out = tmp_path / "out"
+    r = footfall("walk", "--scene", str(path), "--no-video", "--out", str(out), timeout=120)
+    line = error_line(r, "scene.start.left")
+    assert "0.050 m beyond" in line
+    assert not out.exists() or not any(out.iterdir())

@@ -11,12 +11,13 @@ import numpy as np
 from footfall._validate import check_fields, non_negative, positive
 from footfall.control.adjusters import REGION_MODES, STOP_STEPS
 from footfall.errors import InputError
-from footfall.models.biped import BipedParams
+from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import FootstepPlan
 from footfall.sim.biped.model import BipedModel, WalkerModel, measure_model
 from footfall.sim.biped.wbc import WbcGains
 from footfall.sim.disturbance import Push
 from footfall.terrain.scene import Scene
+from footfall.terrain.terrain import LANDING_Z_TOL
 
 #: landing error [m] the walk leaves room for at riser edges (:mod:`footfall.terrain.edges`):
 #: landings fall short of their targets, and a heel landing on the edge of the tread above a
@@ -27,6 +28,9 @@ CONTROLLERS = ("servo", "wbc")
 #: a plan's robot mass and CoM height may differ this much (relative) from the walker model's
 #: (:func:`~footfall.sim.biped.model.planner_params` measures them: 0.0 exactly)
 PLAN_ROBOT_RTOL = 0.01
+#: how far a start sole's corner may stand beyond every region [m] (the walker stands on the
+#: whole sole: past this, a robot standing still tips over the edge)
+START_OVERHANG_TOL = 0.01
 
 
 @dataclass(frozen=True)
@@ -238,5 +242,36 @@ def check_walk_inputs(
             plan.footsteps[0].tolist(),
             f"the scene's start stance foot {start_stance.tolist()}",
         )
+    check_start_soles(scene, plan.robot)
     if opts.check_robot:
         _check_plan_robot(plan.robot, model)
+
+
+def check_start_soles(scene: Scene, robot: BipedParams) -> None:
+    """Raise :class:`InputError` when a start sole (``robot``'s foot_length x foot_width at the
+    start heading) has a corner more than ``START_OVERHANG_TOL`` outside every region at its
+    height (``LANDING_Z_TOL``): the planner needs only the sole centres on the terrain, but the
+    walker stands on the soles before its first step."""
+    start = scene.start
+    c, s = math.cos(start.heading), math.sin(start.heading)
+    half_l, half_w = robot.foot_length / 2.0, robot.foot_width / 2.0
+    for side in Side:
+        foot = np.asarray(start.foot(side), dtype=float)
+        worst = 0.0
+        for sx, sy in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
+            dx, dy = sx * half_l, sy * half_w
+            corner = foot[:2] + np.array([c * dx - s * dy, s * dx + c * dy])
+            gaps = [
+                max(0.0, float(r.signed_distance(corner)))
+                for r in scene.terrain.regions
+                if abs(float(r.height_at(corner)) - float(foot[2])) <= LANDING_Z_TOL
+            ]
+            worst = max(worst, min(gaps, default=math.inf))
+        if worst > START_OVERHANG_TOL:
+            raise InputError(
+                f"scene.start.{side.value}",
+                foot.tolist(),
+                f"a start foot whose {robot.foot_length:.3g} x {robot.foot_width:.3g} m sole "
+                f"stands on the terrain (a corner is {worst:.3f} m beyond every region, at most "
+                f"{START_OVERHANG_TOL} m): move the foot or enlarge its region",
+            )

@@ -724,7 +724,9 @@ def walk(
 
     Raises:
         InputError: when the plan has no footsteps, does not start on the scene's start feet, or
-            was made for another robot's mass or CoM height (see ``WalkOptions.check_robot``).
+            was made for another robot's mass or CoM height (see ``WalkOptions.check_robot``),
+            or a start sole overhangs every region (more than
+            :data:`~footfall.sim.biped.options.START_OVERHANG_TOL`).
     """
     opts = options if options is not None else WalkOptions()
     check_walk_inputs(scene, plan, opts, model_params)
