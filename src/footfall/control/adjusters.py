@@ -472,12 +472,10 @@ class MPCAdjuster(PlanFollower):
     def _stance_frame(self, phase: int) -> tuple[FloatArray, FloatArray]:
         """The stance heading's rotation (2, 2) of ``phase`` and its ALIP-state form (4, 4)
         (``kron(I_2, rot)``: positions and momenta turn alike), made once per phase."""
-        hit = self._frames.get(phase)
-        if hit is None:
+        if phase not in self._frames:
             rot = rot2(float(self.plan.headings[phase]))
-            hit = (rot, np.kron(np.eye(2), rot))
-            self._frames[phase] = hit
-        return hit
+            self._frames[phase] = (rot, np.asarray(np.kron(np.eye(2), rot), dtype=float))
+        return self._frames[phase]
 
     def _region_aware(
         self,
