@@ -9,6 +9,7 @@ from footfall.control.adjusters import (
     extend_plan,
     sole_torque_limits,
 )
+from footfall.control.horizon_regions import HorizonRegions
 from footfall.control.mpc import (
     MPC,
     CondensedMPC,
@@ -24,6 +25,7 @@ __all__ = [
     "MPC",
     "CondensedMPC",
     "FootstepAdjuster",
+    "HorizonRegions",
     "MPCAdjuster",
     "MPCSolution",
     "MPCStatus",
