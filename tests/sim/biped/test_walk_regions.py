@@ -21,11 +21,21 @@ from footfall.sim.biped.trial import MujocoBipedPlant  # noqa: E402
 from footfall.sim.biped.walk import walk  # noqa: E402
 from footfall.sim.disturbance import Disturbance  # noqa: E402
 from footfall.sim.trial import run_trial  # noqa: E402
-from footfall.terrain import builtin_scene  # noqa: E402
+from footfall.terrain import Scene, builtin_scene  # noqa: E402
 
 PLAN = Path(__file__).parent / "data" / "stepping_stones_miqcqp.json"
 #: the measured sole centre sits this close to the stone's surface [m]
 ON_SURFACE_TOL = 0.03
+
+
+def _assert_on_regions(scene: Scene, landed: np.ndarray) -> None:
+    """Every landed sole centre (n, 3) inside a region's polygon (shapely) and on its surface."""
+    for p in landed:
+        assert any(
+            Polygon(r.vertices).covers(Point(p[:2]))
+            and abs(float(r.height_at(p[:2])) - p[2]) <= ON_SURFACE_TOL
+            for r in scene.terrain.regions
+        ), p
 
 
 def test_region_aware_walk_keeps_every_footstep_on_a_stone() -> None:
@@ -88,12 +98,7 @@ def test_horizon_mode_walks_the_stones_asking_the_short_horizon_miqp() -> None:
     n = plan.n_steps + opts.stop_steps
     assert set(calls) == set(range(n - 3 + 1))
     landed = outcome.detail.trace.landed[~np.isnan(outcome.detail.trace.landed[:, 0])]
-    for p in landed:
-        assert any(
-            Polygon(r.vertices).covers(Point(p[:2]))
-            and abs(float(r.height_at(p[:2])) - p[2]) <= ON_SURFACE_TOL
-            for r in scene.terrain.regions
-        ), p
+    _assert_on_regions(scene, landed)
     assert m.footsteps_off_regions == 0
 
 
@@ -153,12 +158,7 @@ def test_new_scenes_are_walked_with_every_footstep_on_a_region(name: str) -> Non
     res = walk(scene, plan, opts)
     assert not res.metrics.fell and res.metrics.reached_goal
     landed = res.trace.landed[~np.isnan(res.trace.landed[:, 0])]
-    for p in landed:
-        assert any(
-            Polygon(r.vertices).covers(Point(p[:2]))
-            and abs(float(r.height_at(p[:2])) - p[2]) <= ON_SURFACE_TOL
-            for r in scene.terrain.regions
-        ), p
+    _assert_on_regions(scene, landed)
     assert res.metrics.footsteps_off_regions == 0
 
 
