@@ -180,6 +180,7 @@ def test_summary_counts_and_largest_level() -> None:
         ({"dv": (0.1,), "phases": (1.2,)}, "phases"),
         ({"dv": (0.1,), "directions": ("up",)}, "directions"),
         ({"dv": (0.1,), "duration": 0.0}, "duration"),
+        ({"dv": (0.1,), "region_aware": "horizons"}, "region_aware"),
     ],
 )
 def test_protocol_refuses_bad_settings(kwargs: dict[str, object], field: str) -> None:
@@ -198,6 +199,7 @@ def test_protocol_refuses_bad_settings(kwargs: dict[str, object], field: str) ->
         (["--robot", "no_such_robot"], "robot"),
         (["--scene", "no_such_scene"], "scene"),
         (["--directions", "sideways"], "directions"),
+        (["--region-aware", "horizons"], "region_aware"),
     ],
 )
 def test_cli_refuses_bad_values(tmp_path: Path, args: list[str], field: str) -> None:
@@ -238,6 +240,19 @@ def test_cli_small_real_run(tmp_path: Path) -> None:
     assert f"largest dv passed: {want}" in r.stdout
     md = (out / "protocol.md").read_text()
     assert f"{passed}/2 pass" in md and md.rstrip().endswith("**")
+    assert "footstep regions planned" in md and "footstep regions planned" in r.stdout
+
     assert md.count("| forward |") == 1 and md.count("| outward |") == 1
     png = (out / "protocol.png").read_bytes()
     assert png.startswith(b"\x89PNG") and png.endswith(b"IEND\xaeB`\x82")
+
+
+def test_the_protocols_walker_takes_the_region_mode() -> None:
+    """The plant a protocol walks with has the protocol's region mode (the walker's options)."""
+    pytest.importorskip("mujoco")
+    from footfall.experiments import protocol as proto
+
+    for mode in ("planned", "horizon"):
+        plant = proto._plant("biped", "wbc", mode)
+        assert plant.options.region_aware == mode
+        assert plant.options.controller == "wbc"

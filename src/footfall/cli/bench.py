@@ -305,6 +305,12 @@ def bench_pushes_cmd(
     ),
     planner: str = typer.Option("miqcqp", help="miqcqp, kinematic or reactive."),
     controller: str = typer.Option("wbc", help="The walker's controller: wbc or servo."),
+    region_aware: str = typer.Option(
+        "planned",
+        "--region-aware",
+        help="How the walker's MPC keeps the next footstep on the terrain: off, planned, nearby "
+        "or horizon (the region the 3-footstep MIQP chooses from the measured state).",
+    ),
     dv: str = typer.Option("0.1,0.2,0.3", "--dv", help=_DV_HELP),
     phases: str = typer.Option(
         "0.2,0.45,0.7",
@@ -370,6 +376,7 @@ def bench_pushes_cmd(
         steps=steps,
         planner=planner,
         controller=controller,
+        region_aware=region_aware,
     )
     from footfall.robots.registry import resolve_robot_file
     from footfall.terrain.resolve import resolve_scene

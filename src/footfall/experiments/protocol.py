@@ -86,6 +86,8 @@ class PushProtocol:
         steps: footsteps N of the plan (None: the planner's smallest N).
         planner: ``miqcqp``, ``kinematic`` or ``reactive``.
         controller: the walker's controller (``wbc`` or ``servo``).
+        region_aware: how the walker's MPC keeps footsteps on the terrain
+            (:attr:`footfall.sim.biped.options.WalkOptions.region_aware`).
     """
 
     dv: tuple[float, ...]
@@ -98,8 +100,13 @@ class PushProtocol:
     steps: int | None = None
     planner: str = "miqcqp"
     controller: str = "wbc"
+    region_aware: str = "planned"
 
     def __post_init__(self) -> None:
+        from footfall.control.adjusters import REGION_MODES
+
+        if self.region_aware not in REGION_MODES:
+            raise InputError("region_aware", self.region_aware, f"one of {', '.join(REGION_MODES)}")
         dv = tuple(finite("dv [m/s]", v) for v in self.dv)
         if not dv or any(v <= 0 for v in dv) or len(set(dv)) != len(dv):
             raise InputError("dv [m/s]", list(self.dv), "distinct velocity changes > 0")
@@ -182,24 +189,33 @@ class ProtocolResult:
 
 
 @functools.lru_cache(maxsize=2)
-def _plant(robot: str, controller: str) -> Any:
-    """The MuJoCo plant of ``robot`` with ``controller`` (one per worker process)."""
+def _plant(robot: str, controller: str, region_aware: str) -> Any:
+    """The MuJoCo plant of ``robot`` with ``controller`` and the MPC's ``region_aware`` mode (one
+    per worker process)."""
     from footfall.sim.biped.options import WalkOptions
     from footfall.sim.biped.plans import robot_model
     from footfall.sim.trial import make_plant
 
     return make_plant(
-        "mujoco", options=WalkOptions(controller=controller), robot=robot_model(robot)
+        "mujoco",
+        options=WalkOptions(controller=controller, region_aware=region_aware),
+        robot=robot_model(robot),
     )
 
 
 def _walk_case(
-    robot: str, controller: str, scene: Any, plan: Any, case: PushCase, d: Disturbance
+    robot: str,
+    controller: str,
+    region_aware: str,
+    scene: Any,
+    plan: Any,
+    case: PushCase,
+    d: Disturbance,
 ) -> dict[str, Any]:
     """Walk one case; its row (:data:`COLUMNS`)."""
     from footfall.sim.trial import run_trial, trial_pushes
 
-    plant = _plant(robot, controller)
+    plant = _plant(robot, controller, region_aware)
     pushes = trial_pushes(plant, plan, d)
     out = run_trial(plant, scene, plan, d)
     reached = bool(out.detail.metrics.reached_goal)
@@ -262,7 +278,7 @@ def run_protocol(
         rows[case] = row
         if progress is not None:
             progress(row)
-    mass = float(_plant(protocol.robot, protocol.controller).mass(plan))
+    mass = float(_plant(protocol.robot, protocol.controller, protocol.region_aware).mass(plan))
     return ProtocolResult(
         protocol, scene.name, int(plan.n_steps), step, mass, [rows[c] for c in cases]
     )
@@ -275,7 +291,7 @@ def _walks(
     jobs: list[tuple[PushCase, Disturbance]],
     workers: int,
 ) -> Iterator[tuple[PushCase, dict[str, Any]]]:
-    args = (protocol.robot, protocol.controller, scene, plan)
+    args = (protocol.robot, protocol.controller, protocol.region_aware, scene, plan)
     if workers <= 1 or len(jobs) <= 1:
         for case, d in jobs:
             yield case, _walk_case(*args, case, d)
@@ -351,7 +367,8 @@ def format_summary(result: ProtocolResult) -> str:
     levels = summarise(result.rows)
     lines = [
         f"push protocol: {p.robot} ({result.mass:.3g} kg) on {result.scene_name}, N = "
-        f"{result.n_steps}, {p.planner}, {p.controller}; pushed single support {result.step}, "
+        f"{result.n_steps}, {p.planner}, {p.controller}, footstep regions {p.region_aware}; "
+        f"pushed single support {result.step}, "
         f"{p.duration:g} s pushes",
     ]
     for lv in levels:
@@ -373,7 +390,8 @@ def format_markdown(result: ProtocolResult) -> str:
         "# Push-recovery protocol",
         "",
         f"{p.robot} ({result.mass:.3g} kg) on {result.scene_name}, N = {result.n_steps} "
-        f"({p.planner}, {p.controller} controller). One push of {p.duration:g} s in single "
+        f"({p.planner}, {p.controller} controller, footstep regions {p.region_aware}). One push "
+        f"of {p.duration:g} s in single "
         f"support {result.step}, at a share of it (phase), in a direction relative to the stance "
         "foot (inward: toward its side); impulse = mass x dv. A case passes when the robot "
         "reaches the goal without falling.",
