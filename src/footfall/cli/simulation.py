@@ -541,7 +541,7 @@ def walk_cmd(
     if video:
         # headless offscreen rendering; MuJoCo picks its GL backend when it is first imported
         os.environ.setdefault("MUJOCO_GL", "egl")
-    from footfall.control.adjusters import REGION_MODES
+    from footfall.control.adjusters import check_region_mode
     from footfall.planning.plan import check_planner_name
     from footfall.results.walk import walk_report
     from footfall.sim.biped.model import planner_params
@@ -555,8 +555,7 @@ def walk_cmd(
 
     check_planner_name(planner)
     _check_controller(controller)
-    if region_aware not in REGION_MODES:
-        raise InputError("region_aware", region_aware, f"one of {', '.join(REGION_MODES)}")
+    check_region_mode(region_aware)
     if steps is not None and steps < 1:
         raise InputError("steps", steps, "an integer >= 1")
     disturbance = disturbance_of(

@@ -40,6 +40,16 @@ SOLE_TORQUE_SHARE = 0.9
 REACH_MARGIN = 0.0
 #: ways the MPC adjuster keeps the footstep on the terrain (:attr:`MPCAdjuster.region_aware`)
 REGION_MODES = ("off", "planned", "nearby", HORIZON_MODE)
+
+
+def check_region_mode(value: object) -> str:
+    """``value`` if it is one of :data:`REGION_MODES`, else :class:`InputError` naming
+    ``region_aware``."""
+    if not isinstance(value, str) or value not in REGION_MODES:
+        raise InputError("region_aware", value, f"one of {', '.join(REGION_MODES)}")
+    return value
+
+
 #: another region is chosen over the preferred one when its eq. (5.19a) cost is lower by more
 #: than this: the cost of a 10 cm footstep deviation at the default W (MPCWeights.w = 10)
 SWITCH_MARGIN = 0.1
@@ -406,8 +416,7 @@ class MPCAdjuster(PlanFollower):
     )
 
     def __post_init__(self) -> None:
-        if self.region_aware not in REGION_MODES:
-            raise InputError("region_aware", self.region_aware, f"one of {', '.join(REGION_MODES)}")
+        check_region_mode(self.region_aware)
         if not (math.isfinite(self.landing_margin) and self.landing_margin >= 0.0):
             raise InputError("landing_margin", self.landing_margin, "a finite number >= 0 [m]")
         if not (math.isfinite(self.switch_margin) and self.switch_margin >= 0.0):

@@ -52,6 +52,8 @@ class HorizonRegions:
     control_dt: float
     solves: int = 0
     failures: int = 0
+    #: control ticks between two solves
+    every: int = field(init=False)
     _planner: HorizonPlanner = field(init=False, repr=False)
     _last: HorizonSolution | None = field(default=None, init=False, repr=False)
     _pick: dict[int, str] = field(default_factory=dict, init=False, repr=False)

@@ -103,10 +103,9 @@ class PushProtocol:
     region_aware: str = "planned"
 
     def __post_init__(self) -> None:
-        from footfall.control.adjusters import REGION_MODES
+        from footfall.control.adjusters import check_region_mode
 
-        if self.region_aware not in REGION_MODES:
-            raise InputError("region_aware", self.region_aware, f"one of {', '.join(REGION_MODES)}")
+        check_region_mode(self.region_aware)
         dv = tuple(finite("dv [m/s]", v) for v in self.dv)
         if not dv or any(v <= 0 for v in dv) or len(set(dv)) != len(dv):
             raise InputError("dv [m/s]", list(self.dv), "distinct velocity changes > 0")

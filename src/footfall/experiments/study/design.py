@@ -169,10 +169,9 @@ class StudyDesign:
             self, "initial_impulse", non_negative("initial_impulse", self.initial_impulse)
         )
         object.__setattr__(self, "time_limit", positive("time_limit", self.time_limit))
-        from footfall.control.adjusters import REGION_MODES
+        from footfall.control.adjusters import check_region_mode
 
-        if not isinstance(self.region_aware, str) or self.region_aware not in REGION_MODES:
-            raise InputError("region_aware", self.region_aware, f"one of {', '.join(REGION_MODES)}")
+        check_region_mode(self.region_aware)
         from footfall.robots.registry import ROBOT_FILE_SUFFIXES, builtin_robot_names
 
         names = builtin_robot_names()

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from footfall._validate import check_fields, non_negative, positive
-from footfall.control.adjusters import REGION_MODES, STOP_STEPS
+from footfall.control.adjusters import STOP_STEPS, check_region_mode
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import FootstepPlan
@@ -166,8 +166,7 @@ class WalkOptions:
     swing_target_rate: bool = True
 
     def __post_init__(self) -> None:
-        if self.region_aware not in REGION_MODES:
-            raise InputError("region_aware", self.region_aware, f"one of {', '.join(REGION_MODES)}")
+        check_region_mode(self.region_aware)
         if self.controller not in CONTROLLERS:
             raise InputError("controller", self.controller, f"one of {', '.join(CONTROLLERS)}")
         if not isinstance(self.wbc_gains, WbcGains):

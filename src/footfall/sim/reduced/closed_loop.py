@@ -58,7 +58,7 @@ from numpy.typing import NDArray
 from footfall._geometry import rot2
 from footfall._typing import FloatArray
 from footfall._validate import check_fields, non_negative, positive
-from footfall.control.adjusters import REGION_MODES
+from footfall.control.adjusters import check_region_mode
 from footfall.control.mpc import (
     MPC,
     SOLVERS,
@@ -83,10 +83,6 @@ ENGINES = ("auto", "compiled", "python")
 
 #: highest MPC rate [Hz]: the loop stores a sample per tick, so memory grows with the rate
 MAX_CONTROL_RATE = 10_000.0
-
-
-#: region modes of this loop: the MuJoCo walker's (:data:`footfall.control.adjusters.REGION_MODES`)
-SIM_REGION_MODES = REGION_MODES
 
 
 @dataclass(frozen=True)
@@ -170,10 +166,7 @@ class SimOptions:
             raise InputError("solver", self.solver, f"one of {', '.join(SOLVERS)}")
         if self.engine not in ENGINES:
             raise InputError("engine", self.engine, f"one of {', '.join(ENGINES)}")
-        if self.region_aware not in SIM_REGION_MODES:
-            raise InputError(
-                "region_aware", self.region_aware, f"one of {', '.join(SIM_REGION_MODES)}"
-            )
+        check_region_mode(self.region_aware)
         if self.engine == "compiled" and self.region_aware != "off":
             raise InputError(
                 "engine",
