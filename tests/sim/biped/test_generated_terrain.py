@@ -102,3 +102,24 @@ def test_the_benchmark_stones_start_is_refused_for_this_sole() -> None:
     plan = load_plan(DATA / "stones-0.json", plan_scene)
     with pytest.raises(InputError, match=r"scene\.start"):
         walk(scene, plan, WalkOptions())
+
+
+def test_pad_ahead_moves_only_the_pads_front_edge() -> None:
+    """``pad_ahead`` puts the start pad's front edge that far ahead of the feet (x = 0) and keeps
+    its back edge at -0.45 m; the default's pad is the benchmark's, 0.05 m; bad values name the
+    field."""
+    from footfall.errors import InputError
+
+    for ahead in (0.05, 0.11):
+        pad = random_stepping_stones(0, 6, pad_ahead=ahead).terrain.regions[0]
+        xs = np.asarray(pad.vertices)[:, 0]
+        assert xs.max() == pytest.approx(ahead, abs=1e-12)
+        assert xs.min() == pytest.approx(-0.45, abs=1e-12)
+    default = np.asarray(random_stepping_stones(0, 6).terrain.regions[0].vertices)
+    assert np.array_equal(
+        default,
+        np.asarray(random_stepping_stones(0, 6, pad_ahead=0.05).terrain.regions[0].vertices),
+    )
+    for bad in (0.0, -1.0, float("nan"), 0.6):
+        with pytest.raises(InputError, match="pad_ahead"):
+            random_stepping_stones(0, 6, pad_ahead=bad)
