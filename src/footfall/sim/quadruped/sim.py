@@ -18,7 +18,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from footfall._geometry import cross3
 from footfall._mjcf import require_mujoco
 from footfall._typing import FloatArray
 from footfall._validate import positive
@@ -26,7 +25,7 @@ from footfall.errors import InputError
 from footfall.quadruped.gait import GaitParams, GaitPlan, GaitTrajectory, PhaseKind, plan_gait
 from footfall.quadruped.ground import PlaneGround, QuadrupedGround
 from footfall.quadruped.robot import JOINT_NAMES, LEGS, QuadrupedRobot
-from footfall.quadruped.stability import centre_of_pressure, stability_margin, support_polygon
+from footfall.quadruped.stability import _GEOM_EPS
 from footfall.results.quadruped import (
     BodySway,
     QuadrupedMetrics,
@@ -38,6 +37,7 @@ from footfall.sim._video import Video
 from footfall.sim.disturbance import Push, push_force
 from footfall.sim.falls import QUADRUPED_FALL
 from footfall.sim.quadruped import names as nm
+from footfall.sim.quadruped._measure import foot_contacts, measure_sample
 from footfall.sim.quadruped.mjcf import SimSettings, ground_scene
 from footfall.sim.quadruped.slip import (
     SlipGuard,
@@ -103,20 +103,16 @@ class QuadrupedSim:
         )
         root = mujoco.mj_name2id(m, obj.mjOBJ_JOINT, nm.ROOT_JOINT)
         self.root_adr = int(m.jnt_qposadr[root])
-        self._foot_of_geom = {g: i for i, g in enumerate(self.foot_geoms)}
-        self._force6 = np.zeros(6)
-        self._vel6 = np.zeros(6)
+        #: (ngeom,) each geom's leg, -1 for the geoms that are no foot
+        self.foot_of_geom = np.full(m.ngeom, -1, dtype=np.int64)
+        self.foot_of_geom[self.foot_geoms] = np.arange(len(LEGS))
 
-    def contact_slip_velocity(self, foot: int, point: FloatArray, normal: FloatArray) -> FloatArray:
-        """Tangential velocity of foot ``foot``'s material point at ``point`` [m/s], shape (3,)."""
-        g = self.foot_geoms[foot]
-        # world-frame [angular, linear] velocity of the geom frame at the geom centre
-        self.mujoco.mj_objectVelocity(
-            self.model, self.data, self.mujoco.mjtObj.mjOBJ_GEOM, g, self._vel6, 0
-        )
-        w, v = self._vel6[:3], self._vel6[3:]
-        vp = v + cross3(w, point - self.data.geom_xpos[g])
-        return vp - (vp @ normal) * normal
+    def foot_velocities(self, out: FloatArray) -> None:
+        """Each foot geom's world-frame ``[angular, linear]`` velocity at its centre into ``out``
+        (4, 6) [rad/s, m/s] (``mj_objectVelocity``)."""
+        mj, geom = self.mujoco, self.mujoco.mjtObj.mjOBJ_GEOM
+        for leg, g in enumerate(self.foot_geoms):
+            mj.mj_objectVelocity(self.model, self.data, geom, g, out[leg], 0)
 
     def set_pose(self, body_pos: FloatArray, pitch_up: float, joints: FloatArray) -> None:
         """Place the robot (trunk pose and joint angles) at rest and run forward kinematics."""
@@ -141,31 +137,20 @@ class QuadrupedSim:
         Returns:
             ``(points (N, 3), forces (N, 3), foot index (N,), trunk_touches_ground)``.
         """
-        d, m = self.data, self.model
-        pts, frc, idx = [], [], []
-        trunk_hit = False
-        for i in range(d.ncon):
-            c = d.contact[i]
-            g1, g2 = int(c.geom[0]), int(c.geom[1])
-            if self.trunk_geom in (g1, g2):
-                trunk_hit = True
-                continue
-            if g1 in self._foot_of_geom:
-                foot, sign = self._foot_of_geom[g1], -1.0
-            elif g2 in self._foot_of_geom:
-                foot, sign = self._foot_of_geom[g2], 1.0
-            else:
-                continue
-            self.mujoco.mj_contactForce(m, d, i, self._force6)
-            # contact frame rows are (normal, tangent1, tangent2); the force acts from geom1 on
-            # geom2, so it is on the robot as is when the foot is geom2 and reversed otherwise
-            f_world = sign * (c.frame.reshape(3, 3).T @ self._force6[:3])
-            pts.append(np.array(c.pos))
-            frc.append(f_world)
-            idx.append(foot)
-        if not pts:
-            return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, dtype=int), trunk_hit
-        return np.array(pts), np.array(frc), np.array(idx), trunk_hit
+        d, con = self.data, self.data.contact
+        pyramidal = self.model.opt.cone == self.mujoco.mjtCone.mjCONE_PYRAMIDAL
+        return foot_contacts(
+            con.geom,
+            con.pos,
+            con.frame,
+            con.efc_address,
+            con.dim,
+            con.friction,
+            d.efc_force,
+            bool(pyramidal),
+            self.foot_of_geom,
+            self.trunk_geom,
+        )
 
 
 class _Recorder:
@@ -179,32 +164,58 @@ class _Recorder:
         self.ground = plan.ground
         self.trace = QuadrupedTrace.empty(ref)
         self.weight = plan.robot.total_mass * float(-sim.model.opt.gravity[2])
+        #: the normal force [N] above which a contact counts as loaded
+        self.loaded_force = CONTACT_FORCE_FRACTION * self.weight
+        #: the ground's normal on a plane (the same everywhere), None on other grounds
+        self._plane_normal = (
+            self.ground.normal(0.0, 0.0) if isinstance(self.ground, PlaneGround) else None
+        )
+        self._normals = np.zeros((0, 3))
+        self._foot_vel = np.zeros((4, 6))
+        self._foot_geoms = np.asarray(sim.foot_geoms, dtype=np.int64)
+
+    def _normals_at(self, pts: FloatArray, feet: FloatArray) -> FloatArray:
+        """The ground's normal (N + 4, 3) at the contact points ``pts`` (N, 3), then under the
+        foot centres ``feet`` (4, 3)."""
+        if self._plane_normal is None:
+            xy = [*pts[:, :2].tolist(), *feet[:, :2].tolist()]
+            return np.array([self.ground.normal(x, y) for x, y in xy]).reshape(-1, 3)
+        rows = pts.shape[0] + 4
+        if self._normals.shape[0] < rows:
+            self._normals = np.tile(self._plane_normal, (rows, 1))
+        return self._normals[:rows]
 
     def measure(self, k: int) -> None:
         """Record sample ``k``: trunk, feet, loaded contacts, CoP, margin, slip; detect a fall."""
         sim, d, tr = self.sim, self.sim.data, self.trace
         tr.trunk_pos[k] = d.xpos[sim.trunk]
         tr.trunk_pitch[k] = _pitch_of(d.xmat[sim.trunk])
-        tr.feet[k] = d.site_xpos[sim.foot_sites]
+        feet = tr.feet[k]
+        feet[:] = d.site_xpos[sim.foot_sites]
         pts, frc, idx, trunk_hit = sim.contacts()
-        loaded = frc[:, 2] > CONTACT_FORCE_FRACTION * self.weight if frc.size else np.zeros(0, bool)
-        tr.n_contacts[k] = np.unique(idx[loaded]).size
-        if loaded.any():
-            z_p = float(pts[loaded, 2].mean())
-            tr.cop[k], _ = centre_of_pressure(pts[loaded], frc[loaded], z_p)
-            # each foot touches at one point (sphere on plane), so the feet's points span it
-            tr.margin[k] = stability_margin(tr.cop[k], support_polygon(pts[loaded]))
-        for j in range(idx.size):
-            normal = self.ground.normal(float(pts[j, 0]), float(pts[j, 1]))
-            tr.slip_vel[k, idx[j]] = sim.contact_slip_velocity(idx[j], pts[j], normal)
-        # a planned stance foot off the ground (bouncing, or the ground lower than planned)
-        # moves with its whole centre: that motion along the ground is slip too
-        stance = tr.planned.contact[k]
-        for leg in range(4):
-            if stance[leg] and not np.any(idx == leg):
-                c = tr.feet[k, leg]
-                normal = self.ground.normal(float(c[0]), float(c[1]))
-                tr.slip_vel[k, leg] = sim.contact_slip_velocity(leg, c, normal)
+        sim.foot_velocities(self._foot_vel)
+        # the CoP of the loaded contacts, their support polygon (each foot touches at one point,
+        # sphere on plane, so the feet's points span it) and the CoP's margin in it; each
+        # contact's sliding, and that of a planned stance foot off the ground (bouncing, or the
+        # ground lower than planned), which moves with its whole centre
+        measure_sample(
+            k,
+            pts,
+            frc,
+            idx,
+            self.loaded_force,
+            _GEOM_EPS,
+            tr.planned.contact[k],
+            feet,
+            d.geom_xpos,
+            self._foot_geoms,
+            self._foot_vel,
+            self._normals_at(pts, feet),
+            tr.cop,
+            tr.margin,
+            tr.n_contacts,
+            tr.slip_vel,
+        )
         if math.isnan(tr.fallen_at) and (trunk_hit or self._fallen(k)):
             tr.fallen_at = float(tr.t[k])
 
