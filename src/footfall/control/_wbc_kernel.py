@@ -5,11 +5,16 @@ solves, ``min 0.5 x^T H x + g^T x`` s.t. ``lower <= C x <= upper`` (equality row
 ``x = (qdd, f)``. It is the same algebra as the module docstring of :mod:`footfall.control.wbc`,
 written as loops so that a 500 Hz controller does not spend its time in numpy's per-call overhead
 (the numpy version took 0.3-0.5 ms per tick for a biped; this takes a few tens of microseconds).
+:func:`rotation_error` is the orientation error both robots' trunk tasks track,
+:func:`footfall._geometry.rotation_log` compiled (BLAS's 3 x 3 product through ``np.dot``, as
+numpy's ``@``).
 
 Everything compiled lives in this module (numba's on-disk cache, ``cache=True``, keys on it).
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from numba import njit
@@ -34,6 +39,36 @@ def _tangents(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     t2[1] = n[2] * t1[0] - n[0] * t1[2]
     t2[2] = n[0] * t1[1] - n[1] * t1[0]
     return t1, t2
+
+
+@njit(cache=True)
+def rotation_log(r: np.ndarray) -> np.ndarray:
+    """:func:`footfall._geometry.rotation_log` compiled, operation for operation."""
+    w = np.empty(3)
+    w[0] = r[2, 1] - r[1, 2]
+    w[1] = r[0, 2] - r[2, 0]
+    w[2] = r[1, 0] - r[0, 1]
+    s = 0.5 * math.sqrt(np.dot(w, w))
+    c = 0.5 * ((r[0, 0] + r[1, 1] + r[2, 2]) - 1.0)
+    angle = math.atan2(s, c)
+    if angle < 1e-9:
+        return 0.5 * w
+    if c > -0.9:
+        return (angle / (2.0 * s)) * w
+    b = (0.5 * (r + r.T) - c * np.eye(3)) / (1.0 - c)
+    k = int(np.argmax(np.diag(b)))
+    bkk = b[k, k]
+    axis = b[:, k] / math.sqrt(1e-300 if 1e-300 > bkk else bkk)
+    axis = axis / math.sqrt(np.dot(axis, axis))
+    if np.dot(axis, w) < 0.0:
+        axis = -axis
+    return angle * axis
+
+
+@njit(cache=True)
+def rotation_error(target: np.ndarray, actual: np.ndarray) -> np.ndarray:
+    """Rotation vector (3,) [rad] that turns ``actual`` (3, 3) into ``target`` (3, 3)."""
+    return rotation_log(np.dot(target, actual.T))
 
 
 @njit(cache=True)

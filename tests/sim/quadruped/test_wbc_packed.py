@@ -30,6 +30,13 @@ from footfall.sim.quadruped.wbc import QuadrupedWbc, QuadrupedWbcGains, _surface
 TORQUE_TOL = 1e-9
 
 
+def _touching(sim: QuadrupedSim) -> list[bool]:
+    """Which feet touch the ground now (a contact not in the margin, ``dist <= 0``)."""
+    con = sim.data.contact
+    hit = set(np.asarray(con.geom)[np.asarray(con.dist) <= 0.0].ravel().tolist())
+    return [g in hit for g in sim.foot_geoms]
+
+
 def _reference_problem(wbc: QuadrupedWbc, t: float) -> WbcProblem:
     """The tick's problem from the dataclasses, at the state in ``wbc.sim.data``."""
     sim, d, g, ref = wbc.sim, wbc.sim.data, wbc.gains, wbc.ref
@@ -41,7 +48,7 @@ def _reference_problem(wbc: QuadrupedWbc, t: float) -> WbcProblem:
     qvel = d.qvel
     stance = ref.contact[k] if w < 0.5 else ref.contact[k + 1]
     to_switch = ref.to_switch[k] - w * ref.dt
-    touching = wbc._touching()
+    touching = _touching(sim)
     contacts, tasks, wrench, heights = [], [], [], []
     for leg in range(4):
         centre = d.site_xpos[sim.foot_sites[leg]]
@@ -128,7 +135,7 @@ def test_packed_tick_equals_the_dataclass_problem_tick_by_tick(params: GaitParam
         expected = plain.solve(_reference_problem(wbc, t))
         k, w = wbc.ref.at(t)
         stance = wbc.ref.contact[k] if w < 0.5 else wbc.ref.contact[k + 1]
-        late += int(any(s and not on for s, on in zip(stance, wbc._touching(), strict=True)))
+        late += int(any(s and not on for s, on in zip(stance, _touching(sim), strict=True)))
         tau = wbc.torques(t)
         np.testing.assert_allclose(tau, expected.torque, rtol=0, atol=TORQUE_TOL)
         problem, sol = wbc.last_problem, wbc.last

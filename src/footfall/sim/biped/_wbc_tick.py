@@ -24,7 +24,7 @@ import math
 import numpy as np
 from numba import njit
 
-from footfall.control._wbc_kernel import assemble
+from footfall.control._wbc_kernel import assemble, rotation_error
 
 #: entries of the gains vector of :func:`pack_tick`
 (COM_KP, COM_KD, TORSO_KP, TORSO_KD, SWING_KP, SWING_KD, POSTURE_KP, POSTURE_KD) = range(8)
@@ -47,36 +47,6 @@ def _matvec(a: np.ndarray, x: np.ndarray, out: np.ndarray) -> None:
     """``out = a @ x`` for ``a`` (r, n), ``x`` (n,), ``out`` (r,): BLAS's product, as numpy's
     ``@`` (a loop sums in another order)."""
     out[:] = np.dot(a, x)
-
-
-@njit(cache=True)
-def rotation_log(r: np.ndarray) -> np.ndarray:
-    """:func:`footfall._geometry.rotation_log` compiled, operation for operation."""
-    w = np.empty(3)
-    w[0] = r[2, 1] - r[1, 2]
-    w[1] = r[0, 2] - r[2, 0]
-    w[2] = r[1, 0] - r[0, 1]
-    s = 0.5 * math.sqrt(np.dot(w, w))
-    c = 0.5 * ((r[0, 0] + r[1, 1] + r[2, 2]) - 1.0)
-    angle = math.atan2(s, c)
-    if angle < 1e-9:
-        return 0.5 * w
-    if c > -0.9:
-        return (angle / (2.0 * s)) * w
-    b = (0.5 * (r + r.T) - c * np.eye(3)) / (1.0 - c)
-    k = int(np.argmax(np.diag(b)))
-    bkk = b[k, k]
-    axis = b[:, k] / math.sqrt(1e-300 if 1e-300 > bkk else bkk)
-    axis = axis / math.sqrt(np.dot(axis, axis))
-    if np.dot(axis, w) < 0.0:
-        axis = -axis
-    return angle * axis
-
-
-@njit(cache=True)
-def _rotation_error(target: np.ndarray, actual: np.ndarray) -> np.ndarray:
-    """Rotation vector (3,) [rad] that turns ``actual`` (3, 3) into ``target`` (3, 3)."""
-    return rotation_log(np.dot(target, actual.T))
 
 
 @njit(cache=True)
@@ -241,7 +211,7 @@ def pack_tick(
     _matvec(torso_jdot, qvel, tdrift)
     omega = np.empty(3)
     _matvec(torso_jac.reshape(2, 3, nv)[1], qvel, omega)  # the angular rows, C-contiguous
-    err = _rotation_error(yaw_rot, xmat[torso].reshape(3, 3))
+    err = rotation_error(yaw_rot, xmat[torso].reshape(3, 3))
     for j in range(3):
         a = g[TORSO_KP] * err[j] - g[TORSO_KD] * omega[j]
         m_jac[j] = torso_jac[3 + j]
@@ -260,7 +230,7 @@ def pack_tick(
         pos = site_xpos[sid]
         _matvec(foot_jac[sd], qvel, v)
         ref = refs[1 + sd]
-        err = _rotation_error(rot_ref[sd], site_xmat[sid].reshape(3, 3))
+        err = rotation_error(rot_ref[sd], site_xmat[sid].reshape(3, 3))
         for j in range(3):
             pos_ref = ref[0, j] + share * (ref[1, j] - ref[0, j])
             a = g[SWING_KP] * (pos_ref - pos[j]) + g[SWING_KD] * (ref[2, j] - v[j])

@@ -1,6 +1,8 @@
 """Compiled packing of the quadruped's whole-body QP (numba, beyond the documents).
 
-:func:`pack_tick` writes one tick's contacts and tasks (:mod:`footfall.sim.quadruped.wbc`'s
+:func:`feet_tick` interpolates the plan and decides each foot's part of the tick (a contact or
+not, its point, its unload weight, a late foot's target below the ground); :func:`pack_tick`
+writes one tick's contacts and tasks (:mod:`footfall.sim.quadruped.wbc`'s
 module docstring) straight into the arrays of :class:`footfall.control.wbc.PackedProblem`, the
 same numbers as building :class:`~footfall.control.wbc.Contact`, ``MotionTask`` and ``WrenchTask``
 and packing them, without the ~40 small numpy operations and dataclasses per tick that cost more
@@ -11,16 +13,20 @@ Everything compiled lives in this module (numba's on-disk cache, ``cache=True``,
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
-from footfall.control._wbc_kernel import assemble
+from footfall.control._wbc_kernel import assemble, rotation_error
 
-#: columns of ``_Reference.table`` (see :class:`footfall.sim.quadruped.wbc._Sample`)
+#: columns of ``_Reference.table`` (see :class:`footfall.sim.quadruped.wbc._Reference`)
 BODY, BODY_V, BODY_A, FEET, FEET_V, FEET_A, JOINTS, JOINTS_V, ZMP = 0, 3, 6, 9, 21, 33, 45, 57, 69
+PITCH = 71
 #: entries of the gains vector of :func:`pack_tick`
 (TRUNK_KP, TRUNK_KD, ROT_KP, ROT_KD, SWING_KP, SWING_KD, POSTURE_KP, POSTURE_KD) = range(8)
 (TRUNK_W, ROT_W, SWING_W, POSTURE_W, COP_W) = range(8, 13)
+(TOUCHDOWN_WINDOW, UNLOAD_TIME, UNLOAD_WEIGHT, REACH_DEPTH, REACH_SPEED) = range(13, 18)
 #: rows of the tick's motion tasks that are not swing feet: trunk (3), orientation (3), joints (12)
 FIXED_MOTION_ROWS = 18
 
@@ -34,9 +40,84 @@ def _matvec(a: np.ndarray, x: np.ndarray, out: np.ndarray) -> None:
 
 
 @njit(cache=True)
+def feet_tick(
+    table: np.ndarray,
+    planned_contact: np.ndarray,
+    to_switch: np.ndarray,
+    k: int,
+    w: float,
+    dt: float,
+    geom: np.ndarray,
+    dist: np.ndarray,
+    foot_of_geom: np.ndarray,
+    site_xpos: np.ndarray,
+    foot_sites: np.ndarray,
+    radius: float,
+    gains: np.ndarray,
+    row: np.ndarray,
+    contact: np.ndarray,
+    unload_w: np.ndarray,
+    pts: np.ndarray,
+    normal: np.ndarray,
+) -> None:
+    """The plan at this instant and each foot's part of the tick
+    (:class:`~footfall.sim.quadruped.wbc.QuadrupedWbc`'s rules), written in place.
+
+    Inputs: the plan ``table`` (T, 72) (``_Reference.table``'s columns), its ``planned_contact``
+    (T, 4) and ``to_switch`` (T, 4) [s]; the sample ``k`` and weight ``w`` of this instant
+    (``_Reference.at``) and the sample period ``dt`` [s]; MuJoCo's contacts ``geom`` (ncon, 2),
+    ``dist`` (ncon,) [m] (a foot touches the ground when one of its contacts is not in the
+    margin, ``dist <= 0``); ``foot_of_geom`` (ngeom,) each geom's leg or -1; ``site_xpos``
+    (nsite, 3) [m] and the feet's ``foot_sites`` (4,); the feet's ``radius`` [m]; ``gains``
+    (:func:`pack_tick`'s vector); ``normal`` (4, 3) the ground's normal under each foot.
+
+    Outputs: ``row`` (72,) the interpolated plan, a late foot's swing target moved below the
+    ground; per leg ``contact`` (bool), ``unload_w`` (< 0: none) and ``pts`` (4, 3) [m] its
+    contact point (the bottom of its sphere along the normal) or, not a contact, its centre.
+    """
+    for i in range(row.shape[0]):
+        row[i] = (1.0 - w) * table[k, i] + w * table[k + 1, i]
+    stance = planned_contact[k] if w < 0.5 else planned_contact[k + 1]
+    touching = np.zeros(4, dtype=np.bool_)
+    for i in range(geom.shape[0]):
+        if dist[i] <= 0.0:  # within the margin: not yet
+            for side in range(2):
+                g = geom[i, side]
+                if g >= 0 and foot_of_geom[g] >= 0:
+                    touching[foot_of_geom[g]] = True
+    window, unload = gains[TOUCHDOWN_WINDOW], gains[UNLOAD_TIME]
+    ahead = w * dt
+    for leg in range(4):
+        left = to_switch[k, leg] - ahead
+        early = touching[leg] and left <= window
+        # a planned stance foot is a contact while it touches the ground; off it (the ground
+        # lower than planned, or a foot that bounced) it reaches down instead of the QP
+        # counting on a force that the ground cannot give
+        is_contact = (stance[leg] and touching[leg]) or early
+        contact[leg] = is_contact
+        # (a foot leaving in its unload window is let go: it lifts off a little early); the
+        # target reach_depth below the foothold along the normal, moving in at reach_speed
+        if stance[leg] and not is_contact and left >= unload:
+            for i in range(3):
+                row[FEET + 3 * leg + i] -= gains[REACH_DEPTH] * normal[leg, i]
+                row[FEET_V + 3 * leg + i] = -gains[REACH_SPEED] * normal[leg, i]
+                row[FEET_A + 3 * leg + i] = 0.0
+        unload_w[leg] = -1.0
+        centre = site_xpos[foot_sites[leg]]
+        if is_contact:
+            for i in range(3):
+                pts[leg, i] = centre[i] - radius * normal[leg, i]
+            if stance[leg] and unload > 0 and left < unload:
+                share = 1.0 - (0.0 if 0.0 > left else left) / unload
+                unload_w[leg] = gains[UNLOAD_WEIGHT] * share
+        else:
+            pts[leg] = centre
+
+
+@njit(cache=True)
 def pack_tick(
     row: np.ndarray,
-    err: np.ndarray,
+    trunk_xmat: np.ndarray,
     contact: np.ndarray,
     unload_w: np.ndarray,
     pts: np.ndarray,
@@ -48,7 +129,8 @@ def pack_tick(
     trunk_jdot: np.ndarray,
     trunk_pos: np.ndarray,
     qvel: np.ndarray,
-    q_joints: np.ndarray,
+    qpos: np.ndarray,
+    joint_qpos: np.ndarray,
     joint_dofs: np.ndarray,
     gains: np.ndarray,
     c_jac: np.ndarray,
@@ -85,14 +167,14 @@ def pack_tick(
     motion rows and wrench rows (the arrays' leading parts that count) and
     :func:`~footfall.control._wbc_kernel.assemble`'s QP.
 
-    Inputs: ``row`` (72,) the plan at this instant (``_Reference.table``'s columns); ``err`` (3,)
-    the trunk's orientation error [rad]; per leg (4): ``contact`` (bool) a contact this tick,
+    Inputs: ``row`` (72,) the plan at this instant (``_Reference.table``'s columns);
+    ``trunk_xmat`` (9,) the trunk's orientation (row-major); per leg (4): ``contact`` (bool) a contact this tick,
     ``unload_w`` the weight of its unload task (< 0: none), ``pts`` (4, 3) its contact point or
     (swing) its foot centre [m], ``normal`` and ``tangent`` (4, 3) its contact normal and friction
     pyramid orientation (zero: any), ``foot_jac`` and ``foot_jdot`` (4, 3, nv) the Jacobian of
     ``pts`` and its derivative; the trunk's ``trunk_jac``, ``trunk_jdot`` (6, nv) at its origin
-    ``trunk_pos`` (3,) [m]; ``qvel`` (nv,); the joint angles ``q_joints`` (12,) [rad], their dofs
-    ``joint_dofs`` (12,); ``gains`` (13,) (the indices above).
+    ``trunk_pos`` (3,) [m]; ``qpos`` (nq,), ``qvel`` (nv,); the planned joints' ``joint_qpos`` (12,)
+    and ``joint_dofs`` (12,) addresses; ``gains`` (18,) (the indices above).
 
     Outputs (written in place, the constant parts set once by the caller: rows 3-5 of ``c_jac``
     and ``c_drift`` zero, one point per contact, the wrench targets zero): the contacts' ``c_jac``
@@ -106,6 +188,12 @@ def pack_tick(
     controller's regularisation weights ``eps``.
     """
     nv = qvel.shape[0]
+    # the planned orientation: nose-up pitch is a rotation about y by -pitch
+    c, s = math.cos(-row[PITCH]), math.sin(-row[PITCH])
+    plan_rot = np.zeros((3, 3))
+    plan_rot[0, 0], plan_rot[0, 2], plan_rot[1, 1] = c, s, 1.0
+    plan_rot[2, 0], plan_rot[2, 2] = -s, c
+    err = rotation_error(plan_rot, trunk_xmat.reshape(3, 3))
     vel = np.empty(6)
     drift = np.empty(6)
     nc = 0
@@ -161,7 +249,7 @@ def pack_tick(
     rm += 6
     for j in range(joint_dofs.shape[0]):
         dof = joint_dofs[j]
-        acc = gains[POSTURE_KP] * (row[JOINTS + j] - q_joints[j]) + gains[POSTURE_KD] * (
+        acc = gains[POSTURE_KP] * (row[JOINTS + j] - qpos[joint_qpos[j]]) + gains[POSTURE_KD] * (
             row[JOINTS_V + j] - qvel[dof]
         )
         for a in range(nv):

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from footfall._geometry import cross3, rotation_log
+from footfall._geometry import cross3
 from footfall._typing import FloatArray
 from footfall._validate import check_fields, non_negative
 from footfall.control.wbc import (
@@ -42,7 +42,7 @@ from footfall.control.wbc import (
 from footfall.errors import InputError, SolverError
 from footfall.quadruped.gait import GaitTrajectory
 from footfall.quadruped.ground import PlaneGround, QuadrupedGround
-from footfall.sim.quadruped._wbc_tick import FEET, FEET_A, FEET_V, FIXED_MOTION_ROWS, pack_tick
+from footfall.sim.quadruped._wbc_tick import FIXED_MOTION_ROWS, feet_tick, pack_tick
 from footfall.sim.wbc_model import MujocoWbcModel
 
 
@@ -331,19 +331,24 @@ class QuadrupedWbc:
         self.friction = float(m.geom_friction[sim.foot_geoms[0], 0])
         self.radius = float(m.geom_size[sim.foot_geoms[0], 0])
         self.foot_bodies = [int(m.site_bodyid[s]) for s in sim.foot_sites]
+        self._foot_sites = np.asarray(sim.foot_sites, dtype=np.int64)
+        self._joint_qpos = np.asarray(sim.qpos_adr, dtype=np.int64)
         #: generalised-velocity index of each planned joint angle (LEGS x JOINT_NAMES order)
         self.joint_dofs = np.array(
             [int(m.jnt_dofadr[int(m.actuator_trnid[a, 0])]) for a in sim.actuators]
         )
         g = gains
-        #: the gains in the order of pack_tick's vector
+        #: the gains in the order of pack_tick's and feet_tick's vector
         self._gains = np.array(
             [
                 *(g.trunk_kp, g.trunk_kd, g.rot_kp, g.rot_kd, g.swing_kp, g.swing_kd),
                 *(g.posture_kp, g.posture_kd, g.trunk_weight, g.rot_weight, g.swing_weight),
-                *(g.posture_weight, g.cop_weight),
+                *(g.posture_weight, g.cop_weight, g.touchdown_window, g.unload_time),
+                *(g.unload_weight, g.reach_depth, g.reach_speed),
             ]
         )
+        #: the plan at the tick's instant (the columns of ``_Reference.table``), filled per tick
+        self._row = np.empty(self.ref.table.shape[1])
         # two sets of arrays: a tick fills the one that does not hold the last solved problem
         self._buffers = (
             _Buffers(self.model, self.friction, self._plane),
@@ -357,13 +362,6 @@ class QuadrupedWbc:
         """Track ``ref`` from now on (same sample times; the slip guard's held reference)."""
         self.ref = _Reference(ref)
 
-    def _touching(self) -> list[bool]:
-        """Which feet touch the ground now (from the contacts of the last collision check)."""
-        con = self.sim.data.contact
-        geoms = np.asarray(con.geom)[np.asarray(con.dist) <= 0.0]  # within the margin: not yet
-        hit = set(geoms.ravel().tolist())
-        return [g in hit for g in self.sim.foot_geoms]
-
     @property
     def last_problem(self) -> WbcProblem | None:
         """The last solved problem as dataclasses (rebuilt from its packed arrays when asked;
@@ -375,49 +373,39 @@ class QuadrupedWbc:
         """The last solution (None before the first solve)."""
         return None if self._last is None else self._last.solution()
 
-    def _reach_down(self, row: FloatArray, leg: int, centre: FloatArray) -> None:
-        """Point the plan row's swing target of ``leg`` (a stance foot still in the air) below
-        the ground: at the planned foothold minus ``reach_depth`` along the normal, moving into
-        the ground at ``reach_speed``, without acceleration."""
-        g = self.gains
-        normal = self.ground.normal(float(centre[0]), float(centre[1]))
-        f = FEET + 3 * leg
-        row[f : f + 3] -= g.reach_depth * normal
-        row[FEET_V + 3 * leg : FEET_V + 3 * leg + 3] = -g.reach_speed * normal
-        row[FEET_A + 3 * leg : FEET_A + 3 * leg + 3] = 0.0
-
-    def _feet(self, buf: _Buffers, k: int, w: float, row: FloatArray) -> None:
-        """Each foot's part of the tick at plan sample ``k``, weight ``w``, into ``buf``: a
-        contact or not, its contact normal, unload weight, point and that point's Jacobians
-        (``row``: the interpolated plan, whose swing target of a late foot is moved down)."""
-        sim, d, g, ref = self.sim, self.sim.data, self.gains, self.ref
-        stance = ref.contact[k] if w < 0.5 else ref.contact[k + 1]
-        to_switch = ref.to_switch[k] - w * ref.dt
-        touching = self._touching()
-        centres = d.site_xpos[sim.foot_sites]
+    def _feet(self, buf: _Buffers, k: int, w: float) -> None:
+        """The plan at sample ``k``, weight ``w``, into ``_row`` and each foot's part of the tick
+        into ``buf`` (:func:`feet_tick`): a contact or not, its contact normal, unload weight,
+        point and that point's Jacobians."""
+        sim, d, ref = self.sim, self.sim.data, self.ref
+        if self._plane is None:  # the ground's normal and pyramid orientation under each foot
+            for leg, site in enumerate(sim.foot_sites):
+                centre = d.site_xpos[site]
+                normal, tangent = _surface(self.ground.normal(float(centre[0]), float(centre[1])))
+                buf.normal[leg] = normal
+                buf.tangent[leg] = 0.0 if tangent is None else tangent
+        con = d.contact
+        feet_tick(
+            ref.table,
+            ref.contact,
+            ref.to_switch,
+            k,
+            w,
+            ref.dt,
+            con.geom,
+            con.dist,
+            sim.foot_of_geom,
+            d.site_xpos,
+            self._foot_sites,
+            self.radius,
+            self._gains,
+            self._row,
+            buf.contact,
+            buf.unload_w,
+            buf.pts,
+            buf.normal,
+        )
         for leg in range(4):
-            early = touching[leg] and to_switch[leg] <= g.touchdown_window
-            # a planned stance foot is a contact while it touches the ground; off it (the ground
-            # lower than planned, or a foot that bounced) it reaches down instead of the QP
-            # counting on a force that the ground cannot give
-            buf.contact[leg] = is_contact = bool((stance[leg] and touching[leg]) or early)
-            # (a foot leaving in its unload window is let go: it lifts off a little early)
-            if stance[leg] and not is_contact and to_switch[leg] >= g.unload_time:
-                self._reach_down(row, leg, centres[leg])
-            buf.unload_w[leg] = -1.0
-            if is_contact:
-                if self._plane is None:
-                    normal, tangent = _surface(
-                        self.ground.normal(float(centres[leg, 0]), float(centres[leg, 1]))
-                    )
-                    buf.normal[leg] = normal
-                    buf.tangent[leg] = 0.0 if tangent is None else tangent
-                buf.pts[leg] = centres[leg] - self.radius * buf.normal[leg]
-                if stance[leg] and g.unload_time > 0 and to_switch[leg] < g.unload_time:
-                    share = 1.0 - max(to_switch[leg], 0.0) / g.unload_time
-                    buf.unload_w[leg] = g.unload_weight * share
-            else:
-                buf.pts[leg] = centres[leg]
             self.model.jacobians(
                 self.foot_bodies[leg], buf.pts[leg], buf.foot_jac[leg], buf.foot_jdot[leg]
             )
@@ -427,21 +415,16 @@ class QuadrupedWbc:
         velocities; ``mj_step1`` has run)."""
         sim, d, ref = self.sim, self.sim.data, self.ref
         k, w = ref.at(t)
-        row = (1.0 - w) * ref.table[k] + w * ref.table[k + 1]
         # fill the buffers that do not hold the last solved problem
         buf = self._buffers[1] if self._last is self._buffers[0] else self._buffers[0]
-        self._feet(buf, k, w, row)
+        self._feet(buf, k, w)
         trunk_pos = d.xpos[sim.trunk]
         self.model.jacobians(sim.trunk, trunk_pos, buf.trunk_jac, buf.trunk_jdot)
-        # the planned orientation: nose-up pitch is a rotation about y by -pitch
-        c, s = math.cos(-row[-1]), math.sin(-row[-1])
-        plan_rot = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-        err = rotation_log(plan_rot @ d.xmat[sim.trunk].reshape(3, 3).T)
         self.model.mass_matrix(buf.mass)
         np.subtract(d.qfrc_bias, d.qfrc_passive, out=buf.bias)
         nc, rm, rw, qp = pack_tick(
-            row,
-            err,
+            self._row,
+            d.xmat[sim.trunk],
             buf.contact,
             buf.unload_w,
             buf.pts,
@@ -453,7 +436,8 @@ class QuadrupedWbc:
             buf.trunk_jdot,
             trunk_pos,
             d.qvel,
-            d.qpos[sim.qpos_adr],
+            d.qpos,
+            self._joint_qpos,
             self.joint_dofs,
             self._gains,
             *buf.outputs,
