@@ -264,9 +264,9 @@ def _margin(p: np.ndarray, points: np.ndarray, eps: float) -> float:
 def _sliding(
     vel: np.ndarray, point: np.ndarray, centre: np.ndarray, normal: np.ndarray, out: np.ndarray
 ) -> None:
-    """``QuadrupedSim.contact_slip_velocity``: the tangential velocity [m/s] of the foot's
-    material point at ``point`` (3,) into ``out`` (3,), from the foot geom's world-frame
-    ``[angular, linear]`` velocity ``vel`` (6,) at its centre ``centre`` (3,) [m]."""
+    """The velocity [m/s] along the ground (unit ``normal`` (3,)) of the foot's material point at
+    ``point`` (3,) into ``out`` (3,), from the foot geom's world-frame ``[angular, linear]``
+    velocity ``vel`` (6,) at its centre ``centre`` (3,) [m]."""
     r = point - centre
     vp = np.empty(3)
     vp[0] = vel[3] + (vel[1] * r[2] - vel[2] * r[1])

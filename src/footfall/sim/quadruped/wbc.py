@@ -156,7 +156,7 @@ class _Buffers:
         model: the robot's model terms.
         friction: the feet's friction coefficient.
         plane: ``_surface`` of a plane ground (its normal and pyramid orientation are set once),
-            None on other grounds (set per contact by the tick).
+            None on other grounds (set per foot by each tick).
     """
 
     def __init__(
