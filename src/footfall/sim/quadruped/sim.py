@@ -229,6 +229,22 @@ class _Recorder:
         return QUADRUPED_FALL.fallen(float(tilt), float(low), post.height)
 
 
+def _sample(rec: _Recorder, k: int, guard: SlipMonitor | None, video: Video, d: Any) -> bool:
+    """Measure sample ``k`` right after the first physics step of its control period, the step
+    that starts at its time ``t[k]``: MuJoCo's kinematics, contacts and contact forces then
+    describe the state at ``t[k]`` (``mj_step`` computes them for the state it starts from, then
+    integrates), the instant of the plan's sample ``k`` they are compared with. Then the slip
+    guard (True when it held the reference, ``rec.trace.planned``) and the video frame."""
+    rec.measure(k)
+    tr = rec.trace
+    held = False
+    if guard is not None and guard.update(k, tr.slip_vel[k]):
+        tr.planned = guard.reference
+        held = True
+    video.frame(k, d)
+    return held
+
+
 def _track(
     sim: QuadrupedSim,
     rec: _Recorder,
@@ -246,6 +262,8 @@ def _track(
     tr = rec.trace
     n = tr.planned.joints.shape[0]
     for k in range(n):
+        if replay is not None:
+            replay.sample(float(tr.t[k]), d)
         joints = tr.planned.joints
         q0 = joints[k]
         q1 = joints[min(k + 1, n - 1)]
@@ -257,12 +275,8 @@ def _track(
                     pushes, float(tr.t[0]) + (k * substeps + s) * m.opt.timestep
                 )
             mj.mj_step(m, d)
-        rec.measure(k)
-        if replay is not None:
-            replay.sample(float(tr.t[k]), d)
-        if guard is not None and guard.update(k, tr.slip_vel[k]):
-            tr.planned = guard.reference
-        video.frame(k, d)
+            if s == 0:
+                _sample(rec, k, guard, video, d)
         if progress is not None and k % 200 == 0:
             progress(k / n)
 
@@ -297,6 +311,8 @@ def _track_wbc(
         mj.mj_step2(m, d)
     n = tr.t.shape[0]
     for k in range(n):
+        if replay is not None:
+            replay.sample(float(tr.t[k]), d)
         for s in range(substeps):
             mj.mj_step1(m, d)
             i = k * substeps + s
@@ -305,13 +321,8 @@ def _track_wbc(
             if pushes:
                 d.xfrc_applied[sim.trunk, :3] = push_force(pushes, t_start + i * m.opt.timestep)
             mj.mj_step2(m, d)
-        rec.measure(k)
-        if replay is not None:
-            replay.sample(float(tr.t[k]), d)
-        if guard is not None and guard.update(k, tr.slip_vel[k]):
-            tr.planned = guard.reference
-            wbc.retarget(tr.planned)
-        video.frame(k, d)
+            if s == 0 and _sample(rec, k, guard, video, d):
+                wbc.retarget(tr.planned)
         if progress is not None and k % 200 == 0:
             progress(k / n)
     tr.qp_failures = wbc.failures
