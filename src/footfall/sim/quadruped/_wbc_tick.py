@@ -27,6 +27,7 @@ PITCH = 71
 (TRUNK_KP, TRUNK_KD, ROT_KP, ROT_KD, SWING_KP, SWING_KD, POSTURE_KP, POSTURE_KD) = range(8)
 (TRUNK_W, ROT_W, SWING_W, POSTURE_W, COP_W) = range(8, 13)
 (TOUCHDOWN_WINDOW, UNLOAD_TIME, UNLOAD_WEIGHT, REACH_DEPTH, REACH_SPEED) = range(13, 18)
+LIFTOFF_DELAY = 18
 #: rows of the tick's motion tasks that are not swing feet: trunk (3), orientation (3), joints (12)
 FIXED_MOTION_ROWS = 18
 
@@ -44,6 +45,7 @@ def feet_tick(
     table: np.ndarray,
     planned_contact: np.ndarray,
     to_switch: np.ndarray,
+    since_lift: np.ndarray,
     k: int,
     w: float,
     dt: float,
@@ -64,7 +66,8 @@ def feet_tick(
     (:class:`~footfall.sim.quadruped.wbc.QuadrupedWbc`'s rules), written in place.
 
     Inputs: the plan ``table`` (T, 72) (``_Reference.table``'s columns), its ``planned_contact``
-    (T, 4) and ``to_switch`` (T, 4) [s]; the sample ``k`` and weight ``w`` of this instant
+    (T, 4), ``to_switch`` (T, 4) [s] and ``since_lift`` (T, 4) [s] (from each leg's last
+    planned lift-off to each sample, inf before the first); the sample ``k`` and weight ``w`` of this instant
     (``_Reference.at``) and the sample period ``dt`` [s]; MuJoCo's contacts ``geom`` (ncon, 2),
     ``dist`` (ncon,) [m] (a foot touches the ground when one of its contacts is not in the
     margin, ``dist <= 0``); ``foot_of_geom`` (ngeom,) each geom's leg or -1; ``site_xpos``
@@ -77,7 +80,9 @@ def feet_tick(
     """
     for i in range(row.shape[0]):
         row[i] = (1.0 - w) * table[k, i] + w * table[k + 1, i]
-    stance = planned_contact[k] if w < 0.5 else planned_contact[k + 1]
+    # the plan's contacts of the nearer sample (and the lift-off times counted from it)
+    near = k if w < 0.5 else k + 1
+    stance = planned_contact[near]
     touching = np.zeros(4, dtype=np.bool_)
     for i in range(geom.shape[0]):
         if dist[i] <= 0.0:  # within the margin: not yet
@@ -90,10 +95,15 @@ def feet_tick(
     for leg in range(4):
         left = to_switch[k, leg] - ahead
         early = touching[leg] and left <= window
+        # a foot that lifted off less than liftoff_delay ago and still touches hands its load
+        # over (its unload task ramps up to full weight over the delay)
+        lifted = since_lift[near, leg] + ahead - (near - k) * dt
+        delay = gains[LIFTOFF_DELAY]
+        late = (not stance[leg]) and touching[leg] and delay > 0 and lifted <= delay
         # a planned stance foot is a contact while it touches the ground; off it (the ground
         # lower than planned, or a foot that bounced) it reaches down instead of the QP
         # counting on a force that the ground cannot give
-        is_contact = (stance[leg] and touching[leg]) or early
+        is_contact = (stance[leg] and touching[leg]) or early or late
         contact[leg] = is_contact
         # (a foot leaving in its unload window is let go: it lifts off a little early); the
         # target reach_depth below the foothold along the normal, moving in at reach_speed
@@ -109,6 +119,9 @@ def feet_tick(
                 pts[leg, i] = centre[i] - radius * normal[leg, i]
             if stance[leg] and unload > 0 and left < unload:
                 share = 1.0 - (0.0 if 0.0 > left else left) / unload
+                unload_w[leg] = gains[UNLOAD_WEIGHT] * share
+            elif late and not early:
+                share = (0.0 if 0.0 > lifted else lifted) / delay
                 unload_w[leg] = gains[UNLOAD_WEIGHT] * share
         else:
             pts[leg] = centre

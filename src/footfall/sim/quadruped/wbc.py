@@ -12,7 +12,10 @@ then strays far from the plan. Here every joint is torque-driven by the whole-bo
   horizontal plane through the stance contacts, as eq. 5 defines it) has no horizontal part;
 - the trunk: position and orientation (the posture's pitch, eq. 9) with PD feedback and the plan's
   acceleration as feedforward; the swing feet: the zero-impact trajectories (eq. 10-13) the same
-  way; the joints: a weak posture task toward the planned angles.
+  way; the joints: a weak posture task toward the planned angles;
+- the hand-overs: a foot about to lift is unloaded before it lifts, and a foot that has just lifted
+  but still touches stays a contact for ``liftoff_delay`` while its load passes to the others (the
+  gait lifts a front foot at the instant the hind foot on its side touches down).
 
 The QP runs at every physics step (or every ``qp_every``-th) from the state of that step
 (``mj_step1`` / ``mj_step2``); the tick packs it straight into arrays (:mod:`._wbc_tick`), the
@@ -21,6 +24,7 @@ dataclasses are rebuilt only when asked (``last_problem``).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, fields
 from typing import Any
@@ -57,13 +61,24 @@ class QuadrupedWbcGains:
         posture_kp, posture_kd: joint posture PD.
         trunk_weight, rot_weight, swing_weight, posture_weight: task weights (residuals in
             m/s^2 or rad/s^2).
-        cop_weight: weight of the horizontal moment about the planned ZMP [1/(N m)^2].
+        cop_weight: weight of the horizontal moment about the planned ZMP divided by the
+            robot's weight, i.e. of the centre of pressure's distance from the planned ZMP
+            [1/m^2] (the QP's weight per (N m)^2 is this over the weight squared, so one value
+            serves robots of any size).
         unload_time: a stance foot's normal force is driven to zero over this time before its
             planned lift-off [s] (the plan's ZMP already lies in the other three feet's triangle),
             so it leaves the ground unloaded instead of kicking the centre of pressure.
-        unload_weight: weight of that task at lift-off [1/N^2] (ramping up from 0).
+        unload_weight: weight of that task at lift-off per (normal force / robot weight)^2
+            [1] (ramping up from 0).
         touchdown_window: a swing foot that touches the ground this close [s] before its planned
             touchdown becomes a contact at once (the QP then chooses its force).
+        liftoff_delay: a foot still touching the ground this long [s] after its planned
+            lift-off stays a contact, its unload task ramping up to full weight over the delay:
+            where the document's gait lifts one foot at the instant another touches down (a hind
+            foot's touchdown and the front foot's lift-off on its side), the load passes from
+            one to the other instead of the two carrying nothing at that instant (the swing's
+            time law starts with zero velocity and acceleration, eq. 10-13: in 0.02 s of a 0.5 s
+            swing it rises 0.06 % of its height).
         reach_depth, reach_speed: a planned stance foot that does not touch the ground (the
             ground lower than planned, or a foot that bounced off) is not a contact: its target
             moves this far [m] below the foothold along the normal, at this speed [m/s], until
@@ -83,12 +98,13 @@ class QuadrupedWbcGains:
     rot_weight: float = 1.0
     swing_weight: float = 10.0
     posture_weight: float = 1e-3
-    cop_weight: float = 1e-4
+    cop_weight: float = 300.0
     unload_time: float = 0.05
-    unload_weight: float = 1e-5
+    unload_weight: float = 10.0
     touchdown_window: float = 0.05
     reach_depth: float = 0.01
     reach_speed: float = 0.1
+    liftoff_delay: float = 0.02
     qp_every: int = 2
 
     def __post_init__(self) -> None:
@@ -138,6 +154,13 @@ class _Reference:
             changed = ref.contact[k + 1] != ref.contact[k]
             nxt = np.where(changed, ref.t[k + 1], nxt)
             self.to_switch[k] = nxt - ref.t[k]
+        #: (T, 4) time from each leg's last planned lift-off to each sample [s] (inf: none yet)
+        self.since_lift = np.full(ref.contact.shape, np.inf)
+        last = np.full(4, -np.inf)
+        for k in range(1, ref.t.size):
+            lifted = (ref.contact[k] == 0) & (ref.contact[k - 1] != 0)
+            last = np.where(lifted, ref.t[k], last)
+            self.since_lift[k] = ref.t[k] - last
 
     def at(self, t: float) -> tuple[int, float]:
         """Sample index k and weight w of time ``t``: value = (1 - w) x[k] + w x[k + 1]."""
@@ -339,12 +362,19 @@ class QuadrupedWbc:
         )
         g = gains
         #: the gains in the order of pack_tick's and feet_tick's vector
+        # the CoP's and the unload's weights are per (m)^2 and per (share of the weight)^2: in
+        # the QP, per (N m)^2 and per N^2 of this robot's weight
+        weight = float(np.sum(m.body_mass)) * -float(m.opt.gravity[2])
+        g = dataclasses.replace(
+            g, cop_weight=g.cop_weight / weight**2, unload_weight=g.unload_weight / weight**2
+        )
         self._gains = np.array(
             [
                 *(g.trunk_kp, g.trunk_kd, g.rot_kp, g.rot_kd, g.swing_kp, g.swing_kd),
                 *(g.posture_kp, g.posture_kd, g.trunk_weight, g.rot_weight, g.swing_weight),
                 *(g.posture_weight, g.cop_weight, g.touchdown_window, g.unload_time),
                 *(g.unload_weight, g.reach_depth, g.reach_speed),
+                g.liftoff_delay,
             ]
         )
         #: the plan at the tick's instant (the columns of ``_Reference.table``), filled per tick
@@ -389,6 +419,7 @@ class QuadrupedWbc:
             ref.table,
             ref.contact,
             ref.to_switch,
+            ref.since_lift,
             k,
             w,
             ref.dt,
