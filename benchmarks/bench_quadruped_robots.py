@@ -4,6 +4,7 @@ built-in quadruped scenes, the gait and the scenes' lengths scaled to each robot
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_quadruped_robots.py [--robots go2,solo12,anymal_c] [--cycles 6]
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_quadruped_robots.py --speed   # x real time only
+    ... bench_quadruped_robots.py --robots document,go2 --cop-weight 100   # another CoP weight
 
 One walk per robot and ground (the simulation is deterministic). Success: no fall, and the trunk
 ends within 25 % of the planned distance of where the plan ends. CoP-ZMP: the measured centre of
@@ -26,19 +27,26 @@ from footfall.quadruped.scene import builtin_quadruped_scene, builtin_quadruped_
 from footfall.robots.quadruped import resolve_quadruped
 from footfall.sim.quadruped.mjcf import robot_settings
 from footfall.sim.quadruped.sim import simulate
+from footfall.sim.quadruped.wbc import QuadrupedWbcGains
 
 PLANES_DEG = (15.0, 20.0, -15.0)
 PLANE_FRICTION = 0.8
 
 
-def _row(robot_name: str, label: str, params: GaitParams, friction: float | None) -> str:
+def _row(
+    robot_name: str,
+    label: str,
+    params: GaitParams,
+    friction: float | None,
+    gains: QuadrupedWbcGains,
+) -> str:
     robot = resolve_quadruped(robot_name)
     try:
         scaled = scale_gait(robot, params)
         plan = plan_gait(robot, scaled)
     except InputError as e:
         return f"| {robot_name} | {label} | infeasible: {e.field} ({e.expected}) | | | | |"
-    res = simulate(plan, robot_settings(robot, friction), controller="wbc")
+    res = simulate(plan, robot_settings(robot, friction), controller="wbc", wbc_gains=gains)
     m = res.metrics
     ok = not m.fell and m.trunk_drift_from_plan_m <= 0.25 * abs(m.planned_distance_up_slope_m)
     cop = (
@@ -77,7 +85,14 @@ def main() -> None:
         action="store_true",
         help="only x real time: document and each robot, 2 cycles up 15 deg, twice, back to back",
     )
+    ap.add_argument(
+        "--cop-weight",
+        type=float,
+        default=QuadrupedWbcGains.cop_weight,
+        help="the whole-body QP's CoP weight [1/m^2] (QuadrupedWbcGains.cop_weight)",
+    )
     args = ap.parse_args()
+    gains = QuadrupedWbcGains(cop_weight=args.cop_weight)
     if args.speed:
         _speed(["document", *args.robots.split(",")])
         return
@@ -91,11 +106,11 @@ def main() -> None:
             params = GaitParams(
                 slope=math.radians(deg), body_pitch=math.radians(body), cycles=args.cycles
             )
-            print(_row(name, f"{deg:+.0f} deg", params, PLANE_FRICTION), flush=True)
+            print(_row(name, f"{deg:+.0f} deg", params, PLANE_FRICTION, gains), flush=True)
         for scene in builtin_quadruped_scene_names():
             sc = builtin_quadruped_scene(scene)
             params = sc.params
-            print(_row(name, scene, params, sc.friction), flush=True)
+            print(_row(name, scene, params, sc.friction, gains), flush=True)
 
 
 if __name__ == "__main__":
