@@ -328,12 +328,32 @@ def measure_sample(
         cop[k, 0] = _sum(lp[:, 0] * lf[:, 2] - dz * lf[:, 0]) / fz
         cop[k, 1] = _sum(lp[:, 1] * lf[:, 2] - dz * lf[:, 1]) / fz
         margin[k] = _margin(cop[k], lp, eps)
+    feet_sliding(pts, idx, stance, feet, geom_xpos, foot_geoms, foot_vel, normals, slip_vel[k])
+
+
+@njit(cache=True)
+def feet_sliding(
+    pts: np.ndarray,
+    idx: np.ndarray,
+    stance: np.ndarray,
+    feet: np.ndarray,
+    geom_xpos: np.ndarray,
+    foot_geoms: np.ndarray,
+    foot_vel: np.ndarray,
+    normals: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """Each foot's sliding velocity [m/s] into ``out`` (4, 3): at each of its contacts (the last
+    one written wins; a point foot has one), at its centre when it is planned in stance
+    (``stance`` (4,)) but off the ground, zero otherwise. Inputs as :func:`measure_sample`'s."""
+    n = idx.shape[0]
+    out[:] = 0.0
     for j in range(n):
         leg = idx[j]
-        _sliding(foot_vel[leg], pts[j], geom_xpos[foot_geoms[leg]], normals[j], slip_vel[k, leg])
+        _sliding(foot_vel[leg], pts[j], geom_xpos[foot_geoms[leg]], normals[j], out[leg])
     # a planned stance foot off the ground moves with its whole centre: that motion along the
     # ground is slip too
     for leg in range(4):
         if stance[leg] and not np.any(idx == leg):
             centre = geom_xpos[foot_geoms[leg]]
-            _sliding(foot_vel[leg], feet[leg], centre, normals[n + leg], slip_vel[k, leg])
+            _sliding(foot_vel[leg], feet[leg], centre, normals[n + leg], out[leg])

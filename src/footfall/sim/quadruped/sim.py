@@ -37,7 +37,7 @@ from footfall.sim._video import Video
 from footfall.sim.disturbance import Push, push_force
 from footfall.sim.falls import QUADRUPED_FALL
 from footfall.sim.quadruped import names as nm
-from footfall.sim.quadruped._measure import foot_contacts, measure_sample
+from footfall.sim.quadruped._measure import feet_sliding, foot_contacts, measure_sample
 from footfall.sim.quadruped.mjcf import SimSettings, ground_scene
 from footfall.sim.quadruped.slip import (
     SlipGuard,
@@ -173,6 +173,9 @@ class _Recorder:
         self._normals = np.zeros((0, 3))
         self._foot_vel = np.zeros((4, 6))
         self._foot_geoms = np.asarray(sim.foot_geoms, dtype=np.int64)
+        self._sliding = np.zeros((4, 3))
+        #: the physics step [s], the interval of the slip's integral
+        self.h = float(sim.model.opt.timestep)
 
     def _normals_at(self, pts: FloatArray, feet: FloatArray) -> FloatArray:
         """The ground's normal (N + 4, 3) at the contact points ``pts`` (N, 3), then under the
@@ -216,8 +219,31 @@ class _Recorder:
             tr.n_contacts,
             tr.slip_vel,
         )
+        tr.slip_disp[k] = tr.slip_vel[k] * self.h
         if math.isnan(tr.fallen_at) and (trunk_hit or self._fallen(k)):
             tr.fallen_at = float(tr.t[k])
+
+    def slide(self, k: int) -> None:
+        """Add one later physics step of control period ``k`` to its sliding displacement
+        (``trace.slip_disp[k]``): the feet's sliding velocity at the state the step just started
+        from (its kinematics and contacts, as :meth:`measure` reads them), times the step. The
+        stance flags are the period's planned ones (``planned.contact[k]``)."""
+        sim, d, tr = self.sim, self.sim.data, self.trace
+        pts, _, idx, _ = sim.contacts()
+        sim.foot_velocities(self._foot_vel)
+        feet = d.site_xpos[sim.foot_sites]
+        feet_sliding(
+            pts,
+            idx,
+            tr.planned.contact[k],
+            feet,
+            d.geom_xpos,
+            self._foot_geoms,
+            self._foot_vel,
+            self._normals_at(pts, feet),
+            self._sliding,
+        )
+        tr.slip_disp[k] += self._sliding * self.h
 
     def _fallen(self, k: int) -> bool:
         """Trunk tilted too far from its planned pitch, or too low above the ground
@@ -277,6 +303,8 @@ def _track(
             mj.mj_step(m, d)
             if s == 0:
                 _sample(rec, k, guard, video, d)
+            else:
+                rec.slide(k)
         if progress is not None and k % 200 == 0:
             progress(k / n)
 
@@ -321,7 +349,9 @@ def _track_wbc(
             if pushes:
                 d.xfrc_applied[sim.trunk, :3] = push_force(pushes, t_start + i * m.opt.timestep)
             mj.mj_step2(m, d)
-            if s == 0 and _sample(rec, k, guard, video, d):
+            if s > 0:
+                rec.slide(k)
+            elif _sample(rec, k, guard, video, d):
                 wbc.retarget(tr.planned)
         if progress is not None and k % 200 == 0:
             progress(k / n)
@@ -460,10 +490,11 @@ def _foot_slips(
     """Each foot's sliding over each planned stance (:func:`.slip.stance_slips`), the lengths of
     those displacements and their parts against ``u`` [m].
 
-    The displacement is the integral of the contact point's sliding velocity over the stance.
+    The displacement is the integral of the contact point's sliding velocity over the stance,
+    taken at every physics step (``slip_disp``).
     """
     down = downhill(plan, res.planned.feet)
-    per_stance = stance_slips(res.t, res.planned.contact, res.slip_vel, down)
+    per_stance = stance_slips(res.t, res.planned.contact, res.slip_disp, down)
     slips = [s.slip_m for s in per_stance]
     backward = [-min(0.0, float(np.dot(s.displacement_m, u))) for s in per_stance]
     return per_stance, slips, backward
