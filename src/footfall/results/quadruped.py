@@ -35,6 +35,12 @@ class QuadrupedTrace:
             rolling of the spherical foot. A foot planned in stance but off the ground (it
             bounced, or the ground is lower than planned) slides with its centre: the centre's
             velocity along the ground; a swing foot off the ground has none.
+        slip_disp: each foot's sliding displacement over control period ``k`` (from ``t[k]`` to
+            ``t[k + 1]``), shape (T, 4, 3) [m]: the same sliding velocity integrated at every
+            physics step of the period (left Riemann sum, the physics step as the interval; the
+            first term is ``slip_vel[k]`` times the physics step). The per-stance slip sums it: a
+            contact that lasts a few physics steps (a foot's release, a bounce) counts for those
+            steps, not for a whole control period as one sample of ``slip_vel`` would.
         planned: the commanded references at the same instants: the plan, held on four feet
             from the slip guard's stop on (the plan itself without a stop).
         fallen_at: gait time of the first fall sample [s], NaN without a fall.
@@ -51,6 +57,7 @@ class QuadrupedTrace:
     n_contacts: NDArray[np.int_]
     feet: FloatArray
     slip_vel: FloatArray
+    slip_disp: FloatArray
     planned: GaitTrajectory
     fallen_at: float = math.nan
     wall_time: float = 0.0
@@ -70,6 +77,7 @@ class QuadrupedTrace:
             n_contacts=np.zeros(n, dtype=int),
             feet=np.empty((n, 4, 3)),
             slip_vel=np.zeros((n, 4, 3)),
+            slip_disp=np.zeros((n, 4, 3)),
             planned=ref,
         )
 

@@ -132,10 +132,10 @@ def test_stance_slips_lists_each_stance_with_its_part_down_the_slope() -> None:
     t = np.linspace(0.0, 2.5, 6)
     contact = np.ones((6, 4), dtype=bool)
     contact[2:4, 1] = False  # RF swings: two stances of RF
-    vel = np.zeros((6, 4, 3))
-    vel[:, 1] = (-0.1, 0.0, 0.0)  # RF slides backwards at 0.1 m/s whenever it is down
+    disp = np.zeros((6, 4, 3))
+    disp[:, 1] = (-0.05, 0.0, 0.0)  # RF slides 5 cm backwards each 0.5 s period it is down
     down = np.array([-1.0, 0.0, 0.0])
-    out = stance_slips(t, contact, vel, down)
+    out = stance_slips(t, contact, disp, down)
     rf = [s for s in out if s.leg == "RF"]
     assert [(s.t_start_s, s.t_end_s) for s in rf] == [(0.0, 1.0), (2.0, 2.5)]
     assert [s.slip_m for s in rf] == pytest.approx([0.1, 0.1])
@@ -188,8 +188,7 @@ def steep() -> Steep:
 def _slide_after(res: SimResult, t0: float) -> float:
     """Summed length of every foot's sliding displacement after gait time t0 [m]."""
     sel = res.trace.t > t0
-    dt = float(res.trace.t[1] - res.trace.t[0])
-    return float(np.linalg.norm(res.trace.slip_vel[sel].sum(axis=0) * dt, axis=1).sum())
+    return float(np.linalg.norm(res.trace.slip_disp[sel].sum(axis=0), axis=1).sum())
 
 
 def test_the_guard_stops_the_slide_on_a_slippery_30_deg_slope(steep: Steep) -> None:

@@ -328,12 +328,106 @@ def measure_sample(
         cop[k, 0] = _sum(lp[:, 0] * lf[:, 2] - dz * lf[:, 0]) / fz
         cop[k, 1] = _sum(lp[:, 1] * lf[:, 2] - dz * lf[:, 1]) / fz
         margin[k] = _margin(cop[k], lp, eps)
+    feet_sliding(pts, idx, stance, feet, geom_xpos, foot_geoms, foot_vel, normals, slip_vel[k])
+
+
+@njit(cache=True)
+def feet_sliding(
+    pts: np.ndarray,
+    idx: np.ndarray,
+    stance: np.ndarray,
+    feet: np.ndarray,
+    geom_xpos: np.ndarray,
+    foot_geoms: np.ndarray,
+    foot_vel: np.ndarray,
+    normals: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """Each foot's sliding velocity [m/s] into ``out`` (4, 3): at each of its contacts (the last
+    one written wins; a point foot has one), at its centre when it is planned in stance
+    (``stance`` (4,)) but off the ground, zero otherwise. Inputs as :func:`measure_sample`'s."""
+    n = idx.shape[0]
+    out[:] = 0.0
     for j in range(n):
         leg = idx[j]
-        _sliding(foot_vel[leg], pts[j], geom_xpos[foot_geoms[leg]], normals[j], slip_vel[k, leg])
+        _sliding(foot_vel[leg], pts[j], geom_xpos[foot_geoms[leg]], normals[j], out[leg])
     # a planned stance foot off the ground moves with its whole centre: that motion along the
     # ground is slip too
     for leg in range(4):
         if stance[leg] and not np.any(idx == leg):
             centre = geom_xpos[foot_geoms[leg]]
-            _sliding(foot_vel[leg], feet[leg], centre, normals[n + leg], slip_vel[k, leg])
+            _sliding(foot_vel[leg], feet[leg], centre, normals[n + leg], out[leg])
+
+
+@njit(cache=True)
+def _point_velocity(
+    cvel: np.ndarray, subtree_com: np.ndarray, body: int, root: int, p: np.ndarray, out: np.ndarray
+) -> None:
+    """World-frame velocity [m/s] into ``out`` (3,) of the point ``p`` (3,) [m] fixed to
+    ``body``: MuJoCo's com-based velocity ``cvel[body]`` (``[angular, linear]``, the linear part
+    that of the point at ``subtree_com[root]``, ``root`` the body's tree root) moved to ``p``
+    (``mj_objectVelocity``'s transform, world frame)."""
+    w = cvel[body]
+    rx = p[0] - subtree_com[root, 0]
+    ry = p[1] - subtree_com[root, 1]
+    rz = p[2] - subtree_com[root, 2]
+    out[0] = w[3] + (w[1] * rz - w[2] * ry)
+    out[1] = w[4] + (w[2] * rx - w[0] * rz)
+    out[2] = w[5] + (w[0] * ry - w[1] * rx)
+
+
+@njit(cache=True)
+def slide_step(
+    geom: np.ndarray,
+    pos: np.ndarray,
+    cvel: np.ndarray,
+    subtree_com: np.ndarray,
+    foot_body: np.ndarray,
+    foot_root: np.ndarray,
+    foot_of_geom: np.ndarray,
+    trunk_geom: int,
+    stance: np.ndarray,
+    site_xpos: np.ndarray,
+    foot_sites: np.ndarray,
+    normals: np.ndarray,
+    h: float,
+    disp: np.ndarray,
+) -> None:
+    """Add one physics step's sliding of the four feet to ``disp`` (4, 3) [m]: each foot's
+    velocity along the ground at its contact point (the last of its contacts wins, as in
+    :func:`feet_sliding`), or at its site when it is planned in stance (``stance`` (4,)) but
+    touches nothing, times the step ``h`` [s].
+
+    Inputs: ``d.contact``'s ``geom`` (ncon, 2) and ``pos`` (ncon, 3) [m]; ``d.cvel`` (nbody, 6)
+    and ``d.subtree_com`` (nbody, 3) [m]; ``foot_body`` (4,) each foot geom's body,
+    ``foot_root`` (4,) that body's tree root; ``foot_of_geom`` (ngeom,) each geom's leg or -1,
+    ``trunk_geom`` the trunk's geom (its contacts are no foot's); ``d.site_xpos`` (nsite, 3) [m] and ``foot_sites`` (4,);
+    ``normals`` (4, 3) the ground's unit normal under each foot."""
+    vel = np.empty(3)
+    slide = np.zeros((4, 3))
+    touched = np.zeros(4, dtype=np.bool_)
+    for i in range(geom.shape[0]):
+        g1, g2 = geom[i, 0], geom[i, 1]
+        if g1 == trunk_geom or g2 == trunk_geom:
+            continue
+        if g1 >= 0 and foot_of_geom[g1] >= 0:
+            foot = foot_of_geom[g1]
+        elif g2 >= 0 and foot_of_geom[g2] >= 0:
+            foot = foot_of_geom[g2]
+        else:
+            continue
+        _point_velocity(cvel, subtree_com, foot_body[foot], foot_root[foot], pos[i], vel)
+        along = _dot(vel, normals[foot])
+        for r in range(3):
+            slide[foot, r] = vel[r] - along * normals[foot, r]
+        touched[foot] = True
+    for leg in range(4):
+        if stance[leg] and not touched[leg]:
+            site = site_xpos[foot_sites[leg]]
+            _point_velocity(cvel, subtree_com, foot_body[leg], foot_root[leg], site, vel)
+            along = _dot(vel, normals[leg])
+            for r in range(3):
+                slide[leg, r] = vel[r] - along * normals[leg, r]
+    for leg in range(4):
+        for r in range(3):
+            disp[leg, r] += slide[leg, r] * h

@@ -37,7 +37,7 @@ from footfall.sim._video import Video
 from footfall.sim.disturbance import Push, push_force
 from footfall.sim.falls import QUADRUPED_FALL
 from footfall.sim.quadruped import names as nm
-from footfall.sim.quadruped._measure import foot_contacts, measure_sample
+from footfall.sim.quadruped._measure import foot_contacts, measure_sample, slide_step
 from footfall.sim.quadruped.mjcf import SimSettings, ground_scene
 from footfall.sim.quadruped.slip import (
     SlipGuard,
@@ -173,6 +173,15 @@ class _Recorder:
         self._normals = np.zeros((0, 3))
         self._foot_vel = np.zeros((4, 6))
         self._foot_geoms = np.asarray(sim.foot_geoms, dtype=np.int64)
+        #: the physics step [s], the interval of the slip's integral
+        self.h = float(sim.model.opt.timestep)
+        m = sim.model
+        self._foot_body = np.asarray(m.geom_bodyid[self._foot_geoms], dtype=np.int64)
+        self._foot_root = np.asarray(m.body_rootid[self._foot_body], dtype=np.int64)
+        self._foot_sites = np.asarray(sim.foot_sites, dtype=np.int64)
+        #: the ground's normal under each foot at the last sample (4, 3)
+        up = self._plane_normal if self._plane_normal is not None else (0.0, 0.0, 1.0)
+        self._foot_normals = np.tile(up, (4, 1))
 
     def _normals_at(self, pts: FloatArray, feet: FloatArray) -> FloatArray:
         """The ground's normal (N + 4, 3) at the contact points ``pts`` (N, 3), then under the
@@ -194,6 +203,8 @@ class _Recorder:
         feet[:] = d.site_xpos[sim.foot_sites]
         pts, frc, idx, trunk_hit = sim.contacts()
         sim.foot_velocities(self._foot_vel)
+        normals = self._normals_at(pts, feet)
+        self._foot_normals[:] = normals[-4:]
         # the CoP of the loaded contacts, their support polygon (each foot touches at one point,
         # sphere on plane, so the feet's points span it) and the CoP's margin in it; each
         # contact's sliding, and that of a planned stance foot off the ground (bouncing, or the
@@ -210,14 +221,40 @@ class _Recorder:
             d.geom_xpos,
             self._foot_geoms,
             self._foot_vel,
-            self._normals_at(pts, feet),
+            normals,
             tr.cop,
             tr.margin,
             tr.n_contacts,
             tr.slip_vel,
         )
+        tr.slip_disp[k] = tr.slip_vel[k] * self.h
         if math.isnan(tr.fallen_at) and (trunk_hit or self._fallen(k)):
             tr.fallen_at = float(tr.t[k])
+
+    def slide(self, k: int) -> None:
+        """Add one later physics step of control period ``k`` to its sliding displacement
+        (``trace.slip_disp[k]``): the feet's sliding velocity at the state the step just started
+        from (its kinematics, velocities and contacts, as :meth:`measure` reads them), times the
+        step. The stance flags are the period's planned ones (``planned.contact[k]``); the
+        ground's normal is the one under each foot at sample ``k`` (on a plane, the plane's)."""
+        d, sim, tr = self.sim.data, self.sim, self.trace
+        con = d.contact
+        slide_step(
+            con.geom,
+            con.pos,
+            d.cvel,
+            d.subtree_com,
+            self._foot_body,
+            self._foot_root,
+            sim.foot_of_geom,
+            sim.trunk_geom,
+            tr.planned.contact[k],
+            d.site_xpos,
+            self._foot_sites,
+            self._foot_normals,
+            self.h,
+            tr.slip_disp[k],
+        )
 
     def _fallen(self, k: int) -> bool:
         """Trunk tilted too far from its planned pitch, or too low above the ground
@@ -277,6 +314,8 @@ def _track(
             mj.mj_step(m, d)
             if s == 0:
                 _sample(rec, k, guard, video, d)
+            else:
+                rec.slide(k)
         if progress is not None and k % 200 == 0:
             progress(k / n)
 
@@ -321,7 +360,9 @@ def _track_wbc(
             if pushes:
                 d.xfrc_applied[sim.trunk, :3] = push_force(pushes, t_start + i * m.opt.timestep)
             mj.mj_step2(m, d)
-            if s == 0 and _sample(rec, k, guard, video, d):
+            if s > 0:
+                rec.slide(k)
+            elif _sample(rec, k, guard, video, d):
                 wbc.retarget(tr.planned)
         if progress is not None and k % 200 == 0:
             progress(k / n)
@@ -460,10 +501,11 @@ def _foot_slips(
     """Each foot's sliding over each planned stance (:func:`.slip.stance_slips`), the lengths of
     those displacements and their parts against ``u`` [m].
 
-    The displacement is the integral of the contact point's sliding velocity over the stance.
+    The displacement is the integral of the contact point's sliding velocity over the stance,
+    taken at every physics step (``slip_disp``).
     """
     down = downhill(plan, res.planned.feet)
-    per_stance = stance_slips(res.t, res.planned.contact, res.slip_vel, down)
+    per_stance = stance_slips(res.t, res.planned.contact, res.slip_disp, down)
     slips = [s.slip_m for s in per_stance]
     backward = [-min(0.0, float(np.dot(s.displacement_m, u))) for s in per_stance]
     return per_stance, slips, backward

@@ -2,11 +2,14 @@
 
 Slip is the sliding of a foot's material point at its ground contact (the recorder's
 ``slip_vel``, tangential to the contact, zero off the ground; a rolling sphere has none),
-integrated over one planned stance of that foot. The same sum serves two purposes:
+integrated over one planned stance of that foot. It is summed two ways:
 
-- :func:`stance_slips`, after the walk: one :class:`StanceSlip` per planned stance of every foot;
+- :func:`stance_slips`, after the walk: one :class:`StanceSlip` per planned stance of every foot,
+  the integral taken at every physics step (the recorder's ``slip_disp``), so a contact that
+  lasts a few physics steps (a foot's release) counts for those steps only;
 - :class:`SlipMonitor`, during the walk: the sum so far of each stance foot, one control sample
-  at a time from the sample just measured (causal: no later sample is read). When a foot's slip
+  at a time from the sample just measured (causal: no later sample is read; at the control
+  rate, as a controller sees the feet: one sample stands for its whole period). When a foot's slip
   in its current stance exceeds :attr:`SlipGuard.limit`, the guard acts. ``stop``: a swing
   first lands its foot; in a body shift or the final hold (all four feet down) the gait holds at
   once. The four-foot stance is then held for the rest of the run: the commanded reference stops
@@ -76,19 +79,19 @@ def downhill(plan: GaitPlan, points: FloatArray) -> FloatArray:
 
 
 def stance_slips(
-    t: FloatArray, contact: np.ndarray, slip_vel: FloatArray, down: FloatArray
+    t: FloatArray, contact: np.ndarray, slip_disp: FloatArray, down: FloatArray
 ) -> list[StanceSlip]:
     """One :class:`StanceSlip` per planned stance of every foot, ordered by start time.
 
     Args:
-        t: sample times, shape (T,) [s], uniform.
+        t: sample times, shape (T,) [s].
         contact: planned (commanded) stance flags, shape (T, 4).
-        slip_vel: measured sliding velocity of each foot's contact point, shape (T, 4, 3) [m/s].
+        slip_disp: measured sliding displacement of each foot's contact point over each sample's
+            control period, shape (T, 4, 3) [m] (``QuadrupedTrace.slip_disp``).
         down: unit vector down the slope, shape (3,), or per sample and foot, shape (T, 4, 3)
             (a stance's part down the slope is taken along the vector at its first sample).
     """
     n = t.shape[0]
-    dt = float(t[1] - t[0]) if n > 1 else 0.0
     down = np.broadcast_to(down, (n, 4, 3))
     out: list[StanceSlip] = []
     for i, leg in enumerate(LEGS):
@@ -97,7 +100,7 @@ def stance_slips(
         for a, b in itertools.pairwise(bounds):
             if not c[a]:
                 continue
-            disp = slip_vel[a:b, i].sum(axis=0) * dt
+            disp = slip_disp[a:b, i].sum(axis=0)
             out.append(
                 StanceSlip(
                     leg.value,

@@ -1,0 +1,123 @@
+"""The per-stance slip integrates the feet's sliding at every physics step: each control period's
+``slip_disp`` equals the sum over its physics steps of the sliding velocity times the step,
+recomputed here from the states MuJoCo started each step from (kept outside the recorder, then
+re-run through ``mj_forward`` on a fresh ``MjData``), MuJoCo's contact list read here. And the
+per-stance slips are sums of it."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import pytest
+
+mujoco = pytest.importorskip("mujoco")
+
+from footfall.quadruped import GaitParams, QuadrupedRobot, plan_gait  # noqa: E402
+from footfall.quadruped.robot import LEGS  # noqa: E402
+from footfall.sim.quadruped import names as nm  # noqa: E402
+from footfall.sim.quadruped import sim as quad_sim  # noqa: E402
+
+SETTLE = 0.5  # s, simulate's default
+
+
+class _StateLog:
+    """The mujoco module with its stepping functions wrapped: each physics step's start state
+    (qpos, qvel) is kept, by step number, before MuJoCo steps."""
+
+    def __init__(self) -> None:
+        self.model: Any = None
+        self.states: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self.timestep = 0.0
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(mujoco, name)
+
+    def _keep(self, m: Any, d: Any) -> None:
+        self.model, self.timestep = m, float(m.opt.timestep)
+        self.states[round(d.time / self.timestep)] = (d.qpos.copy(), d.qvel.copy())
+
+    def mj_step(self, m: Any, d: Any) -> None:
+        self._keep(m, d)
+        mujoco.mj_step(m, d)
+
+    def mj_step1(self, m: Any, d: Any) -> None:
+        self._keep(m, d)
+        mujoco.mj_step1(m, d)
+
+
+def _sliding(log: _StateLog, d: Any, step: int, stance: np.ndarray) -> np.ndarray:
+    """(4, 3) [m/s]: each foot's contact point velocity minus its part along the ground's normal
+    (the plane of the document's slope) at the start of physics step ``step``; the centre's, along the ground, for a foot planned
+    down (``stance``) that touches nothing; zero for a swing foot in the air."""
+    m = log.model
+    d.qpos[:], d.qvel[:] = log.states[step]
+    mujoco.mj_forward(m, d)
+    geom = mujoco.mjtObj.mjOBJ_GEOM
+    feet = [mujoco.mj_name2id(m, geom, nm.foot_geom(leg)) for leg in LEGS]
+    floor = mujoco.mj_name2id(m, geom, nm.FLOOR_GEOM)
+    out = np.zeros((4, 3))
+    touched = [False] * 4
+    vel = np.zeros(6)
+    for c in d.contact[: d.ncon]:
+        pair = {int(c.geom1), int(c.geom2)}
+        if floor not in pair:
+            continue
+        for leg, g in enumerate(feet):
+            if g in pair:
+                mujoco.mj_objectVelocity(m, d, geom, g, vel, 0)
+                point_vel = vel[3:] + np.cross(vel[:3], c.pos - d.geom_xpos[g])
+                normal = NORMAL
+                out[leg] = point_vel - (point_vel @ normal) * normal
+                touched[leg] = True
+    for leg, g in enumerate(feet):
+        if stance[leg] and not touched[leg]:
+            mujoco.mj_objectVelocity(m, d, geom, g, vel, 0)
+            out[leg] = vel[3:] - (vel[3:] @ NORMAL) * NORMAL
+    return out
+
+
+SLOPE = math.radians(15.0)
+#: the slope's upward normal (up the slope is +x)
+NORMAL = np.array([-math.sin(SLOPE), 0.0, math.cos(SLOPE)])
+
+
+@pytest.mark.parametrize("controller", ["wbc", "servo"])
+def test_each_period_integrates_every_physics_step(
+    controller: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    log = _StateLog()
+    monkeypatch.setattr(quad_sim, "require_mujoco", lambda: log)
+    plan = plan_gait(QuadrupedRobot(), GaitParams(slope=SLOPE, body_pitch=SLOPE * 2 / 3, cycles=1))
+    res = quad_sim.simulate(plan, controller=controller, settle_time=SETTLE)
+    tr = res.trace
+    assert math.isnan(tr.fallen_at)
+    h = log.timestep
+    per_period = round(0.01 / h)
+    assert per_period > 1
+    d = mujoco.MjData(log.model)
+    n = tr.t.shape[0]
+    reference = np.zeros((n, 4, 3))
+    for k in range(n):
+        first = round((SETTLE + float(tr.t[k])) / h)
+        for s in range(per_period):
+            reference[k] += _sliding(log, d, first + s, tr.planned.contact[k]) * h
+    np.testing.assert_allclose(tr.slip_disp, reference, rtol=0, atol=1e-12)
+    # the control-rate sum (one sample for its whole period) is a different number: the check
+    # tells them apart, by far more than the match above
+    assert np.abs(tr.slip_vel * 0.01 - reference).max() > 1e-6
+    # each planned stance's slip is the length of the sum of its periods (stances found here
+    # from the planned contact flags: runs of samples with the foot down)
+    expected = []
+    for leg in range(4):
+        down = np.concatenate([[False], tr.planned.contact[:, leg], [False]]).astype(int)
+        starts, ends = np.flatnonzero(np.diff(down) == 1), np.flatnonzero(np.diff(down) == -1)
+        for a, b in zip(starts, ends, strict=True):
+            expected.append((LEGS[leg].value, float(np.linalg.norm(reference[a:b, leg].sum(0)))))
+    got = [(st.leg, st.slip_m) for st in res.metrics.stance_slips]
+    assert sorted(x[0] for x in got) == sorted(x[0] for x in expected)
+    for leg in LEGS:
+        mine = [v for name, v in expected if name == leg.value]
+        theirs = [v for name, v in got if name == leg.value]
+        np.testing.assert_allclose(theirs, mine, rtol=0, atol=1e-12)
