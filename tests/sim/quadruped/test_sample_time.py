@@ -6,51 +6,22 @@ later, for both controllers."""
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 import pytest
 
 mujoco = pytest.importorskip("mujoco")
 
-from footfall.quadruped import GaitParams, QuadrupedRobot, plan_gait  # noqa: E402
 from footfall.quadruped.robot import LEGS  # noqa: E402
 from footfall.sim.quadruped import names as nm  # noqa: E402
-from footfall.sim.quadruped import sim as quad_sim  # noqa: E402
-
-SETTLE = 0.5  # s, simulate's default
+from tests.sim.quadruped.state_log import SETTLE, StateLog, logged_walk  # noqa: E402
 
 
-class _StateLog:
-    """The mujoco module with its stepping functions wrapped: each physics step's start state
-    (time, qpos) is kept before MuJoCo steps."""
-
-    def __init__(self) -> None:
-        self.model: Any = None
-        self.states: dict[int, np.ndarray] = {}
-        self.timestep = 0.0
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(mujoco, name)
-
-    def _keep(self, m: Any, d: Any) -> None:
-        self.model, self.timestep = m, float(m.opt.timestep)
-        self.states[round(d.time / self.timestep)] = d.qpos.copy()
-
-    def mj_step(self, m: Any, d: Any) -> None:
-        self._keep(m, d)
-        mujoco.mj_step(m, d)
-
-    def mj_step1(self, m: Any, d: Any) -> None:
-        self._keep(m, d)
-        mujoco.mj_step1(m, d)
-
-
-def _kinematics(log: _StateLog, step: int) -> tuple[np.ndarray, np.ndarray]:
+def _kinematics(log: StateLog, step: int) -> tuple[np.ndarray, np.ndarray]:
     """Trunk centre and foot sites [m] of the state at the start of physics step ``step``."""
     m = log.model
     d = mujoco.MjData(m)
-    d.qpos[:] = log.states[step]
+    d.qpos[:] = log.states[step][0]
     mujoco.mj_kinematics(m, d)
     trunk = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, nm.TRUNK_BODY)
     sites = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, nm.foot_site(leg)) for leg in LEGS]
@@ -61,11 +32,8 @@ def _kinematics(log: _StateLog, step: int) -> tuple[np.ndarray, np.ndarray]:
 def test_sample_k_is_the_state_at_its_time(
     controller: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    log = _StateLog()
-    monkeypatch.setattr(quad_sim, "require_mujoco", lambda: log)
-    slope = math.radians(15.0)
-    plan = plan_gait(QuadrupedRobot(), GaitParams(slope=slope, body_pitch=slope * 2 / 3, cycles=1))
-    tr = quad_sim.simulate(plan, controller=controller, settle_time=SETTLE).trace
+    log, res = logged_walk(monkeypatch, controller, math.radians(15.0))
+    tr = res.trace
     assert math.isnan(tr.fallen_at)
     n = tr.t.shape[0]
     per_sample = round(0.01 / log.timestep)

@@ -14,40 +14,12 @@ import pytest
 
 mujoco = pytest.importorskip("mujoco")
 
-from footfall.quadruped import GaitParams, QuadrupedRobot, plan_gait  # noqa: E402
 from footfall.quadruped.robot import LEGS  # noqa: E402
 from footfall.sim.quadruped import names as nm  # noqa: E402
-from footfall.sim.quadruped import sim as quad_sim  # noqa: E402
-
-SETTLE = 0.5  # s, simulate's default
+from tests.sim.quadruped.state_log import SETTLE, StateLog, logged_walk  # noqa: E402
 
 
-class _StateLog:
-    """The mujoco module with its stepping functions wrapped: each physics step's start state
-    (qpos, qvel) is kept, by step number, before MuJoCo steps."""
-
-    def __init__(self) -> None:
-        self.model: Any = None
-        self.states: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-        self.timestep = 0.0
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(mujoco, name)
-
-    def _keep(self, m: Any, d: Any) -> None:
-        self.model, self.timestep = m, float(m.opt.timestep)
-        self.states[round(d.time / self.timestep)] = (d.qpos.copy(), d.qvel.copy())
-
-    def mj_step(self, m: Any, d: Any) -> None:
-        self._keep(m, d)
-        mujoco.mj_step(m, d)
-
-    def mj_step1(self, m: Any, d: Any) -> None:
-        self._keep(m, d)
-        mujoco.mj_step1(m, d)
-
-
-def _sliding(log: _StateLog, d: Any, step: int, stance: np.ndarray) -> np.ndarray:
+def _sliding(log: StateLog, d: Any, step: int, stance: np.ndarray) -> np.ndarray:
     """(4, 3) [m/s]: each foot's contact point velocity minus its part along the ground's normal
     (the plane of the document's slope) at the start of physics step ``step``; the centre's, along the ground, for a foot planned
     down (``stance``) that touches nothing; zero for a swing foot in the air."""
@@ -87,10 +59,7 @@ NORMAL = np.array([-math.sin(SLOPE), 0.0, math.cos(SLOPE)])
 def test_each_period_integrates_every_physics_step(
     controller: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    log = _StateLog()
-    monkeypatch.setattr(quad_sim, "require_mujoco", lambda: log)
-    plan = plan_gait(QuadrupedRobot(), GaitParams(slope=SLOPE, body_pitch=SLOPE * 2 / 3, cycles=1))
-    res = quad_sim.simulate(plan, controller=controller, settle_time=SETTLE)
+    log, res = logged_walk(monkeypatch, controller, SLOPE)
     tr = res.trace
     assert math.isnan(tr.fallen_at)
     h = log.timestep
