@@ -1,9 +1,18 @@
-"""Push recovery of the MuJoCo biped: success against push impulse, per scene and controller.
+"""Push recovery of the MuJoCo biped (or any robot): success against push size, per scene and controller.
 
 Run (from the repository root, about 10-20 minutes on 2 cores)::
 
     OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_pushes.py \\
         --controllers wbc,servo --impulses 4,6,8,10,12,15 --seeds 10 --seed-start 0 --out out/pushes
+
+Any robot, pushes as velocity changes (impulse = robot mass x Δv [m/s]; the robots issue's
+measure: Δv = 0.1 m/s on seeds 0-49, success with Wilson intervals)::
+
+    OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_pushes.py --robot g1 \
+        --controllers wbc --scenes flat_long --dv 0.1 --seeds 50 --out out/pushes-g1
+
+``--robot`` takes what ``footfall walk --robot`` takes (a built-in name or a robot file); seed
+``s`` draws the same push as ``footfall walk --push-dv DV --seed s``.
 
 ``--region-aware planned,horizon`` walks every case once per region mode of the walker's MPC
 (:attr:`footfall.sim.biped.options.WalkOptions.region_aware`) and adds a paired comparison of each
@@ -11,7 +20,7 @@ mode against the first: walks that only one mode survived, and the exact two-sid
 (McNemar's exact test) on them.
 
 Every walk follows the scene's miqcqp plan (``plan_for_walk``, cached in ``OUT/plans``) with one
-horizontal push of ``impulse`` N s over 0.1 s, its direction, step and phase drawn from the seed
+horizontal push of ``impulse`` N s (or robot mass x ``dv`` m/s) over 0.1 s, its direction, step and phase drawn from the seed
 (:meth:`footfall.sim.disturbance.Disturbance.of_seed`, the draw of ``footfall walk --seed`` and
 of the study's trials): seed ``s`` gives both controllers the same push. Success = the goal reached without a fall. Per scene,
 controller and impulse the table gives the successes, the rate with its Wilson 95 % interval, and
@@ -33,6 +42,8 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 #: the scenes and their step counts (the walks' smallest N with 64 heading segments, except the
 #: 20 steps of flat_long)
 SCENES = {"flat_long": 20, "discrete_steps": 15, "stairs_slope_gap": 16}
+#: the two ways to give a push's size: an impulse [N s] or a velocity change [m/s]
+IMPULSE, DV = "impulse_Ns", "dv_m_s"
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -47,34 +58,54 @@ def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
 
 
 def crossing(levels: list[float], rates: list[float], level: float = 0.5) -> str:
-    """The impulse where the success rate first falls below ``level`` (linear interpolation)."""
+    """The push size where the success rate first falls below ``level`` (linear interpolation)."""
     if rates and rates[0] < level:
         return f"< {levels[0]:g}"
     for i in range(len(levels) - 1):
         x0, r0, x1, r1 = levels[i], rates[i], levels[i + 1], rates[i + 1]
         if r0 >= level > r1:
-            return f"{x0 + (r0 - level) / (r0 - r1) * (x1 - x0):.1f}"
+            return f"{x0 + (r0 - level) / (r0 - r1) * (x1 - x0):.3g}"
     return f"> {levels[-1]:g}"
 
 
-def _walk(job: tuple[str, str, str, float, int, str]) -> dict[str, object]:
+def _levels(ap: argparse.ArgumentParser, flag: str, text: str) -> list[float]:
+    """The push sizes of ``text`` (comma separated, each finite and > 0), sorted."""
+    try:
+        levels = sorted(float(x) for x in text.split(","))
+    except ValueError:
+        ap.error(f"{flag}: {text!r} is not a comma-separated list of numbers")
+    if not levels or not all(math.isfinite(x) and x > 0 for x in levels):
+        ap.error(f"{flag}: {text!r}: every value must be a finite number > 0")
+    return levels
+
+
+def _walk(job: tuple[str, str, str, float, int, str, str, str, int]) -> dict[str, object]:
     from footfall.sim.biped.options import WalkOptions
-    from footfall.sim.biped.plans import plan_for_walk
+    from footfall.sim.biped.plans import plan_for_walk, robot_model
     from footfall.sim.biped.trial import MujocoBipedPlant
     from footfall.sim.disturbance import Disturbance
     from footfall.sim.trial import run_trial
     from footfall.terrain.scene import builtin_scene
 
-    scene_name, controller, region, impulse, seed, cache = job
+    scene_name, controller, region, size, seed, cache, robot, unit, steps = job
     scene = builtin_scene(scene_name)
-    plan = plan_for_walk(scene, "miqcqp", SCENES[scene_name], 600.0, Path(cache))
-    plant = MujocoBipedPlant(WalkOptions(controller=controller, region_aware=region))
-    out = run_trial(plant, scene, plan, Disturbance.of_seed(seed, impulse=impulse))
+    model = robot_model(robot)
+    n = steps or SCENES.get(scene_name)
+    plan = plan_for_walk(scene, "miqcqp", n, 600.0, Path(cache), model=model)
+    plant = MujocoBipedPlant(WalkOptions(controller=controller, region_aware=region), robot=model)
+    push = (
+        Disturbance.of_seed(seed, dv=size)
+        if unit == DV
+        else Disturbance.of_seed(seed, impulse=size)
+    )
+    out = run_trial(plant, scene, plan, push)
     return {
+        "robot": robot,
         "scene": scene_name,
         "controller": controller,
         "region_aware": region,
-        "impulse_Ns": impulse,
+        unit: size,
+        "impulse_Ns": push.impulse_for(plan.robot.mass),
         "seed": seed,
         "success": out.success,
         "fell": out.fell,
@@ -85,15 +116,13 @@ def _walk(job: tuple[str, str, str, float, int, str]) -> dict[str, object]:
     }
 
 
-def _paired(rows: list[dict[str, object]], modes: list[str]) -> None:
-    """Each region mode against the first, paired by (scene, controller, impulse, seed): the
+def _paired(rows: list[dict[str, object]], modes: list[str], unit: str) -> None:
+    """Each region mode against the first, paired by (scene, controller, push size, seed): the
     walks only one of the two survived and the exact two-sided sign test on them."""
     from scipy.stats import binomtest
 
     ok = {
-        (r["scene"], r["controller"], r["impulse_Ns"], r["seed"], r["region_aware"]): bool(
-            r["success"]
-        )
+        (r["scene"], r["controller"], r[unit], r["seed"], r["region_aware"]): bool(r["success"])
         for r in rows
     }
     keys = sorted({k[:4] for k in ok}, key=str)
@@ -116,20 +145,42 @@ def main() -> None:
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--region-aware", default="planned", help="region modes, comma-separated")
     ap.add_argument("--impulses", default="4,6,8,10,12,15", help="push impulses [N s]")
+    ap.add_argument(
+        "--dv", default="", help="pushes as velocity changes [m/s] (impulse = mass x dv) instead"
+    )
+    ap.add_argument("--robot", default="biped", help="biped, g1, talos or a robot file (.yaml)")
+    ap.add_argument(
+        "--steps", type=int, default=0, help="footsteps N of every scene (0: each scene's own)"
+    )
     ap.add_argument("--seeds", type=int, default=10, help="walks per scene, controller, impulse")
     ap.add_argument("--seed-start", type=int, default=0, help="first seed (held-out seeds)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", type=Path, default=Path("out/pushes"))
     a = ap.parse_args()
-    levels = sorted(float(x) for x in a.impulses.split(","))
+    unit = DV if a.dv else IMPULSE
+    levels = _levels(ap, "--dv" if a.dv else "--impulses", a.dv or a.impulses)
     scenes = a.scenes.split(",")
+    for sc in scenes:
+        if sc not in SCENES and a.steps <= 0:
+            ap.error(
+                f"--scenes: {sc!r} has no default N (one of {', '.join(SCENES)}); give --steps"
+            )
+    if a.steps < 0 or a.seeds < 1:
+        ap.error("--steps must be >= 0 and --seeds >= 1")
+    from footfall.errors import FootfallError
+    from footfall.sim.biped.plans import robot_model
+
+    try:
+        robot_model(a.robot)
+    except FootfallError as e:
+        ap.error(f"--robot: {e}")
     controllers = a.controllers.split(",")
     modes = a.region_aware.split(",")
     variants = [(ctl, mode) for ctl in controllers for mode in modes]
     a.out.mkdir(parents=True, exist_ok=True)
     cache = str(a.out / "plans")
     jobs = [
-        (sc, ctl, mode, imp, seed, cache)
+        (sc, ctl, mode, imp, seed, cache, a.robot, unit, a.steps)
         for sc in scenes
         for ctl, mode in variants
         for imp in levels
@@ -137,16 +188,18 @@ def main() -> None:
     ]
     # plan once per scene before the pool (the cache then serves every worker)
     for sc in scenes:
-        _walk((sc, controllers[0], modes[0], levels[0], 0, cache))
+        _walk((sc, controllers[0], modes[0], levels[0], 0, cache, a.robot, unit, a.steps))
     with Pool(a.workers) as pool:
         rows = pool.map(_walk, jobs, chunksize=1)
     with (a.out / "pushes.csv").open("w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
+    label = "m/s" if unit == DV else "N s"
+    print(f"{a.robot}, pushes as {'velocity changes' if unit == DV else 'impulses'} [{label}]")
     print(
         "| scene | controller | region mode | "
-        + " | ".join(f"{x:g} N s" for x in levels)
+        + " | ".join(f"{x:g} {label}" for x in levels)
         + " | 50 % at |"
     )
     print("|---|---|---|" + "---|" * len(levels) + "---|")
@@ -157,7 +210,7 @@ def main() -> None:
                 rs = [
                     r
                     for r in rows
-                    if (r["scene"], r["controller"], r["region_aware"], r["impulse_Ns"])
+                    if (r["scene"], r["controller"], r["region_aware"], r[unit])
                     == (sc, ctl, mode, imp)
                 ]
                 k = sum(bool(r["success"]) for r in rs)
@@ -167,10 +220,10 @@ def main() -> None:
             print(
                 f"| {sc} | {ctl} | {mode} | "
                 + " | ".join(cells)
-                + f" | {crossing(levels, rates)} N s |"
+                + f" | {crossing(levels, rates)} {label} |"
             )
     if len(modes) > 1:
-        _paired(rows, modes)
+        _paired(rows, modes, unit)
     wall = sum(float(r["wall_s"]) for r in rows)
     sim = sum(float(r["sim_s"]) for r in rows)
     print(f"\n{len(rows)} walks, {sim / wall:.1f}x real time per walk (mean over workers)")
