@@ -5,8 +5,8 @@ Run (from the repository root, about 10-20 minutes on 2 cores)::
     OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_pushes.py \\
         --controllers wbc,servo --impulses 4,6,8,10,12,15 --seeds 10 --seed-start 0 --out out/pushes
 
-Any robot, pushes as velocity changes (impulse = robot mass x Δv [m/s]; the robots issue's
-measure: Δv = 0.1 m/s on seeds 0-49, success with Wilson intervals)::
+Any robot, pushes as velocity changes (impulse = robot mass x Δv [m/s]), e.g. the measure per
+robot of RESULTS.md, Δv = 0.1 m/s on seeds 0-49 with Wilson intervals::
 
     OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_pushes.py --robot g1 \
         --controllers wbc --scenes flat_long --dv 0.1 --seeds 50 --out out/pushes-g1
