@@ -1,4 +1,4 @@
-"""Push recovery of the MuJoCo biped (or any robot): success against push size, per scene and controller.
+"""Push recovery of a MuJoCo humanoid: success against push size, per scene and controller.
 
 Run (from the repository root, about 10-20 minutes on 2 cores)::
 
@@ -8,7 +8,7 @@ Run (from the repository root, about 10-20 minutes on 2 cores)::
 Any robot, pushes as velocity changes (impulse = robot mass x Δv [m/s]), e.g. the measure per
 robot of RESULTS.md, Δv = 0.1 m/s on seeds 0-49 with Wilson intervals::
 
-    OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_pushes.py --robot g1 \
+    OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_pushes.py --robot g1 \\
         --controllers wbc --scenes flat_long --dv 0.1 --seeds 50 --out out/pushes-g1
 
 ``--robot`` takes what ``footfall walk --robot`` takes (a built-in name or a robot file); seed
@@ -20,8 +20,8 @@ mode against the first: walks that only one mode survived, and the exact two-sid
 (McNemar's exact test) on them.
 
 Every walk follows the scene's miqcqp plan (``plan_for_walk``, cached in ``OUT/plans``) with one
-horizontal push of ``impulse`` N s (or robot mass x ``dv`` m/s) over 0.1 s, its direction, step and phase drawn from the seed
-(:meth:`footfall.sim.disturbance.Disturbance.of_seed`, the draw of ``footfall walk --seed`` and
+horizontal push of ``impulse`` N s (or robot mass x ``dv`` m/s) over 0.1 s, its direction, step
+and phase drawn from the seed (:meth:`footfall.sim.disturbance.Disturbance.of_seed`, the draw of ``footfall walk --seed`` and
 of the study's trials): seed ``s`` gives both controllers the same push. Success = the goal reached without a fall. Per scene,
 controller and impulse the table gives the successes, the rate with its Wilson 95 % interval, and
 the impulse at which the success rate crosses 50 % (linear interpolation between the levels
@@ -169,11 +169,17 @@ def main() -> None:
         ap.error("--steps must be >= 0 and --seeds >= 1")
     from footfall.errors import FootfallError
     from footfall.sim.biped.plans import robot_model
+    from footfall.terrain.scene import builtin_scene
 
     try:
         robot_model(a.robot)
     except FootfallError as e:
         ap.error(f"--robot: {e}")
+    for sc in scenes:
+        try:
+            builtin_scene(sc)
+        except FootfallError as e:
+            ap.error(f"--scenes: {e}")
     controllers = a.controllers.split(",")
     modes = a.region_aware.split(",")
     variants = [(ctl, mode) for ctl in controllers for mode in modes]
