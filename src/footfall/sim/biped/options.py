@@ -144,8 +144,8 @@ class WalkOptions:
             off, document 000's point-mass prediction). Needs the CoM-velocity estimate
             (``true_momentum`` False). Default 0: with 0.5 Talos reaches the flat_long goal
             (falls without) and survives 20 of 50 random 0.1 m/s pushes (0 without), our biped's
-            held-out 4 N s pushes go from 93 to 99 of 100 and the G1's and its ZMP offsets drop
-            by a third to a half, but Alexander (legs 36 % of its mass each) survives 32 of 50
+            held-out 4 N s pushes go from 93 to 99 of 100 and its and the G1's ZMP offsets
+            drop by 40-45 %, but Alexander (legs 36 % of its mass each) survives 32 of 50
             pushes against 44 (benchmarks/RESULTS.md, "The legs' momentum in the MPC's
             prediction").
     """
