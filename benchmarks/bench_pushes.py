@@ -79,7 +79,7 @@ def _levels(ap: argparse.ArgumentParser, flag: str, text: str) -> list[float]:
     return levels
 
 
-def _walk(job: tuple[str, str, str, float, int, str, str, str, int]) -> dict[str, object]:
+def _walk(job: tuple[str, str, str, float, int, str, str, str, int, float]) -> dict[str, object]:
     from footfall.sim.biped.options import WalkOptions
     from footfall.sim.biped.plans import plan_for_walk, robot_model
     from footfall.sim.biped.trial import MujocoBipedPlant
@@ -87,12 +87,13 @@ def _walk(job: tuple[str, str, str, float, int, str, str, str, int]) -> dict[str
     from footfall.sim.trial import run_trial
     from footfall.terrain.scene import builtin_scene
 
-    scene_name, controller, region, size, seed, cache, robot, unit, steps = job
+    scene_name, controller, region, size, seed, cache, robot, unit, steps, leg = job
     scene = builtin_scene(scene_name)
     model = robot_model(robot)
     n = steps or SCENES.get(scene_name)
     plan = plan_for_walk(scene, "miqcqp", n, 600.0, Path(cache), model=model)
-    plant = MujocoBipedPlant(WalkOptions(controller=controller, region_aware=region), robot=model)
+    options = WalkOptions(controller=controller, region_aware=region, leg_momentum=leg)
+    plant = MujocoBipedPlant(options, robot=model)
     push = (
         Disturbance.of_seed(seed, dv=size)
         if unit == DV
@@ -152,6 +153,12 @@ def main() -> None:
     ap.add_argument(
         "--steps", type=int, default=0, help="footsteps N of every scene (0: each scene's own)"
     )
+    ap.add_argument(
+        "--leg-momentum",
+        type=float,
+        default=0.0,
+        help="WalkOptions.leg_momentum: share of the legs' forecast momentum (0: off)",
+    )
     ap.add_argument("--seeds", type=int, default=10, help="walks per scene, controller, impulse")
     ap.add_argument("--seed-start", type=int, default=0, help="first seed (held-out seeds)")
     ap.add_argument("--workers", type=int, default=2)
@@ -175,6 +182,13 @@ def main() -> None:
         robot_model(a.robot)
     except FootfallError as e:
         ap.error(f"--robot: {e}")
+    from footfall.sim.biped.options import WalkOptions
+
+    for ctl in a.controllers.split(","):
+        try:
+            WalkOptions(controller=ctl, leg_momentum=a.leg_momentum)
+        except FootfallError as e:
+            ap.error(f"--controllers / --leg-momentum: {e}")
     for sc in scenes:
         try:
             builtin_scene(sc)
@@ -186,7 +200,7 @@ def main() -> None:
     a.out.mkdir(parents=True, exist_ok=True)
     cache = str(a.out / "plans")
     jobs = [
-        (sc, ctl, mode, imp, seed, cache, a.robot, unit, a.steps)
+        (sc, ctl, mode, imp, seed, cache, a.robot, unit, a.steps, a.leg_momentum)
         for sc in scenes
         for ctl, mode in variants
         for imp in levels
@@ -194,7 +208,20 @@ def main() -> None:
     ]
     # plan once per scene before the pool (the cache then serves every worker)
     for sc in scenes:
-        _walk((sc, controllers[0], modes[0], levels[0], 0, cache, a.robot, unit, a.steps))
+        _walk(
+            (
+                sc,
+                controllers[0],
+                modes[0],
+                levels[0],
+                0,
+                cache,
+                a.robot,
+                unit,
+                a.steps,
+                a.leg_momentum,
+            )
+        )
     with Pool(a.workers) as pool:
         rows = pool.map(_walk, jobs, chunksize=1)
     with (a.out / "pushes.csv").open("w", newline="") as fh:

@@ -181,6 +181,8 @@ def test_summary_counts_and_largest_level() -> None:
         ({"dv": (0.1,), "directions": ("up",)}, "directions"),
         ({"dv": (0.1,), "duration": 0.0}, "duration"),
         ({"dv": (0.1,), "region_aware": "horizons"}, "region_aware"),
+        ({"dv": (0.1,), "leg_momentum": -0.5}, "leg_momentum"),
+        ({"dv": (0.1,), "leg_momentum": 0.5, "controller": "servo"}, "leg_momentum"),
     ],
 )
 def test_protocol_refuses_bad_settings(kwargs: dict[str, object], field: str) -> None:
@@ -200,6 +202,8 @@ def test_protocol_refuses_bad_settings(kwargs: dict[str, object], field: str) ->
         (["--scene", "no_such_scene"], "scene"),
         (["--directions", "sideways"], "directions"),
         (["--region-aware", "horizons"], "region_aware"),
+        (["--leg-momentum", "1.5"], "leg_momentum"),
+        (["--leg-momentum", "0.5", "--controller", "servo"], "leg_momentum"),
     ],
 )
 def test_cli_refuses_bad_values(tmp_path: Path, args: list[str], field: str) -> None:

@@ -311,6 +311,12 @@ def bench_pushes_cmd(
         help="How the walker's MPC keeps the next footstep on the terrain: off, planned, nearby "
         "or horizon (the region the 3-footstep MIQP chooses from the measured state).",
     ),
+    leg_momentum: float = typer.Option(
+        0.0,
+        "--leg-momentum",
+        help="Share in [0, 1] of the legs' forecast sagittal momentum [kg m^2/s] that the "
+        "walker's MPC carries (0: off; see footfall walk --leg-momentum).",
+    ),
     dv: str = typer.Option("0.1,0.2,0.3", "--dv", help=_DV_HELP),
     phases: str = typer.Option(
         "0.2,0.45,0.7",
@@ -377,6 +383,7 @@ def bench_pushes_cmd(
         planner=planner,
         controller=controller,
         region_aware=region_aware,
+        leg_momentum=leg_momentum,
     )
     from footfall.robots.registry import resolve_robot_file
     from footfall.terrain.resolve import resolve_scene

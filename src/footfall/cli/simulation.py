@@ -518,6 +518,14 @@ def walk_cmd(
         help=_REGION_HELP + " The walker's default is planned (over the built-in scenes with "
         "2 N s pushes it reached the goal in 90 of 90 walks, 70 of 90 with off).",
     ),
+    leg_momentum: float = typer.Option(
+        0.0,
+        "--leg-momentum",
+        help="Share in [0, 1] of the legs' sagittal momentum about the CoM [kg m^2/s], "
+        "forecast over each single support from the previous one, that the MPC's prediction "
+        "carries (0: off, the document's point-mass prediction). Robots with heavy legs: "
+        "0.5 let Talos reach the flat_long goal (see benchmarks/RESULTS.md).",
+    ),
     quiet: bool = typer.Option(
         False, "--quiet", help="No planning progress lines or status line (results still print)."
     ),
@@ -558,6 +566,10 @@ def walk_cmd(
     check_region_mode(region_aware)
     if steps is not None and steps < 1:
         raise InputError("steps", steps, "an integer >= 1")
+    # the walker's options are checked before planning, which can take minutes
+    options = WalkOptions(
+        controller=controller, region_aware=region_aware, leg_momentum=leg_momentum
+    )
     disturbance = disturbance_of(
         push, push_dv, seed, push_step, push_phase, push_direction, push_duration
     )
@@ -591,7 +603,7 @@ def walk_cmd(
         raise typer.Exit(1)
     replay = ReplayRecorder("biped")
     plant = MujocoBipedPlant(
-        WalkOptions(controller=controller, region_aware=region_aware),
+        options,
         robot=model,
         video_path=out / "walk.mp4" if video else None,
         replay=replay,

@@ -88,6 +88,8 @@ class PushProtocol:
         controller: the walker's controller (``wbc`` or ``servo``).
         region_aware: how the walker's MPC keeps footsteps on the terrain
             (:attr:`footfall.sim.biped.options.WalkOptions.region_aware`).
+        leg_momentum: the share of the legs' forecast momentum the walker's MPC carries
+            (:attr:`footfall.sim.biped.options.WalkOptions.leg_momentum`; 0: off).
     """
 
     dv: tuple[float, ...]
@@ -101,11 +103,15 @@ class PushProtocol:
     planner: str = "miqcqp"
     controller: str = "wbc"
     region_aware: str = "planned"
+    leg_momentum: float = 0.0
 
     def __post_init__(self) -> None:
         from footfall.control.adjusters import check_region_mode
+        from footfall.sim.biped.options import CONTROLLERS, WalkOptions
 
         check_region_mode(self.region_aware)
+        if self.controller in CONTROLLERS:  # an unknown controller: run_protocol says so
+            WalkOptions(controller=self.controller, leg_momentum=self.leg_momentum)
         dv = tuple(finite("dv [m/s]", v) for v in self.dv)
         if not dv or any(v <= 0 for v in dv) or len(set(dv)) != len(dv):
             raise InputError("dv [m/s]", list(self.dv), "distinct velocity changes > 0")
@@ -188,16 +194,18 @@ class ProtocolResult:
 
 
 @functools.lru_cache(maxsize=2)
-def _plant(robot: str, controller: str, region_aware: str) -> Any:
-    """The MuJoCo plant of ``robot`` with ``controller`` and the MPC's ``region_aware`` mode (one
-    per worker process)."""
+def _plant(robot: str, controller: str, region_aware: str, leg_momentum: float = 0.0) -> Any:
+    """The MuJoCo plant of ``robot`` with ``controller``, the MPC's ``region_aware`` mode and
+    ``leg_momentum`` share (one per worker process)."""
     from footfall.sim.biped.options import WalkOptions
     from footfall.sim.biped.plans import robot_model
     from footfall.sim.trial import make_plant
 
     return make_plant(
         "mujoco",
-        options=WalkOptions(controller=controller, region_aware=region_aware),
+        options=WalkOptions(
+            controller=controller, region_aware=region_aware, leg_momentum=leg_momentum
+        ),
         robot=robot_model(robot),
     )
 
@@ -206,6 +214,7 @@ def _walk_case(
     robot: str,
     controller: str,
     region_aware: str,
+    leg_momentum: float,
     scene: Any,
     plan: Any,
     case: PushCase,
@@ -214,7 +223,7 @@ def _walk_case(
     """Walk one case; its row (:data:`COLUMNS`)."""
     from footfall.sim.trial import run_trial, trial_pushes
 
-    plant = _plant(robot, controller, region_aware)
+    plant = _plant(robot, controller, region_aware, leg_momentum)
     pushes = trial_pushes(plant, plan, d)
     out = run_trial(plant, scene, plan, d)
     reached = bool(out.detail.metrics.reached_goal)
@@ -277,7 +286,8 @@ def run_protocol(
         rows[case] = row
         if progress is not None:
             progress(row)
-    mass = float(_plant(protocol.robot, protocol.controller, protocol.region_aware).mass(plan))
+    p = protocol
+    mass = float(_plant(p.robot, p.controller, p.region_aware, p.leg_momentum).mass(plan))
     return ProtocolResult(
         protocol, scene.name, int(plan.n_steps), step, mass, [rows[c] for c in cases]
     )
@@ -290,7 +300,8 @@ def _walks(
     jobs: list[tuple[PushCase, Disturbance]],
     workers: int,
 ) -> Iterator[tuple[PushCase, dict[str, Any]]]:
-    args = (protocol.robot, protocol.controller, protocol.region_aware, scene, plan)
+    p = protocol
+    args = (p.robot, p.controller, p.region_aware, p.leg_momentum, scene, plan)
     if workers <= 1 or len(jobs) <= 1:
         for case, d in jobs:
             yield case, _walk_case(*args, case, d)

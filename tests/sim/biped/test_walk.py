@@ -150,6 +150,8 @@ def test_bad_walk_inputs_name_the_field(short_walk) -> None:  # type: ignore[no-
         ["--steps", "0"],
         ["--scene", "nowhere"],
         ["--region-aware", "anywhere"],
+        ["--leg-momentum", "-0.2"],
+        ["--leg-momentum", "0.5", "--controller", "servo"],
     ],
 )
 def test_cli_walk_rejects_bad_input(args: list[str], tmp_path) -> None:  # type: ignore[no-untyped-def]

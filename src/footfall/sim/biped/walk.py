@@ -57,6 +57,7 @@ from footfall.results.walk import WalkResult, WalkTrace
 from footfall.robots import names as nm
 from footfall.sim._video import Video
 from footfall.sim.biped.ik import WholeBodyIK
+from footfall.sim.biped.leg_momentum import LegMomentumForecast
 from footfall.sim.biped.metrics import summarise
 from footfall.sim.biped.model import BipedSimSettings, WalkerModel
 from footfall.sim.biped.options import WalkOptions, check_walk_inputs
@@ -145,6 +146,13 @@ class BipedWalk:
         self.robot = robot = plan.robot
         self.alip = robot.alip()
         self.ad_tick, self.bd_tick = self.alip.discretize(self.dt)
+        self.leg_momentum = (
+            LegMomentumForecast(
+                self.ad_tick, self.bd_tick, self.dt, plan.robot.t_ss, self.opts.leg_momentum
+            )
+            if self.opts.leg_momentum > 0.0
+            else None
+        )
         self.ds_map = ds_propagator(self.alip, self.dt)
         self.n = self.plan.n_steps
         self.t_ss, self.t_ds = robot.t_ss, robot.t_ds
@@ -402,6 +410,8 @@ class BipedWalk:
             x_meas = np.array([r[0], r[1], l_c[0], l_c[1]])
         else:
             x_meas = x_cv
+        if self.leg_momentum is not None:
+            x_meas = x_meas + self.leg_momentum.shift(i, tp, obs.l_g, float(self.plan.headings[i]))
         nxt, u = self.src.update(tp, x_meas, stance, i)
         nxt = self._limit_target(nxt)
         self._raise_swing(tp, nxt)
