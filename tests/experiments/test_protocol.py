@@ -17,7 +17,10 @@ from footfall.experiments.protocol import (
     PROTOCOL_DURATION,
     PROTOCOL_PHASES,
     LevelSummary,
+    ProtocolResult,
     PushProtocol,
+    format_markdown,
+    format_summary,
     largest_passed,
     summarise,
 )
@@ -260,3 +263,12 @@ def test_the_protocols_walker_takes_the_region_mode() -> None:
         plant = proto._plant("biped", "wbc", mode)
         assert plant.options.region_aware == mode
         assert plant.options.controller == "wbc"
+
+
+def test_reports_name_the_leg_momentum_share_only_when_on() -> None:
+    row = {"dv_m_s": 0.1, "phase": 0.2, "direction": "forward", "success": True, "fell": False}
+    for share, shown in ((0.0, False), (0.5, True)):
+        proto = PushProtocol(dv=(0.1,), phases=(0.2,), directions=("forward",), leg_momentum=share)
+        res = ProtocolResult(proto, "flat_long", 20, 10, 30.0, [dict(row)])
+        for text in (format_summary(res), format_markdown(res)):
+            assert ("legs' momentum 0.5" in text) is shown

@@ -377,7 +377,8 @@ def format_summary(result: ProtocolResult) -> str:
     levels = summarise(result.rows)
     lines = [
         f"push protocol: {p.robot} ({result.mass:.3g} kg) on {result.scene_name}, N = "
-        f"{result.n_steps}, {p.planner}, {p.controller}, footstep regions {p.region_aware}; "
+        f"{result.n_steps}, {p.planner}, {p.controller}, footstep regions {p.region_aware}"
+        f"{_legs(p)}; "
         f"pushed single support {result.step}, "
         f"{p.duration:g} s pushes",
     ]
@@ -390,6 +391,11 @@ def format_summary(result: ProtocolResult) -> str:
     return "\n".join(lines)
 
 
+def _legs(p: PushProtocol) -> str:
+    """The leg-momentum share in a summary line (nothing when it is off)."""
+    return f", legs' momentum {p.leg_momentum:g}" if p.leg_momentum > 0 else ""
+
+
 def format_markdown(result: ProtocolResult) -> str:
     """``protocol.md``: per level a direction x phase table of pass / FAIL, then the largest
     level passed."""
@@ -400,7 +406,8 @@ def format_markdown(result: ProtocolResult) -> str:
         "# Push-recovery protocol",
         "",
         f"{p.robot} ({result.mass:.3g} kg) on {result.scene_name}, N = {result.n_steps} "
-        f"({p.planner}, {p.controller} controller, footstep regions {p.region_aware}). One push "
+        f"({p.planner}, {p.controller} controller, footstep regions {p.region_aware}{_legs(p)})."
+        " One push "
         f"of {p.duration:g} s in single "
         f"support {result.step}, at a share of it (phase), in a direction relative to the stance "
         "foot (inward: toward its side); impulse = mass x dv. A case passes when the robot "
