@@ -615,6 +615,11 @@ def walk_cmd(
     replay.write(out / REPLAY_FILE, biped_traces(res.trace, replay.times), scene_to_yaml(sc))
     # walk.json's "controller" (from the result) names the controller and holds its tally
     report = walk_report(sc.name, planner, robot, plan, disturbance, pushes, res)
+    # the walker's options that change a walk, so that walk.json says how it was walked
+    report["walker"] = {
+        "region_aware": options.region_aware,
+        "leg_momentum": options.leg_momentum,
+    }
     write_json(out / "walk.json", report)
     plot_walk(res, sc, out / "walk.png", params=model, title=f"{sc.name}, {planner}, {robot}")
     m = res.metrics

@@ -131,3 +131,19 @@ def test_forecast_lowers_the_zmp_offset_of_a_flat_walk():
     assert off.reached_goal and on.reached_goal
     assert on.zmp.mean < 0.85 * off.zmp.mean
     assert on.correction_m.mean < 0.85 * off.correction_m.mean
+
+
+def test_walk_command_records_the_share(tmp_path):
+    pytest.importorskip("mujoco")
+    import json
+
+    from typer.testing import CliRunner
+
+    from footfall.cli import app
+
+    args = ["walk", "--scene", "flat", "--planner", "reactive", "--no-video", "--quiet"]
+    res = CliRunner().invoke(app, [*args, "--leg-momentum", "0.5", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    walked = json.loads((tmp_path / "walk.json").read_text())
+    assert walked["walker"] == {"region_aware": "planned", "leg_momentum": 0.5}
+    assert walked["metrics"]["reached_goal"]
