@@ -39,22 +39,14 @@ from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+# imported after the BLAS setting above
+from footfall.experiments.study.stats import wilson
+
 #: the scenes and their step counts (the walks' smallest N with 64 heading segments, except the
 #: 20 steps of flat_long)
 SCENES = {"flat_long": 20, "discrete_steps": 15, "stairs_slope_gap": 16}
 #: the two ways to give a push's size: an impulse [N s] or a velocity change [m/s]
 IMPULSE, DV = "impulse_Ns", "dv_m_s"
-
-
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    """Wilson score interval of a binomial proportion k / n."""
-    if n == 0:
-        return (math.nan, math.nan)
-    p = k / n
-    den = 1.0 + z * z / n
-    mid = (p + z * z / (2 * n)) / den
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
-    return (max(0.0, mid - half), min(1.0, mid + half))
 
 
 def crossing(levels: list[float], rates: list[float], level: float = 0.5) -> str:

@@ -19,21 +19,13 @@ from dataclasses import replace
 
 from scipy import stats
 
+from footfall.experiments.study.stats import wilson
 from footfall.quadruped import GaitParams, QuadrupedRobot, plan_gait
 from footfall.quadruped.scene import resolve_quadruped_scene
 from footfall.sim.disturbance import Disturbance
 from footfall.sim.quadruped.sim import simulate
 from footfall.sim.quadruped.trial import QuadrupedPlant
 from footfall.sim.trial import run_trial
-
-
-def wilson(k: int, n: int) -> tuple[float, float]:
-    z = 1.959964
-    p = k / n
-    den = 1 + z * z / n
-    mid = (p + z * z / (2 * n)) / den
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
-    return max(0.0, mid - half), min(1.0, mid + half)
 
 
 def main() -> None:

@@ -549,7 +549,6 @@ def walk_cmd(
     if video:
         # headless offscreen rendering; MuJoCo picks its GL backend when it is first imported
         os.environ.setdefault("MUJOCO_GL", "egl")
-    from footfall.control.adjusters import check_region_mode
     from footfall.planning.plan import check_planner_name
     from footfall.results.walk import walk_report
     from footfall.sim.biped.model import planner_params
@@ -563,13 +562,13 @@ def walk_cmd(
 
     check_planner_name(planner)
     _check_controller(controller)
-    check_region_mode(region_aware)
-    if steps is not None and steps < 1:
-        raise InputError("steps", steps, "an integer >= 1")
-    # the walker's options are checked before planning, which can take minutes
+    # the walker's options (region mode, leg-momentum share) are checked before planning, which
+    # can take minutes
     options = WalkOptions(
         controller=controller, region_aware=region_aware, leg_momentum=leg_momentum
     )
+    if steps is not None and steps < 1:
+        raise InputError("steps", steps, "an integer >= 1")
     disturbance = disturbance_of(
         push, push_dv, seed, push_step, push_phase, push_direction, push_duration
     )

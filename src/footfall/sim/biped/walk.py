@@ -148,7 +148,7 @@ class BipedWalk:
         self.ad_tick, self.bd_tick = self.alip.discretize(self.dt)
         self.leg_momentum = (
             LegMomentumForecast(
-                self.ad_tick, self.bd_tick, self.dt, plan.robot.t_ss, self.opts.leg_momentum
+                self.ad_tick, self.bd_tick, self.dt, robot.t_ss, self.opts.leg_momentum
             )
             if self.opts.leg_momentum > 0.0
             else None
