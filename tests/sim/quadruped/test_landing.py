@@ -122,3 +122,26 @@ def test_the_qp_runs_at_every_step_only_near_a_touchdown() -> None:
         odd_due += int(wbc.due(i, t))
     assert wbc.due(0, 0.0) and wbc.due(2, 2 * h)
     assert 0 < odd_due < round(float(ref.t[-1]) / h) // 2
+
+
+def test_feet_tipped_off_the_ground_come_back_fast_enough_after_pushes() -> None:
+    """Go2 pushed sideways with seeds 2 and 4 of ``footfall bench quadruped-pushes`` (in four-
+    and three-foot stances; the robot tips onto two feet) at 0.3-0.65 m/s, 16 walks: none falls.
+    The tipped feet descend at ``reach_speed + reach_gain x height``; measured with
+    ``reach_gain`` 0 (the slow landing speed alone) three of these walks fell, with 10 one."""
+    from footfall.experiments.quadruped_pushes import push_of_seed, push_walk_plan
+    from footfall.sim.disturbance import Push
+
+    robot = resolve_quadruped("go2")
+    plan = push_walk_plan("go2", 15.0, 4)
+    settings = robot_settings(robot)
+    falls = []
+    for seed in (2, 4):
+        share, side = push_of_seed(seed, 0.05)
+        for dv in (0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6, 0.65):
+            push = Push.horizontal(
+                share * plan.duration, robot.total_mass * dv, side * math.pi / 2, 0.05
+            )
+            if simulate(plan, settings, controller="wbc", pushes=(push,)).metrics.fell:
+                falls.append((seed, dv))
+    assert falls == []

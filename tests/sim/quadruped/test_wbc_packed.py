@@ -108,9 +108,11 @@ def _reference_problem(wbc: QuadrupedWbc, t: float) -> WbcProblem:
             if stance[leg] and to_switch[leg] >= g.unload_time:  # off the ground, not lifting
                 # down along the normal from where the foot is, to reach_depth at most
                 n = wbc.ground.normal(centre[0], centre[1])
-                depth = max(float(n @ (centre - target)), -g.reach_depth)
-                target = target + depth * n
-                target_v, target_a = -g.reach_speed * n, np.zeros(3)
+                # faster the higher above its foothold
+                depth = float(n @ (centre - target))
+                speed = g.reach_speed + g.reach_gain * max(depth, 0.0)
+                target = target + max(depth, -g.reach_depth) * n
+                target_v, target_a = -speed * n, np.zeros(3)
             jac, drift = wbc.model.frame(wbc.foot_bodies[leg], centre, angular=False)
             acc = target_a + g.swing_kp * (target - centre)
             acc = acc + g.swing_kd * (target_v - jac @ qvel)

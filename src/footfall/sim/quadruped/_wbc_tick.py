@@ -30,6 +30,7 @@ JOINTS_A = 72
 (TRUNK_W, ROT_W, SWING_W, POSTURE_W, COP_W) = range(8, 13)
 (TOUCHDOWN_WINDOW, UNLOAD_TIME, UNLOAD_WEIGHT, REACH_DEPTH, REACH_SPEED) = range(13, 18)
 LIFTOFF_DELAY = 18
+REACH_GAIN = 19
 #: rows of the tick's motion tasks that are not swing feet: trunk (3), orientation (3), joints (12)
 FIXED_MOTION_ROWS = 18
 
@@ -128,10 +129,12 @@ def feet_tick(
             depth = 0.0
             for i in range(3):
                 depth += (centre[i] - row[FEET + 3 * leg + i]) * normal[leg, i]
+            # faster the higher above its foothold (a foot the robot tipped off its ground)
+            speed = gains[REACH_SPEED] + gains[REACH_GAIN] * max(depth, 0.0)
             depth = max(depth, -gains[REACH_DEPTH])
             for i in range(3):
                 row[FEET + 3 * leg + i] += depth * normal[leg, i]
-                row[FEET_V + 3 * leg + i] = -gains[REACH_SPEED] * normal[leg, i]
+                row[FEET_V + 3 * leg + i] = -speed * normal[leg, i]
                 row[FEET_A + 3 * leg + i] = 0.0
         unload_w[leg] = -1.0
         centre = site_xpos[foot_sites[leg]]

@@ -85,13 +85,17 @@ class QuadrupedWbcGains:
             one to the other instead of the two carrying nothing at that instant (the swing's
             time law starts with zero velocity and acceleration, eq. 10-13: in 0.02 s of a 0.5 s
             swing it rises 0.06 % of its height).
-        reach_depth, reach_speed: a planned stance foot that does not touch the ground (the
-            ground lower than planned, a foot that bounced off or is a few milliseconds late) is
-            not a contact: it descends from where it is along the normal at this speed [m/s],
-            to at most this far [m] below its foothold, until it touches (in its unload window
-            before lift-off it is let go instead). Its target has no step, so the foot lands at
-            that speed (a target a centimetre below, as before, put the ~0.1 m/s impact of a
-            late foot in the centre of pressure).
+        reach_depth, reach_speed, reach_gain: a planned stance foot that does not touch the
+            ground (the ground lower than planned, a foot that bounced off or is a few
+            milliseconds late, a foot the robot tipped off the ground) is not a contact: it
+            descends from where it is along the normal at ``reach_speed`` [m/s] plus
+            ``reach_gain`` [1/s] times its height above its foothold, to at most
+            ``reach_depth`` [m] below the foothold, until it touches (in its unload window
+            before lift-off it is let go instead). Its target has no step, so a foot a fraction
+            of a millimetre late lands at about ``reach_speed`` (a target a centimetre below,
+            as before, put the ~0.1 m/s impact of a late foot in the centre of pressure), and a
+            foot tipped a centimetre up comes back at ~0.3 m/s (``reach_speed`` alone let
+            ANYmal C and Go2 fall after lateral pushes they had survived).
         qp_every: physics steps per QP solve (the torques are held in between), except
             within ``landing_window`` [s] of a planned touchdown, where the QP runs at every
             step: torques held over two steps leave the swing foot a few tenths of a millimetre
@@ -118,6 +122,7 @@ class QuadrupedWbcGains:
     reach_depth: float = 0.01
     reach_speed: float = 0.02
     liftoff_delay: float = 0.02
+    reach_gain: float = 30.0
     landing_window: float = 0.1
     qp_every: int = 2
 
@@ -391,6 +396,7 @@ class QuadrupedWbc:
                 *(g.posture_weight, g.cop_weight, g.touchdown_window, g.unload_time),
                 *(g.unload_weight, g.reach_depth, g.reach_speed),
                 g.liftoff_delay,
+                g.reach_gain,
             ]
         )
         #: the plan at the tick's instant (the columns of ``_Reference.table``), filled per tick
