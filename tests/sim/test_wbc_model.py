@@ -174,3 +174,28 @@ def test_actuator_with_a_gear_is_rejected() -> None:
     with pytest.raises(InputError) as err:
         MujocoWbcModel(mujoco, s.model, s.data, s.actuators)
     assert err.value.field == "actuators"
+
+
+def test_implicit_damping_predicts_the_implicit_step(sim: BipedSim) -> None:
+    """With ``implicit_damping``, ``M + h D`` and ``h`` give the acceleration MuJoCo's
+    implicit-fast step realizes, ``(qvel' - qvel) / h`` after ``mj_step`` (the robot in the air, so
+    no contact, some joint torques); ``M`` alone misses it by more than the tolerance."""
+    m, d = sim.model, sim.data
+    assert int(m.opt.integrator) == int(mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
+    assert np.any(m.dof_damping > 0.0)
+    d.qpos[sim.root_adr + 2] += 1.0  # in the air
+    model = MujocoWbcModel(mujoco, m, d, sim.actuators, implicit_damping=True)
+    model.set_torque_mode()
+    d.ctrl[sim.actuators] = np.linspace(-20.0, 20.0, len(sim.actuators))
+    mujoco.mj_forward(m, d)
+    assert d.ncon == 0
+    m_eff, h = model.dynamics()
+    tau = np.zeros(m.nv)
+    tau[model.actuated] = d.ctrl[sim.actuators]
+    predicted = np.linalg.solve(m_eff, tau - h)
+    explicit = np.linalg.solve(m_eff - np.diag(model.implicit_damping), tau - h)
+    qvel = np.array(d.qvel)
+    mujoco.mj_step(m, d)
+    realized = (d.qvel - qvel) / m.opt.timestep
+    np.testing.assert_allclose(predicted, realized, atol=1e-6)
+    assert np.abs(explicit - realized).max() > 1e-3

@@ -251,7 +251,9 @@ def test_the_guard_does_not_trigger_on_the_nominal_15_deg_walk() -> None:
 def test_the_guard_stops_the_whole_body_controller_on_a_slippery_climb() -> None:
     """30 deg up at friction 0.6 (the cone's edge is 31 deg), two cycles: a foot of the wbc walk
     slides past the limit in the second cycle; the gait lands the swinging foot and holds, and
-    the robot stays put (the trunk within 3 cm over the five seconds held)."""
+    the robot stands in the held pose: over the last two seconds the trunk stays within 3 cm of
+    the held reference. (The reference is the plan's at the stop, which can lie some centimetres
+    from where the trunk was then, mid-shift: the trunk moves there first.)"""
     pytest.importorskip("mujoco")
     from footfall._mjcf import SimSettings
     from footfall.sim.quadruped.sim import simulate
@@ -265,7 +267,9 @@ def test_the_guard_stops_the_whole_body_controller_on_a_slippery_climb() -> None
     assert res.trace.planned.contact[hold].all()
     assert not res.metrics.fell
     assert res.trace.qp_failures == 0
-    assert np.linalg.norm(res.trace.trunk_pos[hold][-1] - res.trace.trunk_pos[hold][0]) < 0.03
+    tail = hold & (res.trace.t >= res.trace.t[-1] - 2.0)
+    off = np.linalg.norm(res.trace.trunk_pos[tail] - res.trace.planned.body_pos[tail], axis=1)
+    assert off.max() < 0.03
 
 
 def test_simulate_refuses_a_guard_of_the_wrong_type() -> None:

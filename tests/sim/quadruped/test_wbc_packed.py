@@ -59,22 +59,32 @@ def _reference_problem(wbc: QuadrupedWbc, t: float) -> WbcProblem:
     body, body_v, body_a = row[0:3], row[3:6], row[6:9]
     feet, feet_v, feet_a = (row[a : a + 12].reshape(4, 3) for a in (9, 21, 33))
     joints, joints_v, zmp, pitch = row[45:57], row[57:69], row[69:71], row[71]
+    joints_a = row[72:84]
     qvel = d.qvel
     stance = ref.contact[near]
-    to_switch = ref.to_switch[k] - w * ref.dt
+    # time to each leg's next switch, from the nearer sample
+    to_switch = ref.to_switch[near] + (near - k) * ref.dt - w * ref.dt
     touching = _touching(sim)
     contacts, tasks, wrench, heights = [], [], [], []
+    early, late, lifted, is_contact = [], [], [], []
     for leg in range(4):
-        centre = d.site_xpos[sim.foot_sites[leg]]
-        early = touching[leg] and to_switch[leg] <= g.touchdown_window
+        early.append(touching[leg] and to_switch[leg] <= g.touchdown_window)
         # (from the sample, then the tick's part of the period: the tick's own association;
         # t - t_lift rounds differently, and a hand-over tick's torques follow its weight to 1e-9)
-        lifted = _since_lift(ref.contact, ref.t, near, leg, ref.t[near])
-        lifted += w * ref.dt - (near - k) * ref.dt
-        late = (
-            not stance[leg] and touching[leg] and 0 < g.liftoff_delay and lifted <= g.liftoff_delay
+        lift = _since_lift(ref.contact, ref.t, near, leg, ref.t[near])
+        lifted.append(lift + w * ref.dt - (near - k) * ref.dt)
+        late.append(
+            not stance[leg]
+            and touching[leg]
+            and 0 < g.liftoff_delay
+            and lifted[leg] <= g.liftoff_delay
         )
-        if (stance[leg] and touching[leg]) or early or late:
+        is_contact.append((stance[leg] and touching[leg]) or early[leg] or late[leg])
+    # a foot hands its load over only onto three other contacts
+    handing = sum(is_contact) == 4
+    for leg in range(4):
+        centre = d.site_xpos[sim.foot_sites[leg]]
+        if is_contact[leg]:
             normal, tangent = _surface(wbc.ground.normal(centre[0], centre[1]))
             normal_force = np.concatenate([normal, np.zeros(3)]).reshape(1, 6)
             pt = centre - wbc.radius * normal
@@ -82,23 +92,27 @@ def _reference_problem(wbc: QuadrupedWbc, t: float) -> WbcProblem:
             name = f"foot{leg}"
             contacts.append(Contact.point(name, jac, drift, pt, normal, wbc.friction, 0.0, tangent))
             heights.append(pt[2])
-            if stance[leg] and g.unload_time > 0 and to_switch[leg] < g.unload_time:
+            if handing and stance[leg] and g.unload_time > 0 and to_switch[leg] < g.unload_time:
                 share = 1.0 - max(to_switch[leg], 0.0) / g.unload_time
                 w_unload = g.unload_weight / weight**2 * share
                 wrench.append(
                     WrenchTask(f"unload{leg}", pt, normal_force, np.zeros(1), w_unload, (name,))
                 )
-            elif late and not early:
-                w_unload = g.unload_weight / weight**2 * (max(lifted, 0.0) / g.liftoff_delay)
+            elif handing and late[leg] and not early[leg]:
+                w_unload = g.unload_weight / weight**2 * (max(lifted[leg], 0.0) / g.liftoff_delay)
                 wrench.append(
                     WrenchTask(f"unload{leg}", pt, normal_force, np.zeros(1), w_unload, (name,))
                 )
         else:
             target, target_v, target_a = feet[leg], feet_v[leg], feet_a[leg]
             if stance[leg] and to_switch[leg] >= g.unload_time:  # off the ground, not lifting
+                # down along the normal from where the foot is, to reach_depth at most
                 n = wbc.ground.normal(centre[0], centre[1])
-                target = target - g.reach_depth * n
-                target_v, target_a = -g.reach_speed * n, np.zeros(3)
+                # faster the higher above its foothold
+                depth = float(n @ (centre - target))
+                speed = g.reach_speed + g.reach_gain * max(depth, 0.0)
+                target = target + max(depth, -g.reach_depth) * n
+                target_v, target_a = -speed * n, np.zeros(3)
             jac, drift = wbc.model.frame(wbc.foot_bodies[leg], centre, angular=False)
             acc = target_a + g.swing_kp * (target - centre)
             acc = acc + g.swing_kd * (target_v - jac @ qvel)
@@ -116,7 +130,7 @@ def _reference_problem(wbc: QuadrupedWbc, t: float) -> WbcProblem:
     dofs = wbc.joint_dofs
     select = np.zeros((dofs.size, wbc.model.nv))
     select[np.arange(dofs.size), dofs] = 1.0
-    acc_q = g.posture_kp * (joints - d.qpos[sim.qpos_adr])
+    acc_q = joints_a + g.posture_kp * (joints - d.qpos[sim.qpos_adr])
     acc_q = acc_q + g.posture_kd * (joints_v - qvel[dofs])
     tasks.append(MotionTask("posture", select, np.zeros(dofs.size), acc_q, g.posture_weight))
     if heights and g.cop_weight > 0:

@@ -23,11 +23,14 @@ from footfall.control._wbc_kernel import assemble, rotation_error
 #: columns of ``_Reference.table`` (see :class:`footfall.sim.quadruped.wbc._Reference`)
 BODY, BODY_V, BODY_A, FEET, FEET_V, FEET_A, JOINTS, JOINTS_V, ZMP = 0, 3, 6, 9, 21, 33, 45, 57, 69
 PITCH = 71
+#: the planned joint accelerations (12) [rad/s^2], after the columns above
+JOINTS_A = 72
 #: entries of the gains vector of :func:`pack_tick`
 (TRUNK_KP, TRUNK_KD, ROT_KP, ROT_KD, SWING_KP, SWING_KD, POSTURE_KP, POSTURE_KD) = range(8)
 (TRUNK_W, ROT_W, SWING_W, POSTURE_W, COP_W) = range(8, 13)
 (TOUCHDOWN_WINDOW, UNLOAD_TIME, UNLOAD_WEIGHT, REACH_DEPTH, REACH_SPEED) = range(13, 18)
 LIFTOFF_DELAY = 18
+REACH_GAIN = 19
 #: rows of the tick's motion tasks that are not swing feet: trunk (3), orientation (3), joints (12)
 FIXED_MOTION_ROWS = 18
 
@@ -65,7 +68,7 @@ def feet_tick(
     """The plan at this instant and each foot's part of the tick
     (:class:`~footfall.sim.quadruped.wbc.QuadrupedWbc`'s rules), written in place.
 
-    Inputs: the plan ``table`` (T, 72) (``_Reference.table``'s columns), its ``planned_contact``
+    Inputs: the plan ``table`` (T, 84) (``_Reference.table``'s columns), its ``planned_contact``
     (T, 4), ``to_switch`` (T, 4) [s] and ``since_lift`` (T, 4) [s] (from each leg's last
     planned lift-off to each sample, inf before the first); the sample ``k`` and weight ``w`` of this instant
     (``_Reference.at``) and the sample period ``dt`` [s]; MuJoCo's contacts ``geom`` (ncon, 2),
@@ -74,9 +77,10 @@ def feet_tick(
     (nsite, 3) [m] and the feet's ``foot_sites`` (4,); the feet's ``radius`` [m]; ``gains``
     (:func:`pack_tick`'s vector); ``normal`` (4, 3) the ground's normal under each foot.
 
-    Outputs: ``row`` (72,) the interpolated plan, a late foot's swing target moved below the
-    ground; per leg ``contact`` (bool), ``unload_w`` (< 0: none) and ``pts`` (4, 3) [m] its
-    contact point (the bottom of its sphere along the normal) or, not a contact, its centre.
+    Outputs: ``row`` (84,) the interpolated plan, with the target of a planned stance foot off
+    the ground descending from where it is; per leg ``contact`` (bool), ``unload_w`` (< 0:
+    none) and ``pts`` (4, 3) [m] its contact point (the bottom of its sphere along the normal)
+    or, not a contact, its centre.
     """
     for i in range(row.shape[0]):
         row[i] = (1.0 - w) * table[k, i] + w * table[k + 1, i]
@@ -91,37 +95,62 @@ def feet_tick(
                 if g >= 0 and foot_of_geom[g] >= 0:
                     touching[foot_of_geom[g]] = True
     window, unload = gains[TOUCHDOWN_WINDOW], gains[UNLOAD_TIME]
+    delay = gains[LIFTOFF_DELAY]
     ahead = w * dt
+    left = np.empty(4)
+    lifted = np.empty(4)
+    early = np.zeros(4, dtype=np.bool_)
+    late = np.zeros(4, dtype=np.bool_)
     for leg in range(4):
-        left = to_switch[k, leg] - ahead
-        early = touching[leg] and left <= window
+        # time to this leg's next switch as seen from the nearer sample (from sample k, a
+        # switch at k + 1 would still be the next one after the foot has switched)
+        left[leg] = to_switch[near, leg] + (near - k) * dt - ahead
+        early[leg] = touching[leg] and left[leg] <= window
         # a foot that lifted off less than liftoff_delay ago and still touches hands its load
         # over (its unload task ramps up to full weight over the delay)
-        lifted = since_lift[near, leg] + ahead - (near - k) * dt
-        delay = gains[LIFTOFF_DELAY]
-        late = (not stance[leg]) and touching[leg] and delay > 0 and lifted <= delay
+        lifted[leg] = since_lift[near, leg] + ahead - (near - k) * dt
+        late[leg] = (not stance[leg]) and touching[leg] and delay > 0 and lifted[leg] <= delay
         # a planned stance foot is a contact while it touches the ground; off it (the ground
         # lower than planned, or a foot that bounced) it reaches down instead of the QP
         # counting on a force that the ground cannot give
-        is_contact = (stance[leg] and touching[leg]) or early or late
-        contact[leg] = is_contact
-        # (a foot leaving in its unload window is let go: it lifts off a little early); the
-        # target reach_depth below the foothold along the normal, moving in at reach_speed
-        if stance[leg] and not is_contact and left >= unload:
+        contact[leg] = (stance[leg] and touching[leg]) or early[leg] or late[leg]
+    n_contacts = 0
+    for leg in range(4):
+        if contact[leg]:
+            n_contacts += 1
+    for leg in range(4):
+        is_contact = contact[leg]
+        # a planned stance foot off the ground outside its unload window (in it, it is let go
+        # and lifts off a little early) descends from where it is along the normal at
+        # reach_speed, to at most reach_depth below its foothold: no step in its target, so
+        # it lands as gently as that speed
+        if stance[leg] and not is_contact and left[leg] >= unload:
+            centre = site_xpos[foot_sites[leg]]
+            depth = 0.0
             for i in range(3):
-                row[FEET + 3 * leg + i] -= gains[REACH_DEPTH] * normal[leg, i]
-                row[FEET_V + 3 * leg + i] = -gains[REACH_SPEED] * normal[leg, i]
+                depth += (centre[i] - row[FEET + 3 * leg + i]) * normal[leg, i]
+            # faster the higher above its foothold (a foot the robot tipped off its ground)
+            speed = gains[REACH_SPEED] + gains[REACH_GAIN] * max(depth, 0.0)
+            depth = max(depth, -gains[REACH_DEPTH])
+            for i in range(3):
+                row[FEET + 3 * leg + i] += depth * normal[leg, i]
+                row[FEET_V + 3 * leg + i] = -speed * normal[leg, i]
                 row[FEET_A + 3 * leg + i] = 0.0
         unload_w[leg] = -1.0
         centre = site_xpos[foot_sites[leg]]
         if is_contact:
             for i in range(3):
                 pts[leg, i] = centre[i] - radius * normal[leg, i]
-            if stance[leg] and unload > 0 and left < unload:
-                share = 1.0 - (0.0 if 0.0 > left else left) / unload
+            # the load passes to the other feet only when three of them carry it (a foot
+            # about to land that has not touched yet cannot take it: the leaving foot waits,
+            # and lifts late through liftoff_delay)
+            if n_contacts < 4:
+                continue
+            if stance[leg] and unload > 0 and left[leg] < unload:
+                share = 1.0 - (0.0 if 0.0 > left[leg] else left[leg]) / unload
                 unload_w[leg] = gains[UNLOAD_WEIGHT] * share
-            elif late and not early:
-                share = (0.0 if 0.0 > lifted else lifted) / delay
+            elif late[leg] and not early[leg]:
+                share = (0.0 if 0.0 > lifted[leg] else lifted[leg]) / delay
                 unload_w[leg] = gains[UNLOAD_WEIGHT] * share
         else:
             pts[leg] = centre
@@ -180,7 +209,7 @@ def pack_tick(
     motion rows and wrench rows (the arrays' leading parts that count) and
     :func:`~footfall.control._wbc_kernel.assemble`'s QP.
 
-    Inputs: ``row`` (72,) the plan at this instant (``_Reference.table``'s columns);
+    Inputs: ``row`` (84,) the plan at this instant (``_Reference.table``'s columns);
     ``trunk_xmat`` (9,) the trunk's orientation (row-major); per leg (4): ``contact`` (bool) a contact this tick,
     ``unload_w`` the weight of its unload task (< 0: none), ``pts`` (4, 3) its contact point or
     (swing) its foot centre [m], ``normal`` and ``tangent`` (4, 3) its contact normal and friction
@@ -262,8 +291,13 @@ def pack_tick(
     rm += 6
     for j in range(joint_dofs.shape[0]):
         dof = joint_dofs[j]
-        acc = gains[POSTURE_KP] * (row[JOINTS + j] - qpos[joint_qpos[j]]) + gains[POSTURE_KD] * (
-            row[JOINTS_V + j] - qvel[dof]
+        # the plan's joint acceleration as feedforward: without it the task pulls against the
+        # swing leg's planned motion (at lift-off ~100 rad/s^2 at a heavy leg's knee), and the
+        # QP gives way by moving the trunk off its plan
+        acc = (
+            row[JOINTS_A + j]
+            + gains[POSTURE_KP] * (row[JOINTS + j] - qpos[joint_qpos[j]])
+            + gains[POSTURE_KD] * (row[JOINTS_V + j] - qvel[dof])
         )
         for a in range(nv):
             m_jac[rm, a] = 0.0

@@ -342,10 +342,9 @@ def _track_wbc(
     wbc = QuadrupedWbc(sim, tr.planned, rec.ground, gains)
     substeps = max(1, round(control_dt / m.opt.timestep))
     t_start = float(tr.t[0])
-    every = gains.qp_every
     for i in range(round(settle_time / m.opt.timestep)):
         mj.mj_step1(m, d)
-        if i % every == 0:
+        if i % gains.qp_every == 0:
             d.ctrl[sim.actuators] = wbc.torques(t_start)
         mj.mj_step2(m, d)
     n = tr.t.shape[0]
@@ -355,10 +354,11 @@ def _track_wbc(
         for s in range(substeps):
             mj.mj_step1(m, d)
             i = k * substeps + s
-            if i % every == 0:
-                d.ctrl[sim.actuators] = wbc.torques(t_start + i * m.opt.timestep)
+            t = t_start + i * m.opt.timestep
+            if wbc.due(i, t):
+                d.ctrl[sim.actuators] = wbc.torques(t)
             if pushes:
-                d.xfrc_applied[sim.trunk, :3] = push_force(pushes, t_start + i * m.opt.timestep)
+                d.xfrc_applied[sim.trunk, :3] = push_force(pushes, t)
             mj.mj_step2(m, d)
             if s > 0:
                 rec.slide(k)

@@ -12,14 +12,19 @@ then strays far from the plan. Here every joint is torque-driven by the whole-bo
   horizontal plane through the stance contacts, as eq. 5 defines it) has no horizontal part;
 - the trunk: position and orientation (the posture's pitch, eq. 9) with PD feedback and the plan's
   acceleration as feedforward; the swing feet: the zero-impact trajectories (eq. 10-13) the same
-  way; the joints: a weak posture task toward the planned angles;
+  way; the joints: a weak posture task toward the planned angles, also with the plan's
+  acceleration as feedforward;
 - the hand-overs: a foot about to lift is unloaded before it lifts, and a foot that has just lifted
   but still touches stays a contact for ``liftoff_delay`` while its load passes to the others (the
-  gait lifts a front foot at the instant the hind foot on its side touches down).
+  gait lifts a front foot at the instant the hind foot on its side touches down); a foot hands its
+  load over only onto three other contacts;
+- the dynamics: MuJoCo's ``M`` and bias with the implicit integrator's damping term
+  (:class:`~footfall.sim.wbc_model.MujocoWbcModel`'s ``implicit_damping``).
 
-The QP runs at every physics step (or every ``qp_every``-th) from the state of that step
-(``mj_step1`` / ``mj_step2``); the tick packs it straight into arrays (:mod:`._wbc_tick`), the
-dataclasses are rebuilt only when asked (``last_problem``).
+The QP runs at every ``qp_every``-th physics step, and at every step near a planned touchdown
+(``landing_window``), from the state of that step (``mj_step1`` / ``mj_step2``); the tick packs
+it straight into arrays (:mod:`._wbc_tick`), the dataclasses are rebuilt only when asked
+(``last_problem``).
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from footfall._geometry import cross3
 from footfall._typing import FloatArray
@@ -79,11 +85,22 @@ class QuadrupedWbcGains:
             one to the other instead of the two carrying nothing at that instant (the swing's
             time law starts with zero velocity and acceleration, eq. 10-13: in 0.02 s of a 0.5 s
             swing it rises 0.06 % of its height).
-        reach_depth, reach_speed: a planned stance foot that does not touch the ground (the
-            ground lower than planned, or a foot that bounced off) is not a contact: its target
-            moves this far [m] below the foothold along the normal, at this speed [m/s], until
-            it touches (in its unload window before lift-off it is let go instead).
-        qp_every: physics steps per QP solve (the torques are held in between).
+        reach_depth, reach_speed, reach_gain: a planned stance foot that does not touch the
+            ground (the ground lower than planned, a foot that bounced off or is a few
+            milliseconds late, a foot the robot tipped off the ground) is not a contact: it
+            descends from where it is along the normal at ``reach_speed`` [m/s] plus
+            ``reach_gain`` [1/s] times its height above its foothold, to at most
+            ``reach_depth`` [m] below the foothold, until it touches (in its unload window
+            before lift-off it is let go instead). Its target has no step, so a foot a fraction
+            of a millimetre late lands at about ``reach_speed`` (a target a centimetre below,
+            as before, put the ~0.1 m/s impact of a late foot in the centre of pressure), and a
+            foot tipped a centimetre up comes back at ~0.3 m/s (``reach_speed`` alone let
+            ANYmal C and Go2 fall after lateral pushes they had survived).
+        qp_every: physics steps per QP solve (the torques are held in between), except
+            within ``landing_window`` [s] of a planned touchdown, where the QP runs at every
+            step: torques held over two steps leave the swing foot a few tenths of a millimetre
+            off its plan, and in the last millimetre of the zero-impact swing (eq. 10-13) that
+            decides whether the foot lands early, with an impact.
     """
 
     trunk_kp: float = 400.0
@@ -103,8 +120,10 @@ class QuadrupedWbcGains:
     unload_weight: float = 10.0
     touchdown_window: float = 0.05
     reach_depth: float = 0.01
-    reach_speed: float = 0.1
+    reach_speed: float = 0.02
     liftoff_delay: float = 0.02
+    reach_gain: float = 30.0
+    landing_window: float = 0.1
     qp_every: int = 2
 
     def __post_init__(self) -> None:
@@ -142,9 +161,11 @@ class _Reference:
             np.gradient(ref.joints, dt, axis=0),
             ref.zmp,
             ref.body_pitch[:, None],
+            np.gradient(np.gradient(ref.joints, dt, axis=0), dt, axis=0),
         ]
-        #: (T, 72) the columns above: body position (3) [m], velocity, acceleration, feet
-        #: (4 x 3) [m], velocities, accelerations, joints (12) [rad], rates, ZMP (2) [m], pitch
+        #: (T, 84) the columns above: body position (3) [m], velocity, acceleration, feet
+        #: (4 x 3) [m], velocities, accelerations, joints (12) [rad], rates, ZMP (2) [m], pitch,
+        #: joint accelerations (12) [rad/s^2]
         self.table = np.hstack(columns)
         self.contact = ref.contact
         #: (T, 4) time from each sample to the next change of each leg's planned contact [s]
@@ -343,7 +364,7 @@ class QuadrupedWbc:
     ) -> None:
         mj, m = sim.mujoco, sim.model
         self.sim = sim
-        self.model = MujocoWbcModel(mj, m, sim.data, sim.actuators)
+        self.model = MujocoWbcModel(mj, m, sim.data, sim.actuators, implicit_damping=True)
         self.model.set_torque_mode()
         self.ctrl = WholeBodyController()
         self.ref = _Reference(ref)
@@ -375,6 +396,7 @@ class QuadrupedWbc:
                 *(g.posture_weight, g.cop_weight, g.touchdown_window, g.unload_time),
                 *(g.unload_weight, g.reach_depth, g.reach_speed),
                 g.liftoff_delay,
+                g.reach_gain,
             ]
         )
         #: the plan at the tick's instant (the columns of ``_Reference.table``), filled per tick
@@ -386,11 +408,21 @@ class QuadrupedWbc:
         )
         self._last: _Buffers | None = None
         self.failures = 0
+        self._fine = self._near_touchdown()
         self.last_tau = np.zeros(len(sim.actuators))
 
     def retarget(self, ref: GaitTrajectory) -> None:
         """Track ``ref`` from now on (same sample times; the slip guard's held reference)."""
         self.ref = _Reference(ref)
+        self._fine = self._near_touchdown()
+
+    def _near_touchdown(self) -> NDArray[np.bool_]:
+        """Per plan sample (T,): a swing foot lands within ``landing_window`` (and one sample)
+        of it, where the QP runs at every physics step (:meth:`due`)."""
+        ref = self.ref
+        swing = np.asarray(ref.contact, dtype=bool) == 0
+        window = self.gains.landing_window + ref.dt
+        return np.asarray(np.any(swing & (ref.to_switch <= window), axis=1))
 
     @property
     def last_problem(self) -> WbcProblem | None:
@@ -440,6 +472,14 @@ class QuadrupedWbc:
             self.model.jacobians(
                 self.foot_bodies[leg], buf.pts[leg], buf.foot_jac[leg], buf.foot_jdot[leg]
             )
+
+    def due(self, step: int, t: float) -> bool:
+        """Whether the QP runs at physics step ``step`` (gait time ``t`` [s]): at every
+        ``qp_every``-th step, and at every step near a planned touchdown."""
+        if step % self.gains.qp_every == 0:
+            return True
+        k, _ = self.ref.at(t)
+        return bool(self._fine[k] or self._fine[k + 1])
 
     def torques(self, t: float) -> FloatArray:
         """Joint torques (12,) [N m] at gait time ``t`` from the current state (positions and
