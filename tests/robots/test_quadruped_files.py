@@ -361,3 +361,25 @@ def test_push_sweep_bad_input_leaves_the_last_results(
     assert isinstance(res.exception, InputError), res.output
     assert res.exception.field == field
     assert last.read_text() == "the last run's table\n"
+
+
+def test_push_summary_says_what_qualifies_the_largest_level() -> None:
+    """The largest level every seed survived, with a lower level that lost a seed said, and a
+    grid that never failed said as a lower bound (made-up rows, no walk)."""
+    from footfall.experiments.quadruped_pushes import QuadrupedPushRow, summary_lines
+
+    def rows(outcomes: dict[float, list[bool]]) -> list[QuadrupedPushRow]:
+        return [
+            QuadrupedPushRow("go2", 15.0, dv, seed, 16.0 * dv, 5.0, "left", not ok, 0.0, 1.0, ok)
+            for dv, oks in outcomes.items()
+            for seed, ok in enumerate(oks)
+        ]
+
+    text = "\n".join(summary_lines(rows({0.5: [True, True], 0.55: [True, False], 0.6: [True] * 2})))
+    assert "largest level every seed survived: 0.6 m/s (but not 0.55 m/s)" in text
+    text = "\n".join(summary_lines(rows({0.5: [True, True], 0.6: [True, True]})))
+    assert "largest level every seed survived: >= 0.6 m/s (no level of the grid failed)" in text
+    text = "\n".join(summary_lines(rows({0.5: [True, False], 0.6: [False, False]})))
+    assert "no level every seed survived" in text
+    text = "\n".join(summary_lines(rows({0.5: [True, True], 0.6: [True, False]})))
+    assert text.endswith("largest level every seed survived: 0.5 m/s")

@@ -147,7 +147,7 @@ def summary_lines(rows: list[QuadrupedPushRow]) -> list[str]:
         "| dv [m/s] | impulse [N s] | success | 95 % Wilson |",
         "|---|---|---|---|",
     ]
-    best = None
+    survived = []
     for dv in levels:
         sel = [r for r in rows if r.dv_m_s == dv]
         k, n = sum(r.success for r in sel), len(sel)
@@ -155,15 +155,23 @@ def summary_lines(rows: list[QuadrupedPushRow]) -> list[str]:
         out.append(
             f"| {dv:g} | {sel[0].impulse_n_s:.2f} | {k}/{n} | {100 * lo:.0f}-{100 * hi:.0f} % |"
         )
-        if k == n and (best is None or dv > best):
-            best = dv
+        survived.append(k == n)
     out.append("")
-    out.append(
-        f"largest level every seed survived: {best:g} m/s"
-        if best is not None
-        else "no level every seed survived"
-    )
+    out.append(_largest_survived(levels, survived))
     return out
+
+
+def _largest_survived(levels: list[float], survived: list[bool]) -> str:
+    """The summary line: the largest level every seed survived, said with what qualifies it
+    (no level of the grid failed: the limit is at or above it; a lower level failed)."""
+    best = max((dv for dv, ok in zip(levels, survived, strict=True) if ok), default=None)
+    if best is None:
+        return "no level every seed survived"
+    if all(survived):
+        return f"largest level every seed survived: >= {best:g} m/s (no level of the grid failed)"
+    below = [dv for dv, ok in zip(levels, survived, strict=True) if not ok and dv < best]
+    note = f" (but not {', '.join(f'{v:g}' for v in below)} m/s)" if below else ""
+    return f"largest level every seed survived: {best:g} m/s{note}"
 
 
 def rows_csv(rows: list[QuadrupedPushRow]) -> str:
