@@ -126,7 +126,11 @@ def test_walk_logs_its_smallest_n_search_and_records_its_controller(tmp_path: Pa
     walked = json.loads((out / "walk.json").read_text())
     assert records[-1]["n_steps"] == walked["plan"]["n_steps"]
     assert walked["controller"]["name"] == "wbc"  # the biped's default controller
-    assert walked["walker"] == {"region_aware": "planned", "leg_momentum": 0.0}
+    assert walked["walker"] == {
+        "region_aware": "planned",
+        "leg_momentum": 0.0,
+        "capture_stop": True,
+    }
 
 
 def test_study_logs_its_smallest_n_searches(tmp_path: Path) -> None:

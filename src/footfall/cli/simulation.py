@@ -618,6 +618,7 @@ def walk_cmd(
     report["walker"] = {
         "region_aware": options.region_aware,
         "leg_momentum": options.leg_momentum,
+        "capture_stop": options.capture_stop,
     }
     write_json(out / "walk.json", report)
     plot_walk(res, sc, out / "walk.png", params=model, title=f"{sc.name}, {planner}, {robot}")

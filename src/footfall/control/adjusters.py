@@ -366,8 +366,10 @@ class MPCAdjuster(PlanFollower):
         weights: MPC weights.
         freeze_after: as for :class:`PlanFollower`, later by default: the MPC's footstep keeps
             improving late in the swing, and freezing early left every footstep short.
-        capture_stop: off: the MPC's terminal term (Q_f toward the plan's final state at rest)
-            places the last footstep.
+        capture_stop: the last footstep by the capture point (:meth:`stop_target`, then kept
+            legal), in every ``region_aware`` mode; off: the MPC's terminal term (Q_f toward the
+            plan's final state at rest) places it. The walker turns it on
+            (``WalkOptions.capture_stop``).
         torque_limits: semi-axes ``(U_x, U_y)`` [N m] of the MPC's torque ellipse
             (:func:`footfall.control.mpc.build_mpc`); None = the plan's ``U_max`` ball
             (eq. 5.19e). The MuJoCo walker passes :func:`sole_torque_limits`.
@@ -455,6 +457,10 @@ class MPCAdjuster(PlanFollower):
             return self._frozen[phase], self._frozen_torque[phase]
         if self.region_aware != "off" and phase not in self._frozen:
             target, u = self._region_aware(t, phase, args, rot, state, stance, ref_next)
+            if self.capture_stop and phase == plan.n_steps - 1:
+                target = np.array(target, dtype=float)
+                target[:2] = self.stop_target(t, state, stance, phase, u)
+                target = self._legal(target, ref_next, stance, phase)
             target = self._maybe_freeze(t, phase, target)
             if phase in self._frozen:
                 self._frozen_torque[phase] = u

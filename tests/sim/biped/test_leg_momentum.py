@@ -145,5 +145,9 @@ def test_walk_command_records_the_share(tmp_path):
     res = CliRunner().invoke(app, [*args, "--leg-momentum", "0.5", "--out", str(tmp_path)])
     assert res.exit_code == 0, res.output
     walked = json.loads((tmp_path / "walk.json").read_text())
-    assert walked["walker"] == {"region_aware": "planned", "leg_momentum": 0.5}
+    assert walked["walker"] == {
+        "region_aware": "planned",
+        "leg_momentum": 0.5,
+        "capture_stop": True,
+    }
     assert walked["metrics"]["reached_goal"]

@@ -316,6 +316,33 @@ def test_stop_target_leaves_the_capture_point_midway(short_walk) -> None:  # typ
     assert xi == pytest.approx(d / 2, abs=STOP_FORMULA_TOL)
 
 
+@pytest.mark.parametrize("region_aware", ["off", "planned", "nearby"])
+def test_capture_stop_places_the_last_footstep_in_every_region_mode(  # type: ignore[no-untyped-def]
+    short_walk, region_aware: str
+) -> None:
+    """With ``capture_stop`` the last stopping step is the capture-point footstep of
+    ``stop_target`` (tested above against the exact double-support ALIP) in the region-aware
+    modes too (they solved their own MPC and skipped it); without, it is not."""
+    scene, plan, _ = short_walk
+    regions = {r.name: r for r in scene.terrain.regions}
+    robot = plan.robot
+    state = robot.alip().state_from_velocity(np.zeros(2), np.array([0.05, 0.12]))
+    stance = np.array(plan.footsteps[-1], dtype=float)
+    t = 0.1
+
+    def last_step(capture: bool) -> tuple[np.ndarray, MPCAdjuster, np.ndarray, int]:
+        adj = MPCAdjuster(plan, regions, region_aware=region_aware, capture_stop=capture)
+        last = adj.plan.n_steps - 1
+        target, u = adj.update(t, state, stance, last)
+        return target, adj, u, last
+
+    target, adj, u, last = last_step(True)
+    expected = adj.stop_target(t, state, stance, last, u)
+    assert target[:2] == pytest.approx(expected, abs=1e-9)
+    other, _, _, _ = last_step(False)
+    assert np.linalg.norm(other[:2] - expected) > 0.01
+
+
 #: flat 20-step walk: mean landed-vs-planned footstep distance [m] and goal distance [m]
 FLAT20_FOOTSTEP_TOL = 0.06
 #: measured CoP against the MPC's commanded ZMP: accepted range of the regression slope

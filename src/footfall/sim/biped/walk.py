@@ -181,6 +181,7 @@ class BipedWalk:
             torque_limits=sole_torque_limits(plan.robot),
             region_aware=opts.region_aware,
             landing_margin=opts.landing_margin,
+            capture_stop=opts.capture_stop,
         )
 
     def _init_state(self) -> None:
