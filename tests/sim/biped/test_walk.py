@@ -343,6 +343,13 @@ def test_capture_stop_places_the_last_footstep_in_every_region_mode(  # type: ig
     assert np.linalg.norm(other[:2] - expected) > 0.01
 
 
+@pytest.mark.parametrize("value", ["yes", 1, None])
+def test_capture_stop_must_be_a_bool(value: object) -> None:
+    with pytest.raises(InputError) as err:
+        WalkOptions(capture_stop=value)  # type: ignore[arg-type]
+    assert err.value.field == "capture_stop"
+
+
 #: flat 20-step walk: mean landed-vs-planned footstep distance [m] and goal distance [m]
 FLAT20_FOOTSTEP_TOL = 0.06
 #: measured CoP against the MPC's commanded ZMP: accepted range of the regression slope

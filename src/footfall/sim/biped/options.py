@@ -208,6 +208,8 @@ class WalkOptions:
         object.__setattr__(self, "com_feedback", fb)
         if self.true_momentum is not None and not isinstance(self.true_momentum, bool):
             raise InputError("true_momentum", self.true_momentum, "True, False or None")
+        if not isinstance(self.capture_stop, bool):
+            raise InputError("capture_stop", self.capture_stop, "True or False")
         lm = non_negative("leg_momentum", self.leg_momentum)
         if lm > 1.0:
             raise InputError("leg_momentum", self.leg_momentum, "a share in [0, 1]")
