@@ -1,7 +1,7 @@
 """Compiled packing of the quadruped's whole-body QP (numba, beyond the documents).
 
 :func:`feet_tick` interpolates the plan and decides each foot's part of the tick (a contact or
-not, its point, its unload weight, a late foot's target below the ground); :func:`pack_tick`
+not, its point, its unload weight, the target of a stance foot off the ground); :func:`pack_tick`
 writes one tick's contacts and tasks (:mod:`footfall.sim.quadruped.wbc`'s
 module docstring) straight into the arrays of :class:`footfall.control.wbc.PackedProblem`, the
 same numbers as building :class:`~footfall.control.wbc.Contact`, ``MotionTask`` and ``WrenchTask``
@@ -114,18 +114,15 @@ def feet_tick(
         # lower than planned, or a foot that bounced) it reaches down instead of the QP
         # counting on a force that the ground cannot give
         contact[leg] = (stance[leg] and touching[leg]) or early[leg] or late[leg]
-    n_contacts = 0
-    for leg in range(4):
-        if contact[leg]:
-            n_contacts += 1
+    n_contacts = np.sum(contact)
     for leg in range(4):
         is_contact = contact[leg]
+        centre = site_xpos[foot_sites[leg]]
         # a planned stance foot off the ground outside its unload window (in it, it is let go
         # and lifts off a little early) descends from where it is along the normal at
         # reach_speed, to at most reach_depth below its foothold: no step in its target, so
         # it lands as gently as that speed
         if stance[leg] and not is_contact and left[leg] >= unload:
-            centre = site_xpos[foot_sites[leg]]
             depth = 0.0
             for i in range(3):
                 depth += (centre[i] - row[FEET + 3 * leg + i]) * normal[leg, i]
@@ -137,7 +134,6 @@ def feet_tick(
                 row[FEET_V + 3 * leg + i] = -speed * normal[leg, i]
                 row[FEET_A + 3 * leg + i] = 0.0
         unload_w[leg] = -1.0
-        centre = site_xpos[foot_sites[leg]]
         if is_contact:
             for i in range(3):
                 pts[leg, i] = centre[i] - radius * normal[leg, i]
