@@ -108,7 +108,7 @@ class MujocoWbcModel:
         else:  # MuJoCo < 3.5: mj_fullM(m, dst, qM)
             self.mj.mj_fullM(self.m, mass, self.d.qM)
         if self.implicit_damping is not None:
-            mass[np.diag_indices(self.nv)] += self.implicit_damping
+            mass.flat[:: self.nv + 1] += self.implicit_damping  # the diagonal, in place
         return mass
 
     def frame(

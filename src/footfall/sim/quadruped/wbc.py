@@ -147,6 +147,7 @@ class _Reference:
         self.dt = dt
         body_v = np.gradient(ref.body_pos, dt, axis=0)
         feet_v = np.gradient(ref.feet, dt, axis=0)
+        joints_v = np.gradient(ref.joints, dt, axis=0)
         n = ref.t.size
         # the interpolated quantities side by side (the columns of _wbc_tick.BODY...), so that
         # one interpolation per tick gives them all
@@ -158,10 +159,10 @@ class _Reference:
             feet_v.reshape(n, -1),
             np.gradient(feet_v, dt, axis=0).reshape(n, -1),
             ref.joints,
-            np.gradient(ref.joints, dt, axis=0),
+            joints_v,
             ref.zmp,
             ref.body_pitch[:, None],
-            np.gradient(np.gradient(ref.joints, dt, axis=0), dt, axis=0),
+            np.gradient(joints_v, dt, axis=0),
         ]
         #: (T, 84) the columns above: body position (3) [m], velocity, acceleration, feet
         #: (4 x 3) [m], velocities, accelerations, joints (12) [rad], rates, ZMP (2) [m], pitch,
