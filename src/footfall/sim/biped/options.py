@@ -151,7 +151,8 @@ class WalkOptions:
             held-out 4 N s pushes go from 93 to 99 of 100 and its and the G1's ZMP offsets
             drop by 40-45 %, but Alexander (legs 36 % of its mass each) survives 32 of 50
             pushes against 44 (benchmarks/RESULTS.md, "The legs' momentum in the MPC's
-            prediction").
+            prediction"; measured before ``torque_weight_mass``, with which Talos reaches the
+            goal without it).
         capture_stop: the last stopping step lands where it leaves the capture point between
             the feet (:meth:`~footfall.control.adjusters.PlanFollower.stop_target`), kept in its
             planned region, instead of where the MPC's terminal term toward the plan's final
