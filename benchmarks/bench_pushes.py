@@ -34,6 +34,7 @@ import argparse
 import csv
 import math
 import os
+from dataclasses import replace
 from multiprocessing import Pool
 from pathlib import Path
 
@@ -79,12 +80,14 @@ def _walk(job: tuple[str, str, str, float, int, str, str, str, int, float]) -> d
     from footfall.sim.trial import run_trial
     from footfall.terrain.scene import builtin_scene
 
-    scene_name, controller, region, size, seed, cache, robot, unit, steps, leg = job
+    scene_name, controller, region, size, seed, cache, robot, unit, steps, leg, literal = job
     scene = builtin_scene(scene_name)
     model = robot_model(robot)
     n = steps or SCENES.get(scene_name)
     plan = plan_for_walk(scene, "miqcqp", n, 600.0, Path(cache), model=model)
     options = WalkOptions(controller=controller, region_aware=region, leg_momentum=leg)
+    if literal:
+        options = replace(options, torque_weight_mass=None)
     plant = MujocoBipedPlant(options, robot=model)
     push = (
         Disturbance.of_seed(seed, dv=size)
@@ -151,6 +154,12 @@ def main() -> None:
         default=0.0,
         help="WalkOptions.leg_momentum: share of the legs' forecast momentum (0: off)",
     )
+    ap.add_argument(
+        "--literal-torque-weight",
+        action="store_true",
+        help="WalkOptions.torque_weight_mass=None: the MPC's ankle-torque weight R the same for "
+        "every robot (default: scaled by the robot's mass, the same weight per metre of CoP)",
+    )
     ap.add_argument("--seeds", type=int, default=10, help="walks per scene, controller, impulse")
     ap.add_argument("--seed-start", type=int, default=0, help="first seed (held-out seeds)")
     ap.add_argument("--workers", type=int, default=2)
@@ -192,7 +201,19 @@ def main() -> None:
     a.out.mkdir(parents=True, exist_ok=True)
     cache = str(a.out / "plans")
     jobs = [
-        (sc, ctl, mode, imp, seed, cache, a.robot, unit, a.steps, a.leg_momentum)
+        (
+            sc,
+            ctl,
+            mode,
+            imp,
+            seed,
+            cache,
+            a.robot,
+            unit,
+            a.steps,
+            a.leg_momentum,
+            a.literal_torque_weight,
+        )
         for sc in scenes
         for ctl, mode in variants
         for imp in levels
@@ -212,6 +233,7 @@ def main() -> None:
                 unit,
                 a.steps,
                 a.leg_momentum,
+                a.literal_torque_weight,
             )
         )
     with Pool(a.workers) as pool:

@@ -3,6 +3,7 @@ sparse SOCP solved by Clarabel, the torque ball (not a box), fallback and input 
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 
 import clarabel
@@ -438,3 +439,33 @@ def test_padded_matrices_hold_the_per_tick_matrices(model: CondensedMPC) -> None
             np.testing.assert_array_equal(padded[:n, : exact.shape[1]], exact)
             assert not padded[n:].any() and not padded[:, exact.shape[1] :].any()
         np.testing.assert_array_equal(pad.d_theta[k], model._d_theta[k])
+
+
+@pytest.mark.parametrize("factor", [0.5, 3.0])
+def test_a_heavier_robot_gets_the_same_centre_of_pressure_plan(factor: float) -> None:
+    """The ALIP in (position, velocity, CoP = u / (m g)) does not depend on the mass: a robot
+    ``factor`` times heavier, measured with ``factor`` times the momentum, must get the same
+    footstep and ``factor`` times the torques (the same CoP) when R is scaled by the mass
+    (``r_mass``), including with active torque balls (U_max scaled alike). The literal R
+    (``r_mass=None``) breaks this: the heavier robot moves its footstep instead."""
+    heavy = dataclasses.replace(ROBOT, mass=ROBOT.mass * factor, u_max=ROBOT.u_max * factor)
+    rng = np.random.default_rng(7)
+    scaled = MPCWeights(r_mass=ROBOT.mass)
+    for weights, invariant in ((scaled, True), (MPCWeights(), False)):
+        light_mpc = MPC(build_mpc(ROBOT, weights, RATE_DT))
+        heavy_mpc = MPC(build_mpc(heavy, weights, RATE_DT))
+        worst_step, worst_cop = 0.0, 0.0
+        for j in range(6):
+            theta = random_theta(rng, scale=3.0 if j % 2 else 0.3)
+            k_s = int(rng.integers(0, light_mpc.model.n_ticks))
+            momentum = np.array([1.0, 1.0, factor, factor])
+            args = (np.zeros(3), np.array([*theta[4:6], 0.0]))
+            a = light_mpc.solve(k_s, theta[:4], *args, theta[6:])
+            b = heavy_mpc.solve(k_s, theta[:4] * momentum, *args, theta[6:] * momentum)
+            assert a.status is MPCStatus.OPTIMAL and b.status is MPCStatus.OPTIMAL
+            worst_step = max(worst_step, float(np.max(np.abs(a.next_footstep - b.next_footstep))))
+            worst_cop = max(worst_cop, float(np.max(np.abs(a.torques * factor - b.torques))))
+        if invariant:
+            assert worst_step < 1e-7 and worst_cop < 1e-6 * ROBOT.u_max * factor
+        else:
+            assert worst_step > 1e-3

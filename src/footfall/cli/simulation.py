@@ -619,6 +619,7 @@ def walk_cmd(
         "region_aware": options.region_aware,
         "leg_momentum": options.leg_momentum,
         "capture_stop": options.capture_stop,
+        "torque_weight_mass": options.torque_weight_mass,
     }
     write_json(out / "walk.json", report)
     plot_walk(res, sc, out / "walk.png", params=model, title=f"{sc.name}, {planner}, {robot}")

@@ -107,17 +107,15 @@ class MPCWeights:
     Attributes:
         q_pos: Q on the CoM position deviation from the natural trajectory [1/(m^2 s)].
         q_vel: Q on the CoM velocity deviation from the natural trajectory [1/((m/s)^2 s)].
-        r: R on the ankle torque [1/((N m)^2 s)]; 1e-3 makes 15 N m held for a 0.4 s step cost 0.09.
-        w: W on the next-footstep deviation from the plan [1/m^2]; 10 makes 10 cm cost 0.1.
-        qf_pos: Q_f on the CoM position (relative to the new foot) at the start of the next step
-            [1/m^2].
-        qf_vel: Q_f on the CoM velocity at the start of the next step [1/(m/s)^2].
-        qf_dcm: Q_f on the divergent component (capture point) ``xi = c + v / omega`` at the start
-            of the next step [1/m^2]. Only the divergent component needs correcting: the
-            convergent one decays by itself, so a Q_f that weighs it (a rank-2 term
-            ``C_xi^T C_xi``) lets the footstep absorb pushes instead of the ankle (capture-point
-            stepping); diagonal position/velocity weights alone make the one-step horizon fight a
-            velocity error with torque and saturate. 1000 makes a 1 cm error cost 0.1.
+        r: R on the ankle torque [1/((N m)^2 s)] of a robot of ``r_mass``; 1e-3 makes 15 N m held
+            for a 0.4 s step cost 0.09.
+        r_mass: the mass [kg] ``r`` was chosen for, or None (the default: ``R = r`` for every
+            robot, document 000's weight). Given, a robot of mass ``m`` gets
+            ``R = r (r_mass / m)^2``: the same weight on the centre-of-pressure shift
+            ``u / (m g)`` whatever the robot weighs (the ankle's torque per metre of CoP grows
+            with the weight on it; the velocity weights are scaled by the mass already). The
+            MuJoCo walker gives the mass of footfall's biped, on which its weights were chosen
+            (:data:`footfall.sim.biped.options.WEIGHTS_MASS`).
 
     The defaults were chosen in the reduced-order closed loop (``footfall.sim``): with
     ``qf_dcm = 0`` and ``qf_pos = qf_vel = 100`` a 10 N s sideways push on the flat scene makes the
@@ -131,6 +129,7 @@ class MPCWeights:
     qf_pos: float = 1.0
     qf_vel: float = 1.0
     qf_dcm: float = 1000.0
+    r_mass: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("q_pos", "q_vel", "qf_pos", "qf_vel", "qf_dcm"):
@@ -141,6 +140,12 @@ class MPCWeights:
         # R > 0 and W > 0 make the condensed Hessian positive definite (unique solution).
         object.__setattr__(self, "r", positive("weights.r", self.r))
         object.__setattr__(self, "w", positive("weights.w", self.w))
+        if self.r_mass is not None:
+            object.__setattr__(self, "r_mass", positive("weights.r_mass", self.r_mass))
+
+    def torque_weight(self, mass: float) -> float:
+        """R's diagonal [1/((N m)^2 s)] for a robot of ``mass`` [kg] (see ``r_mass``)."""
+        return self.r if self.r_mass is None else self.r * (self.r_mass / mass) ** 2
 
     def matrices(self, robot: BipedParams) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """``(Q (4, 4), R (2, 2), W (2, 2), Q_f (4, 4))`` of eq. (5.19a) for ``robot``."""
@@ -151,7 +156,7 @@ class MPCWeights:
         k = 1.0 / (robot.mass * robot.com_height * robot.alip().omega)
         c_xi = np.array([[1.0, 0.0, 0.0, k], [0.0, 1.0, -k, 0.0]])
         qf = qf + self.qf_dcm * c_xi.T @ c_xi
-        return q, self.r * np.eye(2), self.w * np.eye(2), qf
+        return q, self.torque_weight(robot.mass) * np.eye(2), self.w * np.eye(2), qf
 
 
 @dataclass(frozen=True, eq=False)

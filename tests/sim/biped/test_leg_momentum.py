@@ -149,5 +149,6 @@ def test_walk_command_records_the_share(tmp_path):
         "region_aware": "planned",
         "leg_momentum": 0.5,
         "capture_stop": True,
+        "torque_weight_mass": 30.1,
     }
     assert walked["metrics"]["reached_goal"]

@@ -19,14 +19,15 @@ from footfall.control.adjusters import (  # noqa: E402
     PlanFollower,
     sole_torque_limits,
 )
+from footfall.control.mpc import MPCWeights  # noqa: E402
 from footfall.errors import FootfallError, InputError  # noqa: E402
 from footfall.models.biped import Side  # noqa: E402
 from footfall.planning import make_plan  # noqa: E402
 from footfall.sim.biped.model import planner_params  # noqa: E402
-from footfall.sim.biped.options import WalkOptions  # noqa: E402
+from footfall.sim.biped.options import WEIGHTS_MASS, WalkOptions  # noqa: E402
 from footfall.sim.biped.plant import BipedSim, ankle_joint_torque, sole_cop  # noqa: E402
 from footfall.sim.biped.references import ds_propagator  # noqa: E402
-from footfall.sim.biped.walk import walk  # noqa: E402
+from footfall.sim.biped.walk import BipedWalk, walk  # noqa: E402
 from footfall.sim.disturbance import Push  # noqa: E402
 from footfall.terrain import Goal, Region, builtin_scene  # noqa: E402
 from tests.cli import error_line, footfall  # noqa: E402
@@ -647,3 +648,26 @@ def test_a_start_sole_over_the_pad_edge_is_refused(tmp_path) -> None:  # type: i
     line = error_line(r, "scene.start.left")
     assert "0.050 m beyond" in line
     assert not out.exists() or not any(out.iterdir())
+
+
+@pytest.mark.parametrize("value", [0.0, -30.0, float("nan"), float("inf"), "30"])
+def test_torque_weight_mass_must_be_a_positive_mass(value: object) -> None:
+    with pytest.raises(InputError) as err:
+        WalkOptions(torque_weight_mass=value)  # type: ignore[arg-type]
+    assert err.value.field == "torque_weight_mass"
+
+
+def test_the_walker_scales_the_torque_weight_by_the_plan_robots_mass() -> None:
+    """The walker's MPC gets ``R = r (torque_weight_mass / m)^2`` for the plan's robot of mass
+    ``m`` (footfall's biped: ``m`` = WEIGHTS_MASS, so ``R = r`` by default), and the literal ``r``
+    with ``torque_weight_mass=None``."""
+    scene = builtin_scene("flat_long")
+    plan = make_plan(scene, "reactive", robot=planner_params(base=scene.robot))
+    m = plan.robot.mass
+    r = MPCWeights().r
+    cases = ((WEIGHTS_MASS, r * (WEIGHTS_MASS / m) ** 2), (2.0 * m, 4.0 * r), (None, r))
+    for mass, expected in cases:
+        walker = BipedWalk(scene, plan, WalkOptions(torque_weight_mass=mass))
+        mdl = walker.src.mpc.model  # type: ignore[attr-defined]
+        assert mdl.weights.torque_weight(m) == pytest.approx(expected, rel=1e-12)
+    assert abs(m - WEIGHTS_MASS) < 1e-9

@@ -23,6 +23,10 @@ from footfall.terrain.terrain import LANDING_Z_TOL
 #: landings fall short of their targets, and a heel landing on the edge of the tread above a
 #: step down tips the foot
 RISER_LANDING_TOLERANCE = 0.04
+#: the mass [kg] of footfall's biped as planned (:func:`~footfall.sim.biped.model
+#: .planner_params`), on which the walker's MPC weights were chosen: other robots get its ankle
+#: torque weight scaled by their mass (``WalkOptions.torque_weight_mass``)
+WEIGHTS_MASS = 30.1
 #: the walk's whole-body controllers (``WalkOptions.controller``)
 CONTROLLERS = ("servo", "wbc")
 #: a plan's robot mass and CoM height may differ this much (relative) from the walker model's
@@ -147,13 +151,21 @@ class WalkOptions:
             held-out 4 N s pushes go from 93 to 99 of 100 and its and the G1's ZMP offsets
             drop by 40-45 %, but Alexander (legs 36 % of its mass each) survives 32 of 50
             pushes against 44 (benchmarks/RESULTS.md, "The legs' momentum in the MPC's
-            prediction").
+            prediction"; measured before ``torque_weight_mass``, with which Talos reaches the
+            goal without it).
         capture_stop: the last stopping step lands where it leaves the capture point between
             the feet (:meth:`~footfall.control.adjusters.PlanFollower.stop_target`), kept in its
             planned region, instead of where the MPC's terminal term toward the plan's final
             state puts it. With heavy legs the MPC's last steps drifted inward and the robot
             ended on feet it could not stand on: on flat_long with 0.1 m/s pushes (seeds 0-49),
             Talos fell in 24 walks and Alexander in 6; with this, 3 and 0.
+        torque_weight_mass: the mass [kg] the MPC's ankle-torque weight ``MPCWeights.r`` is
+            given for (``MPCWeights.r_mass``): a robot of mass ``m`` gets ``r (mass / m)^2``, the
+            same weight on its centre-of-pressure shift as footfall's biped, on which the weights
+            were chosen (default :data:`WEIGHTS_MASS`); None: the same ``r`` for every robot.
+            With the same ``r``, Talos (90 kg) paid 9x as much for the same CoP shift, moved its
+            footsteps 10-22 cm instead and ended its walks 15-20 cm past the goal
+            (benchmarks/RESULTS.md, "The ankle's weight per metre of CoP, for every robot").
     """
 
     controller: str = "wbc"
@@ -182,6 +194,7 @@ class WalkOptions:
     swing_target_rate: bool = True
     leg_momentum: float = 0.0
     capture_stop: bool = True
+    torque_weight_mass: float | None = WEIGHTS_MASS
 
     def __post_init__(self) -> None:
         check_region_mode(self.region_aware)
@@ -210,6 +223,9 @@ class WalkOptions:
             raise InputError("true_momentum", self.true_momentum, "True, False or None")
         if not isinstance(self.capture_stop, bool):
             raise InputError("capture_stop", self.capture_stop, "True or False")
+        if self.torque_weight_mass is not None:
+            tm = positive("torque_weight_mass", self.torque_weight_mass)
+            object.__setattr__(self, "torque_weight_mass", tm)
         lm = non_negative("leg_momentum", self.leg_momentum)
         if lm > 1.0:
             raise InputError("leg_momentum", self.leg_momentum, "a share in [0, 1]")

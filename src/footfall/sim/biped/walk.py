@@ -50,6 +50,7 @@ from footfall.control.adjusters import (
     extend_plan,
     sole_torque_limits,
 )
+from footfall.control.mpc import MPCWeights
 from footfall.errors import InputError, SolverError
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import FootstepPlan
@@ -182,6 +183,7 @@ class BipedWalk:
             region_aware=opts.region_aware,
             landing_margin=opts.landing_margin,
             capture_stop=opts.capture_stop,
+            weights=MPCWeights(r_mass=opts.torque_weight_mass),
         )
 
     def _init_state(self) -> None:
