@@ -200,20 +200,9 @@ def main() -> None:
     variants = [(ctl, mode) for ctl in controllers for mode in modes]
     a.out.mkdir(parents=True, exist_ok=True)
     cache = str(a.out / "plans")
+    common = (a.robot, unit, a.steps, a.leg_momentum, a.literal_torque_weight)
     jobs = [
-        (
-            sc,
-            ctl,
-            mode,
-            imp,
-            seed,
-            cache,
-            a.robot,
-            unit,
-            a.steps,
-            a.leg_momentum,
-            a.literal_torque_weight,
-        )
+        (sc, ctl, mode, imp, seed, cache, *common)
         for sc in scenes
         for ctl, mode in variants
         for imp in levels
@@ -221,21 +210,10 @@ def main() -> None:
     ]
     # plan once per scene before the pool (the cache then serves every worker)
     for sc in scenes:
-        _walk(
-            (
-                sc,
-                controllers[0],
-                modes[0],
-                levels[0],
-                0,
-                cache,
-                a.robot,
-                unit,
-                a.steps,
-                a.leg_momentum,
-                a.literal_torque_weight,
-            )
-        )
+        try:
+            _walk((sc, controllers[0], modes[0], levels[0], 0, cache, *common))
+        except FootfallError as e:
+            ap.error(f"--scenes / --steps: {sc}: {e}")
     with Pool(a.workers) as pool:
         rows = pool.map(_walk, jobs, chunksize=1)
     with (a.out / "pushes.csv").open("w", newline="") as fh:

@@ -118,6 +118,16 @@ def test_a_step_beyond_the_walk_is_refused() -> None:
     assert err.value.field == "push step"
 
 
+@pytest.mark.parametrize("step", [None, 0])
+def test_a_walk_without_steps_cannot_be_pushed(step: int | None) -> None:
+    """A plan without a solution has no single support: the push says so (it used to index an
+    empty timeline)."""
+    tl = SupportTimeline.periodic(0.0, 0, 0.4, 0.1)
+    with pytest.raises(InputError) as err:
+        Disturbance(dv=0.1, step=step).pushes(tl, 30.0)
+    assert err.value.field == "plan"
+
+
 def test_push_force_sums_the_active_pushes() -> None:
     a = Push.horizontal(1.0, 2.0, 0.0, 0.1)
     b = Push.horizontal(1.05, 1.0, math.pi / 2, 0.1)

@@ -287,6 +287,10 @@ class Disturbance:
 
     def push_step(self, n_steps: int) -> int:
         """The single support (0-based) of a walk of ``n_steps`` steps that is pushed."""
+        if n_steps < 1:
+            raise InputError(
+                "plan", n_steps, "single supports to push (a plan without a solution has none)"
+            )
         if self.step is not None:
             if self.step >= n_steps:
                 raise InputError("push step", self.step, f"a step of the walk, 0..{n_steps - 1}")
