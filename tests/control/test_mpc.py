@@ -446,8 +446,9 @@ def test_a_heavier_robot_gets_the_same_centre_of_pressure_plan(factor: float) ->
     """The ALIP in (position, velocity, CoP = u / (m g)) does not depend on the mass: a robot
     ``factor`` times heavier, measured with ``factor`` times the momentum, must get the same
     footstep and ``factor`` times the torques (the same CoP) when R is scaled by the mass
-    (``r_mass``), including with active torque balls (U_max scaled alike). The literal R
-    (``r_mass=None``) breaks this: the heavier robot moves its footstep instead."""
+    (``r_mass``), with the torque balls active or not (U_max scaled alike). The document's
+    literal R (the default, ``r_mass=None``) breaks this where the balls are not all active:
+    the heavier robot moves its footstep instead."""
     heavy = dataclasses.replace(ROBOT, mass=ROBOT.mass * factor, u_max=ROBOT.u_max * factor)
     rng = np.random.default_rng(7)
     scaled = MPCWeights(r_mass=ROBOT.mass)
@@ -469,3 +470,10 @@ def test_a_heavier_robot_gets_the_same_centre_of_pressure_plan(factor: float) ->
             assert worst_step < 1e-7 and worst_cop < 1e-6 * ROBOT.u_max * factor
         else:
             assert worst_step > 1e-3
+
+
+@pytest.mark.parametrize("value", [0.0, -30.0, float("nan"), float("inf")])
+def test_r_mass_must_be_a_positive_mass(value: float) -> None:
+    with pytest.raises(InputError) as err:
+        MPCWeights(r_mass=value)
+    assert err.value.field == "weights.r_mass"

@@ -116,6 +116,16 @@ class MPCWeights:
             with the weight on it; the velocity weights are scaled by the mass already). The
             MuJoCo walker gives the mass of footfall's biped, on which its weights were chosen
             (:data:`footfall.sim.biped.options.WEIGHTS_MASS`).
+        w: W on the next-footstep deviation from the plan [1/m^2]; 10 makes 10 cm cost 0.1.
+        qf_pos: Q_f on the CoM position (relative to the new foot) at the start of the next step
+            [1/m^2].
+        qf_vel: Q_f on the CoM velocity at the start of the next step [1/(m/s)^2].
+        qf_dcm: Q_f on the divergent component (capture point) ``xi = c + v / omega`` at the start
+            of the next step [1/m^2]. Only the divergent component needs correcting: the
+            convergent one decays by itself, so a Q_f that weighs it (a rank-2 term
+            ``C_xi^T C_xi``) lets the footstep absorb pushes instead of the ankle (capture-point
+            stepping); diagonal position/velocity weights alone make the one-step horizon fight a
+            velocity error with torque and saturate. 1000 makes a 1 cm error cost 0.1.
 
     The defaults were chosen in the reduced-order closed loop (``footfall.sim``): with
     ``qf_dcm = 0`` and ``qf_pos = qf_vel = 100`` a 10 N s sideways push on the flat scene makes the

@@ -160,7 +160,7 @@ class WalkOptions:
             ended on feet it could not stand on: on flat_long with 0.1 m/s pushes (seeds 0-49),
             Talos fell in 24 walks and Alexander in 6; with this, 3 and 0.
         torque_weight_mass: the mass [kg] the MPC's ankle-torque weight ``MPCWeights.r`` is
-            given for (``MPCWeights.r_mass``): a robot of mass ``m`` gets ``r (mass / m)^2``, the
+            given for (``MPCWeights.r_mass``): a robot of mass ``m`` gets ``r (this / m)^2``, the
             same weight on its centre-of-pressure shift as footfall's biped, on which the weights
             were chosen (default :data:`WEIGHTS_MASS`); None: the same ``r`` for every robot.
             With the same ``r``, Talos (90 kg) paid 9x as much for the same CoP shift, moved its
