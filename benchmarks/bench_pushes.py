@@ -72,7 +72,9 @@ def _levels(ap: argparse.ArgumentParser, flag: str, text: str) -> list[float]:
     return levels
 
 
-def _walk(job: tuple[str, str, str, float, int, str, str, str, int, float]) -> dict[str, object]:
+def _walk(
+    job: tuple[str, str, str, float, int, str, str, str, int, float, bool],
+) -> dict[str, object]:
     from footfall.sim.biped.options import WalkOptions
     from footfall.sim.biped.plans import plan_for_walk, robot_model
     from footfall.sim.biped.trial import MujocoBipedPlant
