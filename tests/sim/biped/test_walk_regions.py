@@ -164,10 +164,11 @@ def test_new_scenes_are_walked_with_every_footstep_on_a_region(name: str) -> Non
 
 @pytest.mark.parametrize("limited", [True, False])
 def test_the_swing_target_moves_at_most_its_speed_per_tick(limited: bool) -> None:
-    """The swing path's target moves toward a jumped MPC footstep by at most speed * dt per
-    tick; the speed crosses the reach trapezoid's diameter in one single support. By hand for
-    the biped: the corners (-0.20, 0.12) and (0.35, 0.12) are 0.55 m apart, T_ss = 0.4 s, so
-    1.375 m/s and 13.75 mm per 10 ms tick; a 0.10 m jump takes 8 ticks (7 full, 0.75 mm)."""
+    """Once the sole moves horizontally, the swing path's target moves toward a jumped MPC
+    footstep by at most speed * dt per tick; the speed crosses the reach trapezoid's diameter in
+    one single support. By hand for the biped: the corners (-0.20, 0.12) and (0.35, 0.12) are
+    0.55 m apart, T_ss = 0.4 s, so 1.375 m/s and 13.75 mm per 10 ms tick; a 0.10 m jump takes 8
+    ticks (7 full, 0.75 mm). The horizontal move starts at 10 % of T_ss, 0.04 s."""
     from footfall.sim.biped.walk import BipedWalk
 
     scene = builtin_scene("stepping_stones")
@@ -178,13 +179,42 @@ def test_the_swing_target_moves_at_most_its_speed_per_tick(limited: bool) -> Non
     walker._begin_step(0)
     planned = np.asarray(plan.footsteps[1], dtype=float)
     goal = planned + np.array([0.0, 0.10, 0.0])
+    tp = 0.04
     if not limited:
-        assert np.allclose(walker._limit_target(goal), goal)
+        assert np.allclose(walker._limit_target(goal, tp), goal)
         return
     expected_y = [0.01375 * k for k in range(1, 8)] + [0.10, 0.10]
     for y in expected_y:
-        target = walker._limit_target(goal)
+        target = walker._limit_target(goal, tp)
         assert target == pytest.approx(planned + np.array([0.0, y, 0.0]), abs=1e-12)
+        tp += walker.dt
     # the next step starts from its own planned footstep
     walker._begin_step(1)
     assert walker.swing.target == pytest.approx(np.asarray(plan.footsteps[2], dtype=float))
+
+
+def test_the_swing_target_follows_the_footstep_at_once_before_the_sole_moves() -> None:
+    """In the first 10 % of T_ss (0.04 s for the biped) the swing path's horizontal part is its
+    start whatever the target (checked on the path itself), so the target takes the MPC's
+    footstep at once, even 0.5 m away (a crossover after an inward push); from 0.04 s on it
+    moves 13.75 mm per tick (see above) from where it got to."""
+    from footfall.sim.biped.references import swing_reference
+    from footfall.sim.biped.walk import BipedWalk
+
+    scene = builtin_scene("stepping_stones")
+    plan = load_plan(PLAN, scene)
+    walker = BipedWalk(scene, plan, WalkOptions())
+    walker._begin_step(0)
+    planned = np.asarray(plan.footsteps[1], dtype=float)
+    start = np.asarray(walker.swing.start, dtype=float)
+    far = planned + np.array([0.0, -0.5, 0.0])
+    for tp in (0.0, 0.01, 0.02, 0.03):
+        a, _ = swing_reference(tp / 0.4, start, planned, 0.1)
+        b, _ = swing_reference(tp / 0.4, start, far, 0.1)
+        assert a[:2] == pytest.approx(start[:2], abs=1e-12)
+        assert b[:2] == pytest.approx(start[:2], abs=1e-12)
+        assert walker._limit_target(far, tp) == pytest.approx(far, abs=1e-12)
+    back = far + np.array([0.0, 0.10, 0.0])
+    assert walker._limit_target(back, 0.04) == pytest.approx(
+        far + np.array([0.0, 0.01375, 0.0]), abs=1e-12
+    )

@@ -64,6 +64,7 @@ from footfall.sim.biped.model import BipedSimSettings, WalkerModel
 from footfall.sim.biped.options import WalkOptions, check_walk_inputs
 from footfall.sim.biped.plant import BipedSim, ankle_joint_torque, sole_cop
 from footfall.sim.biped.references import (
+    SWING_MOVE,
     CoMHeight,
     blend_rot,
     ds_propagator,
@@ -372,11 +373,16 @@ class BipedWalk:
         swing.rot1 = foot_rotation(self.normals[i + 1], plan.headings[i + 1])
         swing.rot1_strike = swing.rot1 @ pitch_about_y(-self.opts.heel_strike)
 
-    def _limit_target(self, nxt: FloatArray) -> FloatArray:
+    def _limit_target(self, nxt: FloatArray, tp: float) -> FloatArray:
         """Move the swing target toward the MPC's footstep ``nxt`` (3,) [m] by at most
-        ``target_speed * dt`` this tick (``swing_target_rate``); return the target to use."""
+        ``target_speed * dt`` this tick (``swing_target_rate``); return the target to use.
+
+        Before the sole starts to move horizontally (the first ``SWING_MOVE[0]`` share of the
+        swing, at ``tp`` [s] into it) the path's horizontal part is still its start, whatever
+        the target: the target then follows the MPC's footstep at once, which moves no
+        reference."""
         swing = self.swing
-        if not self.opts.swing_target_rate:
+        if not self.opts.swing_target_rate or tp < SWING_MOVE[0] * self.t_ss - 1e-9:
             swing.target = np.array(nxt, dtype=float)
             return swing.target.copy()
         swing.target = step_toward(swing.target, nxt, self.target_speed * self.dt)
@@ -416,7 +422,7 @@ class BipedWalk:
         if self.leg_momentum is not None:
             x_meas = x_meas + self.leg_momentum.shift(i, tp, obs.l_g, float(self.plan.headings[i]))
         nxt, u = self.src.update(tp, x_meas, stance, i)
-        nxt = self._limit_target(nxt)
+        nxt = self._limit_target(nxt, tp)
         self._raise_swing(tp, nxt)
         self.log.targets[i] = nxt
         self.log.zmp_planned[k] = alip.zmp(np.zeros(2), u)
