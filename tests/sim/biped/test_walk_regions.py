@@ -193,11 +193,12 @@ def test_the_swing_target_moves_at_most_its_speed_per_tick(limited: bool) -> Non
     assert walker.swing.target == pytest.approx(np.asarray(plan.footsteps[2], dtype=float))
 
 
-def test_the_swing_target_follows_the_footstep_at_once_before_the_sole_moves() -> None:
+def test_the_swing_target_jumps_only_to_a_footstep_the_bound_could_not_reach_in_time() -> None:
     """In the first 10 % of T_ss (0.04 s for the biped) the swing path's horizontal part is its
-    start whatever the target (checked on the path itself), so the target takes the MPC's
-    footstep at once, even 0.5 m away (a crossover after an inward push); from 0.04 s on it
-    moves 13.75 mm per tick (see above) from where it got to."""
+    start whatever the target (checked on the path itself). There a footstep farther than the
+    bounded target can travel before the horizontal move ends (1.375 m/s x (0.36 s - tp):
+    0.495 m at tp = 0, 0.4675 m at tp = 0.02 s) is taken at once, e.g. a crossover after a
+    strong inward push; a nearer one is approached at 13.75 mm per tick from the first tick."""
     from footfall.sim.biped.references import swing_reference
     from footfall.sim.biped.walk import BipedWalk
 
@@ -207,14 +208,29 @@ def test_the_swing_target_follows_the_footstep_at_once_before_the_sole_moves() -
     walker._begin_step(0)
     planned = np.asarray(plan.footsteps[1], dtype=float)
     start = np.asarray(walker.swing.start, dtype=float)
-    far = planned + np.array([0.0, -0.5, 0.0])
+    far = planned + np.array([0.0, -0.6, 0.0])
     for tp in (0.0, 0.01, 0.02, 0.03):
         a, _ = swing_reference(tp / 0.4, start, planned, 0.1)
         b, _ = swing_reference(tp / 0.4, start, far, 0.1)
         assert a[:2] == pytest.approx(start[:2], abs=1e-12)
         assert b[:2] == pytest.approx(start[:2], abs=1e-12)
-        assert walker._limit_target(far, tp) == pytest.approx(far, abs=1e-12)
-    back = far + np.array([0.0, 0.10, 0.0])
-    assert walker._limit_target(back, 0.04) == pytest.approx(
-        far + np.array([0.0, 0.01375, 0.0]), abs=1e-12
+    # near: 0.10 m away, reachable in time, so bounded from tp = 0 on
+    near = planned + np.array([0.0, 0.10, 0.0])
+    assert walker._limit_target(near, 0.0) == pytest.approx(
+        planned + np.array([0.0, 0.01375, 0.0]), abs=1e-12
+    )
+    # 0.48 m from the target at tp = 0.02 s: beyond 0.4675 m, so it is taken at once
+    now = walker.swing.target.copy()
+    jump = now + np.array([0.0, -0.48, 0.0])
+    assert walker._limit_target(jump, 0.02) == pytest.approx(jump, abs=1e-12)
+    # 0.48 m at tp = 0: within 0.495 m, bounded
+    walker._begin_step(0)
+    jump = planned + np.array([0.0, -0.48, 0.0])
+    assert walker._limit_target(jump, 0.0) == pytest.approx(
+        planned + np.array([0.0, -0.01375, 0.0]), abs=1e-12
+    )
+    # once the sole moves (tp >= 0.04 s) even a far footstep is approached at the bound
+    walker._begin_step(0)
+    assert walker._limit_target(far, 0.04) == pytest.approx(
+        planned + np.array([0.0, -0.01375, 0.0]), abs=1e-12
     )

@@ -377,14 +377,22 @@ class BipedWalk:
         """Move the swing target toward the MPC's footstep ``nxt`` (3,) [m] by at most
         ``target_speed * dt`` this tick (``swing_target_rate``); return the target to use.
 
-        Before the sole starts to move horizontally (the first ``SWING_MOVE[0]`` share of the
-        swing, at ``tp`` [s] into it) the path's horizontal part is still its start, whatever
-        the target: the target then follows the MPC's footstep at once, which moves no
-        reference."""
+        One exception, at ``tp`` [s] into the swing: before the sole starts to move horizontally
+        (the first ``SWING_MOVE[0]`` share of T_ss) the path's horizontal part is its start
+        whatever the target, so a target change there moves no reference. When the bounded
+        target could no longer reach ``nxt`` before the horizontal move ends (farther than
+        ``target_speed`` times the time left until then, e.g. a crossover after a strong inward
+        push), it takes ``nxt`` at once; otherwise the bound applies from the first tick.
+        """
         swing = self.swing
-        if not self.opts.swing_target_rate or tp < SWING_MOVE[0] * self.t_ss - 1e-9:
+        if not self.opts.swing_target_rate:
             swing.target = np.array(nxt, dtype=float)
             return swing.target.copy()
+        if tp < SWING_MOVE[0] * self.t_ss - 1e-9:
+            left = SWING_MOVE[1] * self.t_ss - tp
+            if float(np.linalg.norm(nxt - swing.target)) > self.target_speed * left:
+                swing.target = np.array(nxt, dtype=float)
+                return swing.target.copy()
         swing.target = step_toward(swing.target, nxt, self.target_speed * self.dt)
         return swing.target.copy()
 
