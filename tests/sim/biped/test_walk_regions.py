@@ -164,10 +164,11 @@ def test_new_scenes_are_walked_with_every_footstep_on_a_region(name: str) -> Non
 
 @pytest.mark.parametrize("limited", [True, False])
 def test_the_swing_target_moves_at_most_its_speed_per_tick(limited: bool) -> None:
-    """The swing path's target moves toward a jumped MPC footstep by at most speed * dt per
-    tick; the speed crosses the reach trapezoid's diameter in one single support. By hand for
-    the biped: the corners (-0.20, 0.12) and (0.35, 0.12) are 0.55 m apart, T_ss = 0.4 s, so
-    1.375 m/s and 13.75 mm per 10 ms tick; a 0.10 m jump takes 8 ticks (7 full, 0.75 mm)."""
+    """Once the sole moves horizontally, the swing path's target moves toward a jumped MPC
+    footstep by at most speed * dt per tick; the speed crosses the reach trapezoid's diameter in
+    one single support. By hand for the biped: the corners (-0.20, 0.12) and (0.35, 0.12) are
+    0.55 m apart, T_ss = 0.4 s, so 1.375 m/s and 13.75 mm per 10 ms tick; a 0.10 m jump takes 8
+    ticks (7 full, 0.75 mm). The horizontal move starts at 10 % of T_ss, 0.04 s."""
     from footfall.sim.biped.walk import BipedWalk
 
     scene = builtin_scene("stepping_stones")
@@ -178,13 +179,58 @@ def test_the_swing_target_moves_at_most_its_speed_per_tick(limited: bool) -> Non
     walker._begin_step(0)
     planned = np.asarray(plan.footsteps[1], dtype=float)
     goal = planned + np.array([0.0, 0.10, 0.0])
+    tp = 0.04
     if not limited:
-        assert np.allclose(walker._limit_target(goal), goal)
+        assert np.allclose(walker._limit_target(goal, tp), goal)
         return
     expected_y = [0.01375 * k for k in range(1, 8)] + [0.10, 0.10]
     for y in expected_y:
-        target = walker._limit_target(goal)
+        target = walker._limit_target(goal, tp)
         assert target == pytest.approx(planned + np.array([0.0, y, 0.0]), abs=1e-12)
+        tp += walker.dt
     # the next step starts from its own planned footstep
     walker._begin_step(1)
     assert walker.swing.target == pytest.approx(np.asarray(plan.footsteps[2], dtype=float))
+
+
+def test_the_swing_target_jumps_only_to_a_footstep_the_bound_could_not_reach_in_time() -> None:
+    """In the first 10 % of T_ss (0.04 s for the biped) the swing path's horizontal part is its
+    start whatever the target (checked on the path itself). There a footstep farther than the
+    bounded target can travel before the horizontal move ends (1.375 m/s x (0.36 s - tp):
+    0.495 m at tp = 0, 0.4675 m at tp = 0.02 s) is taken at once, e.g. a crossover after a
+    strong inward push; a nearer one is approached at 13.75 mm per tick from the first tick."""
+    from footfall.sim.biped.references import swing_reference
+    from footfall.sim.biped.walk import BipedWalk
+
+    scene = builtin_scene("stepping_stones")
+    plan = load_plan(PLAN, scene)
+    walker = BipedWalk(scene, plan, WalkOptions())
+    walker._begin_step(0)
+    planned = np.asarray(plan.footsteps[1], dtype=float)
+    start = np.asarray(walker.swing.start, dtype=float)
+    far = planned + np.array([0.0, -0.6, 0.0])
+    for tp in (0.0, 0.01, 0.02, 0.03):
+        a, _ = swing_reference(tp / 0.4, start, planned, 0.1)
+        b, _ = swing_reference(tp / 0.4, start, far, 0.1)
+        assert a[:2] == pytest.approx(start[:2], abs=1e-12)
+        assert b[:2] == pytest.approx(start[:2], abs=1e-12)
+    # near: 0.10 m away, reachable in time, so bounded from tp = 0 on
+    near = planned + np.array([0.0, 0.10, 0.0])
+    assert walker._limit_target(near, 0.0) == pytest.approx(
+        planned + np.array([0.0, 0.01375, 0.0]), abs=1e-12
+    )
+    # 0.48 m from the target at tp = 0.02 s: beyond 0.4675 m, so it is taken at once
+    now = walker.swing.target.copy()
+    jump = now + np.array([0.0, -0.48, 0.0])
+    assert walker._limit_target(jump, 0.02) == pytest.approx(jump, abs=1e-12)
+    # 0.48 m at tp = 0: within 0.495 m, bounded
+    walker._begin_step(0)
+    jump = planned + np.array([0.0, -0.48, 0.0])
+    assert walker._limit_target(jump, 0.0) == pytest.approx(
+        planned + np.array([0.0, -0.01375, 0.0]), abs=1e-12
+    )
+    # once the sole moves (tp >= 0.04 s) even a far footstep is approached at the bound
+    walker._begin_step(0)
+    assert walker._limit_target(far, 0.04) == pytest.approx(
+        planned + np.array([0.0, -0.01375, 0.0]), abs=1e-12
+    )

@@ -141,7 +141,9 @@ class WalkOptions:
             reached the goal in 93 of 100 against 84 (9 gained, 0 lost, exact McNemar
             p = 0.004). Its cost: the biped's protocol at 0.5 / 0.6 m/s passed 8 / 4 of 12
             against 9 / 10 (the largest level passed stays 0.4 m/s): the strongest pushes need
-            corrections faster than the bound.
+            corrections faster than the bound. Hence one exception: before the sole moves
+            horizontally a footstep the bound could not reach in time is taken at once
+            (``BipedWalk._limit_target``), which brought the biped's 0.5 m/s protocol to 11 of 12.
         leg_momentum: share [0, 1] of the legs' sagittal momentum about the CoM, forecast over
             the rest of each single support by the previous one's measured profile, that the
             MPC's end-of-step prediction carries (:mod:`footfall.sim.biped.leg_momentum`; 0:

@@ -64,6 +64,7 @@ from footfall.sim.biped.model import BipedSimSettings, WalkerModel
 from footfall.sim.biped.options import WalkOptions, check_walk_inputs
 from footfall.sim.biped.plant import BipedSim, ankle_joint_torque, sole_cop
 from footfall.sim.biped.references import (
+    SWING_MOVE,
     CoMHeight,
     blend_rot,
     ds_propagator,
@@ -372,13 +373,26 @@ class BipedWalk:
         swing.rot1 = foot_rotation(self.normals[i + 1], plan.headings[i + 1])
         swing.rot1_strike = swing.rot1 @ pitch_about_y(-self.opts.heel_strike)
 
-    def _limit_target(self, nxt: FloatArray) -> FloatArray:
+    def _limit_target(self, nxt: FloatArray, tp: float) -> FloatArray:
         """Move the swing target toward the MPC's footstep ``nxt`` (3,) [m] by at most
-        ``target_speed * dt`` this tick (``swing_target_rate``); return the target to use."""
+        ``target_speed * dt`` this tick (``swing_target_rate``); return the target to use.
+
+        One exception, at ``tp`` [s] into the swing: before the sole starts to move horizontally
+        (the first ``SWING_MOVE[0]`` share of T_ss) the path's horizontal part is its start
+        whatever the target, so a target change there moves no reference. When the bounded
+        target could no longer reach ``nxt`` before the horizontal move ends (farther than
+        ``target_speed`` times the time left until then, e.g. a crossover after a strong inward
+        push), it takes ``nxt`` at once; otherwise the bound applies from the first tick.
+        """
         swing = self.swing
         if not self.opts.swing_target_rate:
             swing.target = np.array(nxt, dtype=float)
             return swing.target.copy()
+        if tp < SWING_MOVE[0] * self.t_ss - 1e-9:
+            left = SWING_MOVE[1] * self.t_ss - tp
+            if float(np.linalg.norm(nxt - swing.target)) > self.target_speed * left:
+                swing.target = np.array(nxt, dtype=float)
+                return swing.target.copy()
         swing.target = step_toward(swing.target, nxt, self.target_speed * self.dt)
         return swing.target.copy()
 
@@ -416,7 +430,7 @@ class BipedWalk:
         if self.leg_momentum is not None:
             x_meas = x_meas + self.leg_momentum.shift(i, tp, obs.l_g, float(self.plan.headings[i]))
         nxt, u = self.src.update(tp, x_meas, stance, i)
-        nxt = self._limit_target(nxt)
+        nxt = self._limit_target(nxt, tp)
         self._raise_swing(tp, nxt)
         self.log.targets[i] = nxt
         self.log.zmp_planned[k] = alip.zmp(np.zeros(2), u)
