@@ -385,15 +385,14 @@ class BipedWalk:
         push), it takes ``nxt`` at once; otherwise the bound applies from the first tick.
         """
         swing = self.swing
-        if not self.opts.swing_target_rate:
-            swing.target = np.array(nxt, dtype=float)
-            return swing.target.copy()
-        if tp < SWING_MOVE[0] * self.t_ss - 1e-9:
+        free = not self.opts.swing_target_rate
+        if not free and tp < SWING_MOVE[0] * self.t_ss - 1e-9:
             left = SWING_MOVE[1] * self.t_ss - tp
-            if float(np.linalg.norm(nxt - swing.target)) > self.target_speed * left:
-                swing.target = np.array(nxt, dtype=float)
-                return swing.target.copy()
-        swing.target = step_toward(swing.target, nxt, self.target_speed * self.dt)
+            free = float(np.linalg.norm(nxt - swing.target)) > self.target_speed * left
+        if free:
+            swing.target = np.array(nxt, dtype=float)
+        else:
+            swing.target = step_toward(swing.target, nxt, self.target_speed * self.dt)
         return swing.target.copy()
 
     def _raise_swing(self, tp: float, nxt: FloatArray) -> None:
