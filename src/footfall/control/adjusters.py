@@ -367,9 +367,13 @@ class MPCAdjuster(PlanFollower):
         freeze_after: as for :class:`PlanFollower`, later by default: the MPC's footstep keeps
             improving late in the swing, and freezing early left every footstep short.
         capture_stop: the last footstep by the capture point (:meth:`stop_target`, then kept
-            legal), in every ``region_aware`` mode; off: the MPC's terminal term (Q_f toward the
-            plan's final state at rest) places it. The walker turns it on
-            (``WalkOptions.capture_stop``).
+            in its region), in every ``region_aware`` mode; off: the MPC's terminal term (Q_f
+            toward the plan's final state at rest) places it. The walker turns it on
+            (``WalkOptions.capture_stop``). Unlike :class:`PlanFollower`'s, this footstep is not
+            moved into the reach trapezoid (only with ``limit_reach``): a capture point on the
+            stance foot's far side makes the feet cross, and moved into the trapezoid the G1
+            fell in two such walks that had ended standing (benchmarks/RESULTS.md, "another
+            stopping step").
         torque_limits: semi-axes ``(U_x, U_y)`` [N m] of the MPC's torque ellipse
             (:func:`footfall.control.mpc.build_mpc`); None = the plan's ``U_max`` ball
             (eq. 5.19e). The MuJoCo walker passes :func:`sole_torque_limits`.
