@@ -154,11 +154,11 @@ class WalkOptions:
             estimate, 0 when the adjuster gets the true momentum (``servo``), which holds the
             legs' momentum already. Measured on and off over the same plans, seeds and push
             cases (benchmarks/RESULTS.md, "The legs' momentum on by default"): over six push
-            protocols and five seeded batteries (four robots) 23 walks gained and 9 lost; the
-            G1's 0.1 m/s pushes on discrete_steps x 0.4 reached the goal in 46 of 50 against 42,
-            the biped's held-out 4 N s pushes in 99 of 100 against 93, and its discrete_steps
-            protocol passes every case at 0.2 m/s; Alexander (legs 36 % of its mass each) lost
-            2 of 50 random 0.1 m/s pushes and gained 2 protocol cases.
+            protocols and six seeded batteries (four robots) 36 walks gained and 11 lost; the
+            biped's held-out 4 N s pushes reached the goal in 396 of 400 against 382, the G1's
+            0.1 m/s pushes on the x 0.4 steps in 46 of 50 against 42, and the biped's
+            discrete_steps protocol passes every case at 0.2 m/s; Alexander (legs 36 % of its
+            mass each) lost 2 of 50 random 0.1 m/s pushes and gained 2 protocol cases.
         capture_stop: the last stopping step lands where it leaves the capture point between
             the feet (:meth:`~footfall.control.adjusters.PlanFollower.stop_target`), kept in its
             planned region, instead of where the MPC's terminal term toward the plan's final
