@@ -153,8 +153,9 @@ def main() -> None:
     ap.add_argument(
         "--leg-momentum",
         type=float,
-        default=0.0,
-        help="WalkOptions.leg_momentum: share of the legs' forecast momentum (0: off)",
+        default=None,
+        help="WalkOptions.leg_momentum: share of the legs' forecast momentum (0: off; "
+        "default: the walker's, 0.5 with wbc, 0 with servo)",
     )
     ap.add_argument(
         "--literal-torque-weight",

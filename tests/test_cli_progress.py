@@ -128,7 +128,7 @@ def test_walk_logs_its_smallest_n_search_and_records_its_controller(tmp_path: Pa
     assert walked["controller"]["name"] == "wbc"  # the biped's default controller
     assert walked["walker"] == {
         "region_aware": "planned",
-        "leg_momentum": 0.0,
+        "leg_momentum": 0.5,  # the wbc walker's default share
         "capture_stop": True,
         "torque_weight_mass": 30.1,
     }

@@ -311,11 +311,12 @@ def bench_pushes_cmd(
         help="How the walker's MPC keeps the next footstep on the terrain: off, planned, nearby "
         "or horizon (the region the 3-footstep MIQP chooses from the measured state).",
     ),
-    leg_momentum: float = typer.Option(
-        0.0,
+    leg_momentum: float | None = typer.Option(
+        None,
         "--leg-momentum",
         help="Share in [0, 1] of the legs' forecast sagittal momentum [kg m^2/s] that the "
-        "walker's MPC carries (0: off; see footfall walk --leg-momentum).",
+        "walker's MPC carries (0: off; default 0.5 with wbc, 0 with servo; see footfall walk "
+        "--leg-momentum).",
     ),
     dv: str = typer.Option("0.1,0.2,0.3", "--dv", help=_DV_HELP),
     phases: str = typer.Option(

@@ -518,13 +518,13 @@ def walk_cmd(
         help=_REGION_HELP + " The walker's default is planned (over the built-in scenes with "
         "2 N s pushes it reached the goal in 90 of 90 walks, 70 of 90 with off).",
     ),
-    leg_momentum: float = typer.Option(
-        0.0,
+    leg_momentum: float | None = typer.Option(
+        None,
         "--leg-momentum",
         help="Share in [0, 1] of the legs' sagittal momentum about the CoM [kg m^2/s], "
-        "forecast over each single support from the previous one, that the MPC's prediction "
-        "carries (0: off, the document's point-mass prediction). Robots with heavy legs: "
-        "0.5 let Talos reach the flat_long goal (see benchmarks/RESULTS.md).",
+        "forecast over each single support from the last ones, that the MPC's prediction "
+        "carries (0: off, the document's point-mass prediction). Default: 0.5 with the wbc "
+        "controller, 0 with servo (whose MPC gets the true momentum, legs included).",
     ),
     quiet: bool = typer.Option(
         False, "--quiet", help="No planning progress lines or status line (results still print)."

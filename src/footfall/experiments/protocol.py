@@ -89,7 +89,8 @@ class PushProtocol:
         region_aware: how the walker's MPC keeps footsteps on the terrain
             (:attr:`footfall.sim.biped.options.WalkOptions.region_aware`).
         leg_momentum: the share of the legs' forecast momentum the walker's MPC carries
-            (:attr:`footfall.sim.biped.options.WalkOptions.leg_momentum`; 0: off).
+            (:attr:`footfall.sim.biped.options.WalkOptions.leg_momentum`; 0: off; None: the
+            walker's default for ``controller``, stored resolved).
     """
 
     dv: tuple[float, ...]
@@ -103,7 +104,7 @@ class PushProtocol:
     planner: str = "miqcqp"
     controller: str = "wbc"
     region_aware: str = "planned"
-    leg_momentum: float = 0.0
+    leg_momentum: float | None = None
 
     def __post_init__(self) -> None:
         from footfall.control.adjusters import check_region_mode
@@ -111,7 +112,8 @@ class PushProtocol:
 
         check_region_mode(self.region_aware)
         if self.controller in CONTROLLERS:  # an unknown controller: run_protocol says so
-            WalkOptions(controller=self.controller, leg_momentum=self.leg_momentum)
+            walker = WalkOptions(controller=self.controller, leg_momentum=self.leg_momentum)
+            object.__setattr__(self, "leg_momentum", walker.legs_share)
         dv = tuple(finite("dv [m/s]", v) for v in self.dv)
         if not dv or any(v <= 0 for v in dv) or len(set(dv)) != len(dv):
             raise InputError("dv [m/s]", list(self.dv), "distinct velocity changes > 0")
@@ -194,7 +196,9 @@ class ProtocolResult:
 
 
 @functools.lru_cache(maxsize=2)
-def _plant(robot: str, controller: str, region_aware: str, leg_momentum: float = 0.0) -> Any:
+def _plant(
+    robot: str, controller: str, region_aware: str, leg_momentum: float | None = None
+) -> Any:
     """The MuJoCo plant of ``robot`` with ``controller``, the MPC's ``region_aware`` mode and
     ``leg_momentum`` share (one per worker process)."""
     from footfall.sim.biped.options import WalkOptions
@@ -214,7 +218,7 @@ def _walk_case(
     robot: str,
     controller: str,
     region_aware: str,
-    leg_momentum: float,
+    leg_momentum: float | None,
     scene: Any,
     plan: Any,
     case: PushCase,
@@ -393,7 +397,8 @@ def format_summary(result: ProtocolResult) -> str:
 
 def _legs(p: PushProtocol) -> str:
     """The leg-momentum share in a summary line (nothing when it is off)."""
-    return f", legs' momentum {p.leg_momentum:g}" if p.leg_momentum > 0 else ""
+    share = float(p.leg_momentum or 0.0)
+    return f", legs' momentum {share:g}" if share > 0 else ""
 
 
 def format_markdown(result: ProtocolResult) -> str:

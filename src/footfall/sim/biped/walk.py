@@ -150,9 +150,9 @@ class BipedWalk:
         self.ad_tick, self.bd_tick = self.alip.discretize(self.dt)
         self.leg_momentum = (
             LegMomentumForecast(
-                self.ad_tick, self.bd_tick, self.dt, robot.t_ss, self.opts.leg_momentum
+                self.ad_tick, self.bd_tick, self.dt, robot.t_ss, self.opts.legs_share
             )
-            if self.opts.leg_momentum > 0.0
+            if self.opts.legs_share > 0.0
             else None
         )
         self.ds_map = ds_propagator(self.alip, self.dt)
