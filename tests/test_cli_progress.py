@@ -130,6 +130,7 @@ def test_walk_logs_its_smallest_n_search_and_records_its_controller(tmp_path: Pa
         "region_aware": "planned",
         "leg_momentum": 0.5,  # the wbc walker's default share
         "capture_stop": True,
+        "walk_on": 4,
         "torque_weight_mass": 30.1,
     }
 

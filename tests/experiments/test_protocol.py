@@ -186,6 +186,8 @@ def test_summary_counts_and_largest_level() -> None:
         ({"dv": (0.1,), "region_aware": "horizons"}, "region_aware"),
         ({"dv": (0.1,), "leg_momentum": -0.5}, "leg_momentum"),
         ({"dv": (0.1,), "leg_momentum": 0.5, "controller": "servo"}, "leg_momentum"),
+        ({"dv": (0.1,), "walk_on": 3}, "walk_on"),
+        ({"dv": (0.1,), "walk_on": -2}, "walk_on"),
     ],
 )
 def test_protocol_refuses_bad_settings(kwargs: dict[str, object], field: str) -> None:
@@ -207,6 +209,7 @@ def test_protocol_refuses_bad_settings(kwargs: dict[str, object], field: str) ->
         (["--region-aware", "horizons"], "region_aware"),
         (["--leg-momentum", "1.5"], "leg_momentum"),
         (["--leg-momentum", "0.5", "--controller", "servo"], "leg_momentum"),
+        (["--walk-on", "1"], "walk_on"),
     ],
 )
 def test_cli_refuses_bad_values(tmp_path: Path, args: list[str], field: str) -> None:
@@ -263,6 +266,14 @@ def test_the_protocols_walker_takes_the_region_mode() -> None:
         plant = proto._plant("biped", "wbc", mode)
         assert plant.options.region_aware == mode
         assert plant.options.controller == "wbc"
+
+
+def test_walker_defaults_are_stored_resolved() -> None:
+    # what the walks used, not None: the wbc walker's forecast share and added stopping steps
+    proto = PushProtocol(dv=(0.1,))
+    assert proto.leg_momentum == 0.5 and proto.walk_on == 4
+    assert PushProtocol(dv=(0.1,), walk_on=0).walk_on == 0
+    assert PushProtocol(dv=(0.1,), controller="servo").leg_momentum == 0.0
 
 
 def test_reports_name_the_leg_momentum_share_only_when_on() -> None:

@@ -318,6 +318,12 @@ def bench_pushes_cmd(
         "walker's MPC carries (0: off; default 0.5 with wbc, 0 with servo; see footfall walk "
         "--leg-momentum).",
     ),
+    walk_on: int | None = typer.Option(
+        None,
+        "--walk-on",
+        help="Stopping steps the walker may add, two at a time, to reach the goal after a push "
+        "(0: never; default: the walker's, 4; see footfall walk --walk-on).",
+    ),
     dv: str = typer.Option("0.1,0.2,0.3", "--dv", help=_DV_HELP),
     phases: str = typer.Option(
         "0.2,0.45,0.7",
@@ -385,6 +391,7 @@ def bench_pushes_cmd(
         controller=controller,
         region_aware=region_aware,
         leg_momentum=leg_momentum,
+        walk_on=walk_on,
     )
     from footfall.robots.registry import resolve_robot_file
     from footfall.terrain.resolve import resolve_scene

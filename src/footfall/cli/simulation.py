@@ -526,6 +526,13 @@ def walk_cmd(
         "carries (0: off, the document's point-mass prediction). Default: 0.5 with the wbc "
         "controller, 0 with servo (whose MPC gets the true momentum, legs included).",
     ),
+    walk_on: int = typer.Option(
+        4,
+        "--walk-on",
+        help="Stopping steps the walker may add, two at a time, when its stopping steps land "
+        "more than 0.1 m from their final footholds (a push moved the walk off its goal); 0: "
+        "stop where the planned stopping steps end.",
+    ),
     quiet: bool = typer.Option(
         False, "--quiet", help="No planning progress lines or status line (results still print)."
     ),
@@ -565,7 +572,10 @@ def walk_cmd(
     # the walker's options (region mode, leg-momentum share) are checked before planning, which
     # can take minutes
     options = WalkOptions(
-        controller=controller, region_aware=region_aware, leg_momentum=leg_momentum
+        controller=controller,
+        region_aware=region_aware,
+        leg_momentum=leg_momentum,
+        walk_on=walk_on,
     )
     if steps is not None and steps < 1:
         raise InputError("steps", steps, "an integer >= 1")
@@ -618,6 +628,7 @@ def walk_cmd(
     report["walker"] = {
         "region_aware": options.region_aware,
         "leg_momentum": options.leg_momentum,
+        "walk_on": options.walk_on,
         "capture_stop": options.capture_stop,
         "torque_weight_mass": options.torque_weight_mass,
     }

@@ -204,6 +204,13 @@ class PlanFollower:
         self._dp_to_next_end = (ad_ss @ b_r)[2:4, 0:2]  # dp (x, y) -> L at end of next phase
         self._dp_inv = np.linalg.inv(self._dp_to_next_end)
 
+    def extend_stop(self, extra: int) -> None:
+        """Append ``extra`` stopping steps to the plan (:func:`extend_plan`: each foot steps
+        onto its final foothold again) while the walk is under way: the walker asks for them
+        when its stopping steps landed far from the goal (``WalkOptions.walk_on``). The capture
+        stop moves to the new last step."""
+        self.plan = extend_plan(self.plan, extra)
+
     def torque(self, t: float, phase: int) -> FloatArray:
         """Planned torque (2,) [N m] of ``phase`` at time ``t`` in it (zero-order hold)."""
         k = min(int(t / self._dt), self.plan.torques.shape[1] - 1)

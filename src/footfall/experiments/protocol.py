@@ -17,6 +17,7 @@ and :func:`summarise` counts the passes per level.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import functools
 import io
 import math
@@ -91,6 +92,9 @@ class PushProtocol:
         leg_momentum: the share of the legs' forecast momentum the walker's MPC carries
             (:attr:`footfall.sim.biped.options.WalkOptions.leg_momentum`; 0: off; None: the
             walker's default for ``controller``, stored resolved).
+        walk_on: stopping steps the walker may add to reach the goal
+            (:attr:`footfall.sim.biped.options.WalkOptions.walk_on`; 0: never; None: the
+            walker's default, stored resolved).
     """
 
     dv: tuple[float, ...]
@@ -105,6 +109,7 @@ class PushProtocol:
     controller: str = "wbc"
     region_aware: str = "planned"
     leg_momentum: float | None = None
+    walk_on: int | None = None
 
     def __post_init__(self) -> None:
         from footfall.control.adjusters import check_region_mode
@@ -113,6 +118,9 @@ class PushProtocol:
         check_region_mode(self.region_aware)
         if self.controller in CONTROLLERS:  # an unknown controller: run_protocol says so
             walker = WalkOptions(controller=self.controller, leg_momentum=self.leg_momentum)
+            if self.walk_on is not None:
+                walker = dataclasses.replace(walker, walk_on=self.walk_on)
+            object.__setattr__(self, "walk_on", walker.walk_on)
             object.__setattr__(self, "leg_momentum", walker.legs_share)
         dv = tuple(finite("dv [m/s]", v) for v in self.dv)
         if not dv or any(v <= 0 for v in dv) or len(set(dv)) != len(dv):
@@ -197,19 +205,27 @@ class ProtocolResult:
 
 @functools.lru_cache(maxsize=2)
 def _plant(
-    robot: str, controller: str, region_aware: str, leg_momentum: float | None = None
+    robot: str,
+    controller: str,
+    region_aware: str,
+    leg_momentum: float | None = None,
+    walk_on: int | None = None,
 ) -> Any:
-    """The MuJoCo plant of ``robot`` with ``controller``, the MPC's ``region_aware`` mode and
-    ``leg_momentum`` share (one per worker process)."""
+    """The MuJoCo plant of ``robot`` with ``controller``, the MPC's ``region_aware`` mode, the
+    ``leg_momentum`` share and the stopping steps it may add (``walk_on``; None: the walker's
+    defaults), one per worker process."""
     from footfall.sim.biped.options import WalkOptions
     from footfall.sim.biped.plans import robot_model
     from footfall.sim.trial import make_plant
 
+    options = WalkOptions(
+        controller=controller, region_aware=region_aware, leg_momentum=leg_momentum
+    )
+    if walk_on is not None:
+        options = dataclasses.replace(options, walk_on=walk_on)
     return make_plant(
         "mujoco",
-        options=WalkOptions(
-            controller=controller, region_aware=region_aware, leg_momentum=leg_momentum
-        ),
+        options=options,
         robot=robot_model(robot),
     )
 
@@ -219,6 +235,7 @@ def _walk_case(
     controller: str,
     region_aware: str,
     leg_momentum: float | None,
+    walk_on: int | None,
     scene: Any,
     plan: Any,
     case: PushCase,
@@ -227,7 +244,7 @@ def _walk_case(
     """Walk one case; its row (:data:`COLUMNS`)."""
     from footfall.sim.trial import run_trial, trial_pushes
 
-    plant = _plant(robot, controller, region_aware, leg_momentum)
+    plant = _plant(robot, controller, region_aware, leg_momentum, walk_on)
     pushes = trial_pushes(plant, plan, d)
     out = run_trial(plant, scene, plan, d)
     reached = bool(out.detail.metrics.reached_goal)
@@ -291,7 +308,9 @@ def run_protocol(
         if progress is not None:
             progress(row)
     p = protocol
-    mass = float(_plant(p.robot, p.controller, p.region_aware, p.leg_momentum).mass(plan))
+    mass = float(
+        _plant(p.robot, p.controller, p.region_aware, p.leg_momentum, p.walk_on).mass(plan)
+    )
     return ProtocolResult(
         protocol, scene.name, int(plan.n_steps), step, mass, [rows[c] for c in cases]
     )
@@ -305,7 +324,7 @@ def _walks(
     workers: int,
 ) -> Iterator[tuple[PushCase, dict[str, Any]]]:
     p = protocol
-    args = (p.robot, p.controller, p.region_aware, p.leg_momentum, scene, plan)
+    args = (p.robot, p.controller, p.region_aware, p.leg_momentum, p.walk_on, scene, plan)
     if workers <= 1 or len(jobs) <= 1:
         for case, d in jobs:
             yield case, _walk_case(*args, case, d)

@@ -81,6 +81,34 @@ class WalkTrace:
             timing={"control": 0.0, "ik": 0.0, "physics": 0.0, "render": 0.0},
         )
 
+    def grown(self, n_ticks: int, dt: float, footsteps: FloatArray) -> WalkTrace:
+        """This trace for a walk that got longer: ``n_ticks`` ticks of ``dt`` [s] (at least as
+        many as now) over ``footsteps`` (N' + 1, 3) [m], the old ones first (stopping steps were
+        appended); what was measured is kept, the rest unmeasured."""
+        n_old, n_new = self.t.shape[0], int(n_ticks)
+        steps = np.asarray(footsteps, dtype=float)[1:]
+        if n_new < n_old or steps.shape[0] < self.landed.shape[0]:
+            raise ValueError("a trace only grows")
+
+        def pad(a: NDArray[Any], fill: float) -> NDArray[Any]:
+            extra = np.full((n_new - n_old, *a.shape[1:]), fill, dtype=a.dtype)
+            return np.concatenate([a, extra])
+
+        k_new = steps.shape[0] - self.landed.shape[0]
+        return replace(
+            self,
+            t=np.arange(n_new, dtype=np.float64) * dt,
+            phase=pad(self.phase, -1),
+            com=pad(self.com, np.nan),
+            com_ref=pad(self.com_ref, np.nan),
+            zmp_offset=pad(self.zmp_offset, np.nan),
+            zmp_planned=pad(self.zmp_planned, np.nan),
+            feet=pad(self.feet, np.nan),
+            landed=np.concatenate([self.landed, np.full((k_new, 3), np.nan)]),
+            targets=np.concatenate([self.targets, steps[self.targets.shape[0] :]]),
+            planned=np.concatenate([self.planned, steps[self.planned.shape[0] :]]),
+        )
+
     def trimmed(self, k_end: int, dt: float) -> WalkTrace:
         """The first ``k_end`` ticks (the walk ended there), with its simulated time."""
         return replace(

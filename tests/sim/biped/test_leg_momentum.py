@@ -168,6 +168,7 @@ def test_walk_command_records_the_share(tmp_path):
         "region_aware": "planned",
         "leg_momentum": 0.25,
         "capture_stop": True,
+        "walk_on": 4,
         "torque_weight_mass": 30.1,
     }
     assert walked["metrics"]["reached_goal"]

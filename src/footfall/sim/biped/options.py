@@ -32,6 +32,10 @@ CONTROLLERS = ("servo", "wbc")
 #: a plan's robot mass and CoM height may differ this much (relative) from the walker model's
 #: (:func:`~footfall.sim.biped.model.planner_params` measures them: 0.0 exactly)
 PLAN_ROBOT_RTOL = 0.01
+#: ``WalkOptions.walk_on``: stopping steps the walker may add to reach the goal
+WALK_ON = 4
+#: ``WalkOptions.walk_on_distance`` [m]: the goal tolerance of the walk's metrics
+WALK_ON_DISTANCE = 0.10
 #: ``WalkOptions.leg_momentum`` when not given and the adjuster gets the CoM-velocity estimate
 LEG_MOMENTUM = 0.5
 #: how far a start sole's corner may stand beyond every region [m] (the walker stands on the
@@ -79,6 +83,14 @@ class WalkOptions:
             (:func:`~footfall.control.adjusters.extend_plan`); the adjuster must answer for phases
             up to ``N + stop_steps - 1`` (:class:`~footfall.control.adjusters.PlanFollower`
             does).
+        walk_on: stopping steps the walker may add, two at a time, when the last stopping
+            step is about to start and the foot that landed before it lies more than
+            ``walk_on_distance`` [m] from its final foothold (a push moved the walk off its
+            goal): the robot steps on toward the goal instead of stopping where it is. The
+            adjuster must take them (``extend_stop``, as
+            :class:`~footfall.control.adjusters.PlanFollower` does); 0: never (the stop as
+            planned). A walk whose stopping steps land near the goal is not changed.
+        walk_on_distance: see ``walk_on`` [m].
         com_gain: gain of the CoM tracking feedback: the IK's CoM target is the reference plus
             ``com_gain`` times the horizontal tracking error. Without it the joint servos'
             compliance lets a robot standing on one foot roll slowly over it.
@@ -188,6 +200,8 @@ class WalkOptions:
     hold_time: float = 0.5
     pushes: tuple[Push, ...] = ()
     stop_steps: int = STOP_STEPS
+    walk_on: int = WALK_ON
+    walk_on_distance: float = WALK_ON_DISTANCE
     com_gain: float = 1.5
     ankle_torque: bool = True
     true_momentum: bool | None = None
@@ -246,6 +260,12 @@ class WalkOptions:
                 "default), which holds the legs' momentum already",
             )
         object.__setattr__(self, "leg_momentum", lm)
+        wo = self.walk_on
+        if isinstance(wo, bool) or not isinstance(wo, int) or wo < 0 or wo % 2:
+            raise InputError("walk_on", wo, "an even integer >= 0 (steps are added in pairs)")
+        object.__setattr__(
+            self, "walk_on_distance", positive("walk_on_distance [m]", self.walk_on_distance)
+        )
         it = self.ik_iterations
         if isinstance(it, bool) or not isinstance(it, int) or it < 1:
             raise InputError("ik_iterations", it, "an integer >= 1")

@@ -157,6 +157,8 @@ class BipedWalk:
         )
         self.ds_map = ds_propagator(self.alip, self.dt)
         self.n = self.plan.n_steps
+        #: stopping steps added on the way (``WalkOptions.walk_on``)
+        self.walked_on = 0
         self.t_ss, self.t_ds = robot.t_ss, robot.t_ds
         self.target_speed = swing_target_speed(robot)
         self.t_step = self.t_ss + self.t_ds
@@ -245,19 +247,22 @@ class BipedWalk:
         if replay is not None:
             replay.begin(sim.xml)
         wall0 = time.perf_counter()
-        k = 0
+        k = ticks = 0
         try:
-            for k in range(self.n_ticks):
+            # n_ticks grows when the walker adds stopping steps (WalkOptions.walk_on)
+            while k < self.n_ticks:
+                ticks = k + 1
                 if not self.step(k):
                     break
                 if progress is not None and k % 100 == 0:
                     progress(k / self.n_ticks)
+                k += 1
         except BaseException:  # an error or a signal: no half-written video in place
             self.video.close(complete=False)
             raise
         wall = time.perf_counter() - wall0
         self.log.timing["render"] = self.video.render_time
-        return self._result(k + 1, wall, self.video.close())
+        return self._result(ticks, wall, self.video.close())
 
     def step(self, k: int) -> bool:
         """Control tick ``k``; False when the walk ends at it (a fall with ``stop_on_fall``)."""
@@ -355,6 +360,9 @@ class BipedWalk:
             # re-express the reference relative to the new stance (eq. 5.10's -I block)
             ref.x = ref.ds_aug[:4].copy()
             ref.x[:2] -= (feet.pos[sd_landed] - ref.prev_stance)[:2]
+            if i == self.n - 1:
+                self._maybe_walk_on(i)
+                plan = self.plan
         swing.phase = i
         swing.stance = plan.sides[i]
         swing_side = swing.stance.other
@@ -372,6 +380,30 @@ class BipedWalk:
         # the landing orientation depends on the phase only: once per step, not per tick
         swing.rot1 = foot_rotation(self.normals[i + 1], plan.headings[i + 1])
         swing.rot1_strike = swing.rot1 @ pitch_about_y(-self.opts.heel_strike)
+
+    def _maybe_walk_on(self, i: int) -> None:
+        """Before the last stopping step ``i``: when the foot that just landed lies more than
+        ``walk_on_distance`` from its final foothold and ``walk_on`` allows it, two more
+        stopping steps (each foot onto its foothold again; the adjuster's plan and the capture
+        stop move with them), and the walk's timeline and trace grow by them."""
+        opts = self.opts
+        extend = getattr(self.src, "extend_stop", None)
+        if self.walked_on >= opts.walk_on or extend is None:
+            return
+        side = self.plan.sides[i]
+        miss = float(np.linalg.norm(self.feet.pos[side][:2] - self.plan.footsteps[i, :2]))
+        if miss <= opts.walk_on_distance:
+            return
+        extend(2)
+        self.walked_on += 2
+        self.plan = extend_plan(self.plan, 2)
+        self.n = self.plan.n_steps
+        self.t_end_steps += 2 * self.t_step
+        self.n_ticks = round((self.t_end_steps + opts.stop_time + opts.hold_time) / self.dt)
+        self.log = self.log.grown(self.n_ticks, self.dt, self.plan.footsteps)
+        regions = {r.name: r for r in self.scene.terrain.regions}
+        self.normals = [regions[name].normal for name in self.plan.regions]
+        self.height = CoMHeight(self.plan.footsteps, self.robot.com_height)
 
     def _limit_target(self, nxt: FloatArray, tp: float) -> FloatArray:
         """Move the swing target toward the MPC's footstep ``nxt`` (3,) [m] by at most
