@@ -163,8 +163,7 @@ class BipedWalk:
         self.target_speed = swing_target_speed(robot)
         self.t_step = self.t_ss + self.t_ds
         self.t_walk0 = opts.settle_time + opts.shift_time
-        self.t_end_steps = self.t_walk0 + self.n * self.t_step
-        self.n_ticks = round((self.t_end_steps + opts.stop_time + opts.hold_time) / self.dt)
+        self._set_timeline()
         self._init_state()
         #: records the joint positions for ``footfall view`` when :meth:`run` is given one
         self.replay: ReplayRecorder | None = None
@@ -381,6 +380,12 @@ class BipedWalk:
         swing.rot1 = foot_rotation(self.normals[i + 1], plan.headings[i + 1])
         swing.rot1_strike = swing.rot1 @ pitch_about_y(-self.opts.heel_strike)
 
+    def _set_timeline(self) -> None:
+        """When the steps end and the walk's ticks (steps, stop, hold), from the steps ``n``."""
+        opts = self.opts
+        self.t_end_steps = self.t_walk0 + self.n * self.t_step
+        self.n_ticks = round((self.t_end_steps + opts.stop_time + opts.hold_time) / self.dt)
+
     def _maybe_walk_on(self, i: int) -> None:
         """Before the last stopping step ``i``: when the foot that just landed lies more than
         ``walk_on_distance`` from its final foothold and ``walk_on`` allows it, two more
@@ -398,8 +403,7 @@ class BipedWalk:
         self.walked_on += 2
         self.plan = extend_plan(self.plan, 2)
         self.n = self.plan.n_steps
-        self.t_end_steps += 2 * self.t_step
-        self.n_ticks = round((self.t_end_steps + opts.stop_time + opts.hold_time) / self.dt)
+        self._set_timeline()
         self.log = self.log.grown(self.n_ticks, self.dt, self.plan.footsteps)
         regions = {r.name: r for r in self.scene.terrain.regions}
         self.normals = [regions[name].normal for name in self.plan.regions]
