@@ -526,12 +526,12 @@ def walk_cmd(
         "carries (0: off, the document's point-mass prediction). Default: 0.5 with the wbc "
         "controller, 0 with servo (whose MPC gets the true momentum, legs included).",
     ),
-    walk_on: int = typer.Option(
-        4,
+    walk_on: int | None = typer.Option(
+        None,
         "--walk-on",
         help="Stopping steps the walker may add, two at a time, when its stopping steps land "
-        "more than 0.1 m from their final footholds (a push moved the walk off its goal); 0: "
-        "stop where the planned stopping steps end.",
+        "more than 0.1 m (the goal tolerance) from their final footholds (a push moved the walk "
+        "off its goal); 0: stop where the planned stopping steps end. Default: the walker's, 4.",
     ),
     quiet: bool = typer.Option(
         False, "--quiet", help="No planning progress lines or status line (results still print)."
@@ -572,11 +572,10 @@ def walk_cmd(
     # the walker's options (region mode, leg-momentum share) are checked before planning, which
     # can take minutes
     options = WalkOptions(
-        controller=controller,
-        region_aware=region_aware,
-        leg_momentum=leg_momentum,
-        walk_on=walk_on,
+        controller=controller, region_aware=region_aware, leg_momentum=leg_momentum
     )
+    if walk_on is not None:
+        options = replace(options, walk_on=walk_on)
     if steps is not None and steps < 1:
         raise InputError("steps", steps, "an integer >= 1")
     disturbance = disturbance_of(

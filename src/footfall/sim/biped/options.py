@@ -13,6 +13,7 @@ from footfall.control.adjusters import STOP_STEPS, check_region_mode
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.planning.plan import FootstepPlan
+from footfall.sim.biped.metrics import GOAL_TOL
 from footfall.sim.biped.model import BipedModel, WalkerModel, measure_model
 from footfall.sim.biped.wbc import WbcGains
 from footfall.sim.disturbance import Push
@@ -35,7 +36,7 @@ PLAN_ROBOT_RTOL = 0.01
 #: ``WalkOptions.walk_on``: stopping steps the walker may add to reach the goal
 WALK_ON = 4
 #: ``WalkOptions.walk_on_distance`` [m]: the goal tolerance of the walk's metrics
-WALK_ON_DISTANCE = 0.10
+WALK_ON_DISTANCE = GOAL_TOL
 #: ``WalkOptions.leg_momentum`` when not given and the adjuster gets the CoM-velocity estimate
 LEG_MOMENTUM = 0.5
 #: how far a start sole's corner may stand beyond every region [m] (the walker stands on the
