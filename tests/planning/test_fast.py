@@ -565,33 +565,43 @@ def test_propagation_drops_only_members_without_a_compatible_partner() -> None:
 
 
 def test_clarabel_gets_the_same_problem_from_lists() -> None:
-    """The node solver hands Clarabel its matrices as lists (:class:`relaxation._CscLists`, cheaper to
-    convert): same solution as from the scipy matrices, also for a non-canonical input."""
+    """The node solver hands Clarabel its matrices as lists built straight from COO entries
+    (:meth:`relaxation._CscLists.from_coo`): the same arrays as scipy's canonical CSC (duplicates
+    summed, rows sorted in each column, explicit zeros kept, empty columns), and the same solution."""
     import clarabel
     import scipy.sparse as sp
 
     rng = np.random.default_rng(0)
-    m, n = 12, 5
+    m, n = 12, 6
     a_dense = rng.normal(size=(m, n))
+    a_dense[:, 3] = 0.0  # an empty column
     rows, cols = np.nonzero(a_dense)
-    # duplicate entries (summed by scipy) make the COO input non-canonical
-    a_mat = sp.csc_matrix(
-        (np.r_[a_dense[rows, cols], [1.0]], (np.r_[rows, [0]], np.r_[cols, [0]])), shape=(m, n)
-    )
-    a_dup = sp.csc_matrix(
-        (np.r_[a_dense[rows, cols], [0.5, 0.5]], (np.r_[rows, [0, 0]], np.r_[cols, [0, 0]])),
-        shape=(m, n),
-    )
-    a_dup.has_canonical_format = False
-    p_mat = sp.triu(sp.csc_matrix(np.eye(n) * 2.0), format="csc")
+    # shuffled entries, two duplicates at (0, 0) and an explicit zero at (5, 3)
+    r = np.r_[rows, [0, 0, 5]]
+    c = np.r_[cols, [0, 0, 3]]
+    v = np.r_[a_dense[rows, cols], [0.5, 0.25, 0.0]]
+    perm = rng.permutation(len(r))
+    r, c, v = r[perm], c[perm], v[perm]
+    got_a = relaxation._CscLists.from_coo(r, c, v, (m, n))
+    ref_a = sp.csc_matrix((v, (r, c)), shape=(m, n))
+    ref_a.sum_duplicates()
+    assert got_a.shape == ref_a.shape
+    assert got_a.indptr == ref_a.indptr.tolist()
+    assert got_a.indices == ref_a.indices.tolist()
+    assert np.allclose(got_a.data, ref_a.data, rtol=0.0, atol=1e-15)
+    assert got_a.data[0] == pytest.approx(a_dense[0, 0] + 0.75)
+    assert got_a.indptr[4] - got_a.indptr[3] == 1  # the explicit zero is kept
+    p_dense = np.triu(rng.normal(size=(n, n)) * 0.1) + np.eye(n) * 2.0
+    pi, pj = np.nonzero(p_dense)
+    p_ref = sp.csc_matrix(p_dense)
     q, b = rng.normal(size=n), np.abs(rng.normal(size=m)) + 1.0
     settings = clarabel.DefaultSettings()
     settings.verbose = False
-    ref = clarabel.DefaultSolver(p_mat, q, a_mat, b, [clarabel.NonnegativeConeT(m)], settings)
-    ref_sol = ref.solve()
+    cones = [clarabel.NonnegativeConeT(m)]
+    ref_sol = clarabel.DefaultSolver(p_ref, q, ref_a, b, cones, settings).solve()
     got = clarabel.DefaultSolver(
-        relaxation._CscLists(p_mat), q.tolist(), relaxation._CscLists(a_dup), b.tolist(),
-        [clarabel.NonnegativeConeT(m)], settings,
+        relaxation._CscLists.from_coo(pi, pj, p_dense[pi, pj], (n, n)), q.tolist(), got_a,
+        b.tolist(), cones, settings,
     ).solve()  # fmt: skip
     assert str(got.status) == str(ref_sol.status) == "Solved"
     assert np.allclose(got.x, ref_sol.x, atol=1e-12)
