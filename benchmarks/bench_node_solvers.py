@@ -210,7 +210,16 @@ def main() -> None:
     ap.add_argument("--max-rounds", type=int, default=12, help="cut rounds of highs-oa")
     ap.add_argument("--no-daqp", action="store_true", help="skip the dense daqp solve")
     args = ap.parse_args()
-    keep = {int(s) for s in args.nodes.split(",")}
+    try:
+        keep = {int(s) for s in args.nodes.split(",")}
+    except ValueError:
+        ap.error(f"--nodes: {args.nodes!r} is not a comma-separated list of node-solve indices")
+    if args.steps < 1 or args.max_rounds < 1 or min(keep) < 0:
+        ap.error("--steps and --max-rounds must be >= 1 and --nodes >= 0")
+    try:
+        import highspy  # noqa: F401
+    except ImportError:
+        ap.error("HiGHS is not installed: pip install highspy (not a footfall dependency)")
     for d in capture(args.steps, args.seed, keep):
         n, m = len(d["q"]), d["n_rows"]
         t_c, bound_c, st_c = solve_clarabel(d)
