@@ -141,7 +141,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--controllers", default="wbc,servo")
     ap.add_argument("--scenes", default=",".join(SCENES))
-    ap.add_argument("--region-aware", default="planned", help="region modes, comma-separated")
+    ap.add_argument(
+        "--region-aware",
+        default="horizon",
+        help="region modes, comma-separated (default: the walker's)",
+    )
     ap.add_argument("--impulses", default="4,6,8,10,12,15", help="push impulses [N s]")
     ap.add_argument(
         "--dv", default="", help="pushes as velocity changes [m/s] (impulse = mass x dv) instead"

@@ -127,7 +127,7 @@ def test_walk_logs_its_smallest_n_search_and_records_its_controller(tmp_path: Pa
     assert records[-1]["n_steps"] == walked["plan"]["n_steps"]
     assert walked["controller"]["name"] == "wbc"  # the biped's default controller
     assert walked["walker"] == {
-        "region_aware": "planned",
+        "region_aware": "horizon",  # the walker's default region mode
         "leg_momentum": 0.5,  # the wbc walker's default share
         "capture_stop": True,
         "walk_on": 4,

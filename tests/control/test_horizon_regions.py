@@ -17,7 +17,12 @@ from footfall.control.adjusters import MPCAdjuster, sole_torque_limits
 from footfall.control.horizon_regions import HORIZON_PERIOD, HorizonRegions
 from footfall.errors import InputError
 from footfall.experiments.bench_horizon import _pushed_state
-from footfall.planning.horizon import HorizonPlanner, horizon_input, horizon_problem
+from footfall.planning.horizon import (
+    HorizonOptions,
+    HorizonPlanner,
+    horizon_input,
+    horizon_problem,
+)
 from footfall.planning.plan import FootstepPlan
 from footfall.planning.reactive import plan_reactive
 from footfall.solvers import SolverOptions, SolveStatus, solve
@@ -50,8 +55,10 @@ def _adjuster(plan: FootstepPlan, scene: Scene, mode: str) -> MPCAdjuster:
 
 
 def _scip_region(scene: Scene, plan: FootstepPlan, x: np.ndarray) -> str:
-    """The region holding SCIP's footstep 1 of the independently written problem."""
-    planner = HorizonPlanner(scene, plan.robot)
+    """The region holding SCIP's footstep 1 of the independently written problem, with the
+    walker MPC's torque ellipse (the adjuster hands it to its short-horizon MIQP)."""
+    options = HorizonOptions(torque_limits=sole_torque_limits(plan.robot))
+    planner = HorizonPlanner(scene, plan.robot, options)
     inp = horizon_input(plan, STEP, plan.robot.t_ss - T, x)
     prob = horizon_problem(planner, inp)
     res = solve(prob, "scip", SolverOptions(time_limit=60, gap=1e-6))
@@ -83,6 +90,8 @@ def test_a_pushed_walker_steps_where_scip_puts_the_footstep(
     assert choice.region == expected and choice.planned == planned
     assert choice.candidates == (expected,)
     assert adj.horizon is not None and adj.horizon.solves == 1
+    # the MIQP judges the regions with the torques the walker's MPC will use
+    assert adj.horizon._planner.options.torque_limits == sole_torque_limits(plan.robot)
     # the commanded footstep stands on that stone, the whole sole inside it at its heading
     region = {r.name: r for r in scene.terrain.regions}[expected]
     half = np.array([plan.robot.foot_length, plan.robot.foot_width]) / 2.0

@@ -250,7 +250,7 @@ def test_cli_small_real_run(tmp_path: Path) -> None:
     assert f"largest dv passed: {want}" in r.stdout
     md = (out / "protocol.md").read_text()
     assert f"{passed}/2 pass" in md and md.rstrip().endswith("**")
-    assert "footstep regions planned" in md and "footstep regions planned" in r.stdout
+    assert "footstep regions horizon" in md and "footstep regions horizon" in r.stdout
 
     assert md.count("| forward |") == 1 and md.count("| outward |") == 1
     png = (out / "protocol.png").read_bytes()

@@ -33,6 +33,7 @@ from footfall.planning.horizon import (
     HorizonSolution,
     horizon_input,
     horizon_problem,
+    torque_facets,
 )
 from footfall.planning.plan import FootstepPlan
 from footfall.planning.reactive import plan_reactive
@@ -151,16 +152,23 @@ def check_solution(planner: HorizonPlanner, inp: HorizonInput, sol: HorizonSolut
             bad.append(f"footstep {j + 1}: height change {p[2] - prev[2]}")
         side = Side.RIGHT if side == Side.LEFT else Side.LEFT
         prev = p
-    c8 = robot.u_max * math.cos(math.pi / 8)
+    c8 = math.cos(math.pi / 8)
     normals = np.array(
         [[math.cos(2 * math.pi * k / 8), math.sin(2 * math.pi * k / 8)] for k in range(8)]
     )
+    # the torque scaled to the unit disc: u / U_max for the ball (its octagon in the world
+    # frame), (v_x / U_x, v_y / U_y) of v = R^T u in stance j's frame for an ellipse
     for j in range(h):
         for b in range(blocks):
             u = torques[j, b]
-            if np.linalg.norm(u) > robot.u_max + 1e-9:
-                bad.append(f"torque {j},{b} {u} beyond U_max")
-            if np.any(normals @ u > c8 + 1e-9):
+            if opt.torque_limits is None:
+                scaled = u / robot.u_max
+            else:
+                v = _rot(float(inp.headings[j])).T @ u
+                scaled = v / np.asarray(opt.torque_limits)
+            if np.linalg.norm(scaled) > 1.0 + 1e-9:
+                bad.append(f"torque {j},{b} {u} beyond U_max (or the torque ellipse)")
+            if np.any(normals @ scaled > c8 + 1e-9):
                 bad.append(f"torque {j},{b} {u} outside the octagon")
     w = opt.weights
     cost = 0.0
@@ -292,6 +300,83 @@ def test_pushed_ticks_are_optimal_feasible_and_agree_with_scip(
     assert sol.objective <= res.objective * (1 + TIGHT_GAP) + 1e-9
     assert sol.objective >= res.bound - 1e-6 * abs(res.bound)
     assert sol.bound <= res.objective * (1 + 1e-6)
+
+
+# --------------------------------------------------------------------------- torque ellipse
+#: a sole-shaped torque set: the ball's roll torque, 2.5 times its pitch torque (the G1's sole
+#: gives 7.85 and 22.8 N m)
+ELLIPSE_SHAPE = (1.0, 2.5)
+
+
+@pytest.mark.parametrize("heading", [0.0, 0.7, -2.1])
+@pytest.mark.parametrize("limits", [None, (2.0, 5.0), (6.0, 1.5)])
+def test_torque_facets_are_an_octagon_inscribed_in_the_torque_set(
+    heading: float, limits: tuple[float, float] | None
+) -> None:
+    """Each vertex of the facets' polygon (two consecutive facet lines intersected) lies on the
+    ball of radius U_max, or on the ellipse in the stance frame; each facet's middle too, scaled
+    by 1 / cos(pi / 8); opposite facets are negated."""
+    u_max = 3.0
+    normals, bounds = torque_facets(u_max, limits, heading)
+    assert normals.shape == (8, 2) and bounds.shape == (8,)
+    assert np.allclose(normals[4:], -normals[:4]) and np.allclose(bounds[4:], bounds[:4])
+    semi = np.array([u_max, u_max]) if limits is None else np.array(limits)
+    c, s_ = math.cos(heading), math.sin(heading)
+    to_stance = np.array([[c, s_], [-s_, c]])  # R(heading)^T
+    for k in range(8):
+        a = np.vstack([normals[k], normals[(k + 1) % 8]])
+        vertex = np.linalg.solve(a, np.array([bounds[k], bounds[(k + 1) % 8]]))
+        v = to_stance @ vertex
+        assert math.hypot(v[0] / semi[0], v[1] / semi[1]) == pytest.approx(1.0, rel=1e-12)
+    # the set's support in each facet's direction (its boundary sampled densely, in the world
+    # frame) is the facet's bound over cos(pi / 8): the facet is the set's tangent moved in
+    t = np.linspace(0.0, 2.0 * math.pi, 20001)
+    boundary = np.column_stack([semi[0] * np.cos(t), semi[1] * np.sin(t)]) @ to_stance
+    support = np.max(boundary @ normals.T, axis=0)
+    assert support == pytest.approx(bounds / math.cos(math.pi / 8), rel=1e-6)
+
+
+@pytest.mark.parametrize(("name", "step", "t", "dv"), [TICKS[1], TICKS[3]])
+def test_torque_ellipse_ticks_agree_with_scip_and_cost_no_more(
+    walks: Walks, name: str, step: int, t: float, dv: tuple[float, float]
+) -> None:
+    """With the walker's torque ellipse (``HorizonOptions.torque_limits``) a pushed tick is
+    optimal, feasible for the ellipse's octagon in every stance frame (the checker), agrees with
+    SCIP on :func:`horizon_problem`, and costs no more than with the ball: the ellipse holds the
+    ball, so the problem only gains torques."""
+    scene, plan = walks[name]
+    u = plan.robot.u_max
+    limits = (ELLIPSE_SHAPE[0] * u, ELLIPSE_SHAPE[1] * u)
+    planner = HorizonPlanner(scene, plan.robot, HorizonOptions(gap=TIGHT_GAP, torque_limits=limits))
+    ball = HorizonPlanner(scene, plan.robot, HorizonOptions(gap=TIGHT_GAP))
+    inp = _tick(plan, step, t, dv)
+    sol, sol_ball = planner.solve(inp), ball.solve(inp)
+    assert sol.status == sol_ball.status == "optimal", sol.message
+    assert check_solution(planner, inp, sol) == []
+    assert sol.objective <= sol_ball.objective * (1 + TIGHT_GAP) + 1e-9
+    res = solve(horizon_problem(planner, inp), "scip", SCIP)
+    assert res.status == SolveStatus.OPTIMAL
+    assert sol.objective <= res.objective * (1 + TIGHT_GAP) + 1e-9
+    assert sol.objective >= res.bound - 1e-6 * abs(res.bound)
+
+
+def test_torque_ellipse_lets_the_pitch_torque_exceed_the_ball(stones_tick: Tick) -> None:
+    """A torque the ball's octagon refuses (pitch 1.5 U_max) passes the checker with the
+    ellipse's, and one beyond the ellipse's pitch semi-axis is refused."""
+    planner, inp, sol = stones_tick
+    u = planner.robot.u_max
+    limits = (ELLIPSE_SHAPE[0] * u, ELLIPSE_SHAPE[1] * u)
+    wide = HorizonPlanner(planner.terrain, planner.robot, HorizonOptions(torque_limits=limits))
+    pitch = _rot(float(inp.headings[0])) @ np.array([0.0, 1.5 * u])
+    big = sol.torques.copy()
+    big[0, 0] = pitch
+    assert any("octagon" in v for v in check_solution(planner, inp, replace(sol, torques=big)))
+    assert not any(
+        "octagon" in v or "beyond" in v
+        for v in check_solution(wide, inp, replace(sol, torques=big))
+    )
+    big[0, 0] = _rot(float(inp.headings[0])) @ np.array([0.0, 2.6 * u])
+    assert any("beyond" in v for v in check_solution(wide, inp, replace(sol, torques=big)))
 
 
 # --------------------------------------------------------------------------- warm start
@@ -467,6 +552,9 @@ def test_bad_input_names_the_field(stones_tick: Tick, walks: Walks) -> None:
     _raises("track", HorizonOptions, track=-1.0)
     _raises("gap", HorizonOptions, gap=-1e-3)
     _raises("node_limit", HorizonOptions, node_limit=0)
+    for bad in [(1.0,), (0.0, 1.0), (1.0, -2.0), (math.nan, 1.0), (1.0, math.inf), "ab", 3.0]:
+        _raises("torque_limits", HorizonOptions, torque_limits=bad)
+    assert HorizonOptions(torque_limits=[2, 3]).torque_limits == (2.0, 3.0)
     _, plan = walks["narrow_stones_gap"]
     x = plan.states[0, 0]
     _raises("step", horizon_input, plan, plan.n_steps - 2, 0.2, x)  # needs n - H

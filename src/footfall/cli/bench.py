@@ -306,10 +306,11 @@ def bench_pushes_cmd(
     planner: str = typer.Option("miqcqp", help="miqcqp, kinematic or reactive."),
     controller: str = typer.Option("wbc", help="The walker's controller: wbc or servo."),
     region_aware: str = typer.Option(
-        "planned",
+        "horizon",  # WalkOptions.region_aware's default (a test keeps them equal)
         "--region-aware",
         help="How the walker's MPC keeps the next footstep on the terrain: off, planned, nearby "
-        "or horizon (the region the 3-footstep MIQP chooses from the measured state).",
+        "or horizon (the region the 3-footstep MIQP chooses from the measured state; the "
+        "walker's default).",
     ),
     leg_momentum: float | None = typer.Option(
         None,

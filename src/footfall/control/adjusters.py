@@ -441,7 +441,7 @@ class MPCAdjuster(PlanFollower):
         self.horizon: HorizonRegions | None = None
         if self.region_aware == HORIZON_MODE:
             regions = tuple(self.regions.values())
-            self.horizon = HorizonRegions(self.plan, regions, mdl.control_dt)
+            self.horizon = HorizonRegions(self.plan, regions, mdl.control_dt, self.torque_limits)
 
     def update(
         self, t: float, state: FloatArray, stance: FloatArray, phase: int

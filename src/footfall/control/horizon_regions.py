@@ -43,6 +43,9 @@ class HorizonRegions:
         regions: the regions the footsteps may use.
         control_dt: the caller's control period [s]; solves are ``round(HORIZON_PERIOD /
             control_dt)`` ticks apart (at least 1).
+        torque_limits: semi-axes ``(U_x, U_y)`` [N m] of the caller MPC's ankle-torque ellipse
+            (:attr:`footfall.planning.horizon.HorizonOptions.torque_limits`), so the MIQP judges a
+            region with the torque the MPC will use; None: the plan's ball ``U_max``.
         solves: short-horizon solves made so far.
         failures: solves that returned no solution (the caller's region held).
     """
@@ -50,6 +53,7 @@ class HorizonRegions:
     plan: FootstepPlan
     regions: Sequence[Region]
     control_dt: float
+    torque_limits: tuple[float, float] | None = None
     solves: int = 0
     failures: int = 0
     #: control ticks between two solves
@@ -59,13 +63,14 @@ class HorizonRegions:
     _pick: dict[int, str] = field(default_factory=dict, init=False, repr=False)
 
     def __post_init__(self) -> None:
-        from footfall.planning.horizon import HorizonPlanner
+        from footfall.planning.horizon import HorizonOptions, HorizonPlanner
 
         if not (math.isfinite(self.control_dt) and self.control_dt > 0.0):
             raise InputError("control_dt", self.control_dt, "a period > 0 [s]")
         if self.plan.states is None or not self.plan.has_solution:
             raise InputError("plan", self.plan.planner, "a plan with footsteps and ALIP states")
-        self._planner = HorizonPlanner(Terrain(tuple(self.regions)), self.plan.robot)
+        options = HorizonOptions(torque_limits=self.torque_limits)
+        self._planner = HorizonPlanner(Terrain(tuple(self.regions)), self.plan.robot, options)
         self.every = max(1, round(HORIZON_PERIOD / self.control_dt))
 
     @property

@@ -107,7 +107,7 @@ class PushProtocol:
     steps: int | None = None
     planner: str = "miqcqp"
     controller: str = "wbc"
-    region_aware: str = "planned"
+    region_aware: str = "horizon"  # WalkOptions.region_aware's default (a test keeps them equal)
     leg_momentum: float | None = None
     walk_on: int | None = None
 

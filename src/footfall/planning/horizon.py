@@ -25,6 +25,11 @@ Choices, each made so the problem is a mixed-integer QP that an active-set solve
 * **The torque ball is its inscribed regular octagon** (``TORQUE_SIDES`` rows
   ``n_k^T u <= U_max cos(pi / 8)``): a planned torque never exceeds U_max and is at most
   ``1 - cos(pi / 8)`` (7.6 %) short of it in the worst direction, like the planner's swing bound.
+  Beyond the document, ``HorizonOptions.torque_limits`` makes it the walker MPC's ellipse
+  ``(v_x / U_x)^2 + (v_y / U_y)^2 <= 1`` over the torque ``v = R(theta_j)^T u`` in stance j's
+  frame (eq. 5.19e as :func:`footfall.control.mpc.build_mpc` takes it), with the octagon
+  inscribed in it: rows ``(R(theta_j) D^-1 n_k)^T u <= cos(pi / 8)``, ``D = diag(U_x, U_y)``.
+  The loop's MPC then lands the footstep with the torques this problem assumed.
 * **The tracking term** ``w_p ||p_j - p_j^ref||^2`` (weight ``HorizonOptions.track``, eq. 5.19a's
   W) keeps the footsteps near the full-horizon plan, whose goal lies beyond the horizon.
 
@@ -95,6 +100,10 @@ class HorizonOptions:
         node_limit: most QP solves per call; the search then stops with status ``node_limit``
             and an honest gap (a limit on work, not on time, so results do not depend on the
             machine).
+        torque_limits: semi-axes ``(U_x, U_y)`` [N m] of the ankle-torque ellipse in each stance
+            foot's frame (the walker MPC's, e.g.
+            :func:`footfall.control.adjusters.sole_torque_limits`); None: the document's ball
+            ``||u|| <= U_max`` (5.12d).
     """
 
     horizon: int = DEFAULT_HORIZON
@@ -103,6 +112,7 @@ class HorizonOptions:
     region_margin: float = 0.0
     gap: float = 1e-4
     node_limit: int = 5000
+    torque_limits: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         h = self.horizon
@@ -125,6 +135,33 @@ class HorizonOptions:
         nl = self.node_limit
         if isinstance(nl, bool) or not isinstance(nl, int) or nl < 1:
             raise InputError("node_limit", nl, "an integer >= 1")
+        lim = self.torque_limits
+        if lim is not None:
+            expected = "two finite numbers (U_x, U_y) > 0 [N m], or None for the ball U_max"
+            try:
+                vals = tuple(float(v) for v in lim)
+            except (TypeError, ValueError):
+                raise InputError("torque_limits", lim, expected) from None
+            if len(vals) != 2 or not all(math.isfinite(v) and v > 0.0 for v in vals):
+                raise InputError("torque_limits", lim, expected)
+            object.__setattr__(self, "torque_limits", vals)
+
+
+def torque_facets(
+    u_max: float, torque_limits: tuple[float, float] | None, heading: float
+) -> tuple[FloatArray, FloatArray]:
+    """The ``TORQUE_SIDES``-gon of eq. (5.12d) as rows ``normals @ u <= bounds`` over the world
+    frame torque ``u`` (2,) of a stance foot at ``heading`` [rad]: inscribed in the ball
+    ``||u|| <= u_max`` [N m] when ``torque_limits`` is None, else in the ellipse of semi-axes
+    ``torque_limits = (U_x, U_y)`` [N m] in the stance frame. Returns ``normals`` (S, 2) and
+    ``bounds`` (S,); facet ``k + S/2`` is facet ``k`` negated."""
+    phi = 2.0 * math.pi * np.arange(TORQUE_SIDES) / TORQUE_SIDES
+    unit = np.column_stack([np.cos(phi), np.sin(phi)])
+    inscribed = math.cos(math.pi / TORQUE_SIDES)
+    if torque_limits is None:
+        return unit, np.full(TORQUE_SIDES, u_max * inscribed)
+    normals = (unit / np.asarray(torque_limits, dtype=float)) @ rot2(heading).T
+    return normals, np.full(TORQUE_SIDES, inscribed)
 
 
 @dataclass(frozen=True)
@@ -420,7 +457,10 @@ class HorizonPlanner:
         rows, lo, hi = self._rows(inp)
         z_lo = np.full(nz, -np.inf)
         z_hi = np.full(nz, np.inf)
-        u_box = rb.u_max * math.cos(math.pi / TORQUE_SIDES)
+        lim = self.options.torque_limits
+        # the ball's octagon: its axis facets are these bounds; an ellipse at any heading lies
+        # in the box of its larger semi-axis (its facets are all rows, see _rows)
+        u_box = rb.u_max * math.cos(math.pi / TORQUE_SIDES) if lim is None else max(lim)
         z_lo[: self.nu], z_hi[: self.nu] = -u_box, u_box
         for j in range(1, h + 1):
             ip = self.p_index(j)
@@ -433,17 +473,30 @@ class HorizonPlanner:
         rows: list[FloatArray] = []
         lo: list[float] = []
         hi: list[float] = []
-        # the octagon's axis rows are the variable bounds; its two diagonal rows here
+        lim = self.options.torque_limits
+        # the ball's octagon: its axis rows are the variable bounds, its two diagonal rows here;
+        # an ellipse's octagon: its four facet pairs here (two-sided rows)
         diag = rb.u_max * math.cos(math.pi / TORQUE_SIDES) * math.sqrt(2.0)
+        half = TORQUE_SIDES // 2
         for j in range(h):
+            if lim is not None:
+                normals, bounds = torque_facets(rb.u_max, lim, float(inp.headings[j]))
             for blk in range(self.blocks):
                 iu = self.u_index(j, blk)
-                for sx in (1.0, -1.0):
+                if lim is None:
+                    for sx in (1.0, -1.0):
+                        row = np.zeros(nz)
+                        row[iu], row[iu + 1] = 1.0, sx
+                        rows.append(row)
+                        lo.append(-diag)
+                        hi.append(diag)
+                    continue
+                for k in range(half):
                     row = np.zeros(nz)
-                    row[iu], row[iu + 1] = 1.0, sx
+                    row[iu], row[iu + 1] = normals[k]
                     rows.append(row)
-                    lo.append(-diag)
-                    hi.append(diag)
+                    lo.append(-float(bounds[k]))
+                    hi.append(float(bounds[k]))
         sides = [inp.stance]
         for _ in range(h):
             sides.append(sides[-1].other)
@@ -797,7 +850,9 @@ def horizon_problem(planner: HorizonPlanner, inp: HorizonInput) -> MIQCQP:
     w, opt = planner.options.weights, planner.options
     alip = rb.alip()
     b = ProblemBuilder()
-    u = b.add_vars("u", (h, blocks, 2), lb=-rb.u_max, ub=rb.u_max)
+    lim = opt.torque_limits
+    u_abs = rb.u_max if lim is None else max(lim)
+    u = b.add_vars("u", (h, blocks, 2), lb=-u_abs, ub=u_abs)
     lo_box, hi_box = planner.terrain.bounds()
     p = b.add_vars("p", (h, 3), lb=lo_box, ub=hi_box)
     x = b.add_vars("x", (h, blocks + 1, 4))
@@ -821,9 +876,15 @@ def horizon_problem(planner: HorizonPlanner, inp: HorizonInput) -> MIQCQP:
                 b.add_square({int(u[j, blk, kk]): 1.0}, 0.0, w.torque * dt / rb.node_dt, "torque")
             for s in range(TORQUE_SIDES):
                 phi = 2.0 * math.pi * s / TORQUE_SIDES
+                if lim is None:
+                    coef, rhs_u = (math.cos(phi), math.sin(phi)), rb.u_max
+                else:  # in stance j's frame: (cos phi / U_x, sin phi / U_y) . R^T u
+                    c, s_ = math.cos(float(inp.headings[j])), math.sin(float(inp.headings[j]))
+                    nx, ny = math.cos(phi) / lim[0], math.sin(phi) / lim[1]
+                    coef, rhs_u = (c * nx - s_ * ny, s_ * nx + c * ny), 1.0
                 b.add_le(
-                    {int(u[j, blk, 0]): math.cos(phi), int(u[j, blk, 1]): math.sin(phi)},
-                    rb.u_max * math.cos(math.pi / TORQUE_SIDES),
+                    {int(u[j, blk, 0]): coef[0], int(u[j, blk, 1]): coef[1]},
+                    rhs_u * math.cos(math.pi / TORQUE_SIDES),
                     f"5.12d octagon step {j} block {blk}",
                 )
         nxt = x[j + 1, 0] if j + 1 < h else x_final

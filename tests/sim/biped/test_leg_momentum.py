@@ -165,7 +165,7 @@ def test_walk_command_records_the_share(tmp_path):
     assert res.exit_code == 0, res.output
     walked = json.loads((tmp_path / "walk.json").read_text())
     assert walked["walker"] == {
-        "region_aware": "planned",
+        "region_aware": "horizon",
         "leg_momentum": 0.25,
         "capture_stop": True,
         "walk_on": 4,

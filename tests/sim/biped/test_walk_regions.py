@@ -149,12 +149,12 @@ def test_a_retargeted_swing_is_raised_over_the_regions_under_its_new_path(mode: 
 @pytest.mark.parametrize("name", ["narrow_stones_gap", "roll_ramps", "corridor_corner"])
 def test_new_scenes_are_walked_with_every_footstep_on_a_region(name: str) -> None:
     """Smoke test of the region scenes (plans of ``footfall walk`` stored in data/): the
-    walker's default (region-aware: ``planned``) reaches the goal and no landed sole centre is
+    walker's default (region-aware: ``horizon``) reaches the goal and no landed sole centre is
     off the terrain (shapely)."""
     scene = builtin_scene(name)
     plan = load_plan(Path(__file__).parent / "data" / f"{name}_miqcqp.json", scene)
     opts = WalkOptions()
-    assert opts.region_aware == "planned"
+    assert opts.region_aware == "horizon"
     res = walk(scene, plan, opts)
     assert not res.metrics.fell and res.metrics.reached_goal
     landed = res.trace.landed[~np.isnan(res.trace.landed[:, 0])]
@@ -234,3 +234,19 @@ def test_the_swing_target_jumps_only_to_a_footstep_the_bound_could_not_reach_in_
     assert walker._limit_target(far, 0.04) == pytest.approx(
         planned + np.array([0.0, -0.01375, 0.0]), abs=1e-12
     )
+
+
+def test_every_front_door_defaults_to_the_walkers_region_mode() -> None:
+    """``footfall walk``, ``footfall bench pushes`` and the push protocol's API default to
+    :attr:`WalkOptions.region_aware` (written out there as a string, to keep imports light)."""
+    import inspect
+
+    from footfall.cli.bench import bench_pushes_cmd
+    from footfall.cli.simulation import walk_cmd
+    from footfall.experiments.protocol import PushProtocol
+
+    default = WalkOptions().region_aware
+    for cmd in (walk_cmd, bench_pushes_cmd):
+        option = inspect.signature(cmd).parameters["region_aware"].default
+        assert option.default == default, cmd.__name__
+    assert PushProtocol.__dataclass_fields__["region_aware"].default == default
