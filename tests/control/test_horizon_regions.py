@@ -146,3 +146,20 @@ def test_bad_input_names_the_field(stones: tuple[Scene, FootstepPlan]) -> None:
             HorizonRegions(plan, tuple(scene.terrain.regions), dt)
     with pytest.raises(InputError, match="region_aware"):
         _adjuster(plan, scene, "horizons")
+
+
+def test_one_region_leaves_nothing_to_choose() -> None:
+    """On a terrain of one region the MIQP is not solved and the adjuster's footstep, pushed, is
+    the ``planned`` mode's to the bit."""
+    scene = builtin_scene("flat")
+    plan = plan_reactive(scene)
+    assert len(scene.terrain.regions) == 1
+    step = 2
+    x = _pushed_state(plan, step, T, np.array([-0.3, 0.2]))
+    stance = np.asarray(plan.footsteps[step], dtype=float)
+    adj = _adjuster(plan, scene, "horizon")
+    target, u = adj.update(T, x, stance, step)
+    target_p, u_p = _adjuster(plan, scene, "planned").update(T, x, stance, step)
+    assert adj.horizon is not None and adj.horizon.solves == 0
+    assert np.array_equal(target, target_p) and np.array_equal(u, u_p)
+    assert adj.choices[step].region == plan.regions[step + 1]

@@ -89,9 +89,12 @@ class HorizonRegions:
             time_left: time left in the single support [s].
             state: measured ALIP state (4,) relative to the stance foot (eq. 5.1).
             stance: the stance foot's contact point (3,) [m], world frame.
+
+        A terrain of one region leaves nothing to choose: no solve, the caller's region holds
+        (the same walk as ``planned``, at its speed).
         """
         h = self._planner.h
-        if phase + h > self.plan.n_steps or time_left <= 0.0:
+        if len(self.regions) == 1 or phase + h > self.plan.n_steps or time_left <= 0.0:
             return None
         if tick % self.every and phase in self._pick:
             return self._pick[phase]
