@@ -64,8 +64,8 @@ class _CscLists:
     ``benchmarks/RESULTS.md``). It reads only these attributes and ``shape`` and
     ``has_canonical_format``. :meth:`from_coo` builds the canonical form (columns in order, rows
     sorted within a column, duplicates summed) straight from a node's COO entries: one stable sort
-    of ``column * n_rows + row``, without scipy's checks and conversions (a third of a node's time
-    outside Clarabel went there).
+    of ``column * n_rows + row``, without scipy's checks and conversions (2-4 % of a search's time
+    on one thread, same nodes; inside the noise with two workers; ``benchmarks/RESULTS.md``).
     """
 
     __slots__ = ("data", "has_canonical_format", "indices", "indptr", "shape")
