@@ -156,7 +156,8 @@ def plan(
     time_limit: float = typer.Option(
         60.0,
         help="Time limit of the solve [s]; in the smallest-N search, of each N tried (its checks "
-        "before the solve included).",
+        "before the solve included). A MIQCQP solve that finds no plan in it is followed by a "
+        "search with the headings pinned outside a window of footsteps, for as long again.",
     ),
     gap: float = typer.Option(1e-4, help="Relative optimality gap at which to stop."),
     solver: str = typer.Option(

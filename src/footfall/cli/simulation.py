@@ -493,7 +493,12 @@ def walk_cmd(
     steps: int | None = typer.Option(
         None, help="Footsteps N (optimising planners); omitted: the smallest N with a plan."
     ),
-    time_limit: float = typer.Option(300.0, help="Planner time limit per solve [s]."),
+    time_limit: float = typer.Option(
+        300.0,
+        help="Planner time limit per solve [s]. A MIQCQP solve that finds no plan in it is "
+        "followed by a search with the headings pinned outside a window of footsteps, for as "
+        "long again.",
+    ),
     push: PushOption = 0.0,
     push_dv: PushDvOption = None,
     seed: SeedOption = 0,

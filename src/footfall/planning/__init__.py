@@ -2,7 +2,9 @@
 
 - :func:`lip_walk` — Kajita's LIP walking pattern (document 004).
 - :func:`plan_footsteps` — the full-horizon MIQCQP of document 000 (section 5.3);
-  :func:`build_footstep_problem` returns its inspectable model.
+  :func:`build_footstep_problem` returns its inspectable model. Where its solve finds no plan,
+  :func:`~footfall.planning.windows.heading_window_search` looks for one with the headings
+  pinned outside a window of footsteps (``PlannerOptions.heading_windows``).
 - :func:`plan_kinematic`, :func:`plan_reactive` — the two baselines; :func:`make_plan` dispatches
   by name and :func:`plan_min_steps` searches the smallest N (from the lower bound of
   :func:`reachable_steps_bound`, reporting to a :class:`SearchMonitor`).

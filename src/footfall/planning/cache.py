@@ -80,6 +80,10 @@ def plan_key(
     """
     opts = _plain(options)
     opts.pop("verbose", None)
+    if options.heading_windows == PlannerOptions.heading_windows:
+        # the default leaves the keys of plans cached before the option existed valid: the
+        # search runs only where the solve found no plan, and such a result is never cached
+        opts.pop("heading_windows", None)
     for name in KEY_NEUTRAL_BNB:
         opts["bnb"].pop(name, None)
     doc = {

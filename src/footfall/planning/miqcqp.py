@@ -69,7 +69,7 @@ from footfall.planning.plan import (
     wrap_near,
 )
 from footfall.solvers import ProblemBuilder, SolveStatus, solve
-from footfall.solvers.base import SolveProgress
+from footfall.solvers.base import SolveProgress, SolverResult, relative_gap
 from footfall.solvers.problem import MIQCQP
 from footfall.terrain.scene import Scene
 
@@ -605,12 +605,18 @@ def plan_footsteps(
     result = solve(fp.problem, options.solver, solver_options)
     if members is not None:
         result.stats["members_fixed_out"] = fixed_out
+    searched = ""
+    if result.x is None and result.status is SolveStatus.TIME_LIMIT and options.heading_windows:
+        result, searched = _windows(fp, scene, options, result)
     meta = result_meta(result)
     if result.x is None:
         if result.status is SolveStatus.INFEASIBLE:
             message = _model_infeasible(scene, fp.robot, n_steps, options)
         elif result.status is SolveStatus.TIME_LIMIT:
-            message = f"no feasible plan found within the time limit of {options.time_limit:g} s"
+            message = (
+                f"no feasible plan found within the time limit of {options.time_limit:g} s"
+                + searched
+            )
         else:
             message = solver_failure_message(result)
         return FootstepPlan.empty("miqcqp", robot=fp.robot, message=message, **meta)
@@ -619,7 +625,46 @@ def plan_footsteps(
         SolveStatus.TIME_LIMIT: f"time limit reached; best plan has gap {result.gap:.3g}",
         SolveStatus.FEASIBLE: f"feasible plan, gap {result.gap:.3g}",
     }.get(result.status, "")
-    return extract_plan(fp, result.x, message=message, **meta)
+    return extract_plan(fp, result.x, message=message + searched, **meta)
+
+
+def _windows(
+    fp: FootstepProblem, scene: Scene, options: PlannerOptions, result: SolverResult
+) -> tuple[SolverResult, str]:
+    """After a solve that ended at its time limit without a plan: the heading-window search
+    (:mod:`footfall.planning.windows`) for as long again, and the message it adds. Its plan is
+    returned at status TIME_LIMIT with the solve's bound (valid for the whole model), so the
+    gap claims no more than the solve proved."""
+    from footfall.planning.windows import heading_window_search
+
+    found = heading_window_search(fp, scene, options, options.time_limit)
+    stats = dict(result.stats)
+    if found is None:
+        stats["heading_windows"] = {"found": False}
+        return replace(result, stats=stats), (
+            f"; nor did the heading-window search in {options.time_limit:g} s more"
+        )
+    stats["heading_windows"] = {
+        "found": True,
+        "centre": found.centre,
+        "tried": found.tried,
+        "feasible": found.feasible,
+        "seconds": found.seconds,
+    }
+    lo, hi = found.centre - options.heading_windows, found.centre + options.heading_windows
+    plan_result = replace(
+        result,
+        x=found.x,
+        objective=found.objective,
+        gap=relative_gap(found.objective, result.bound),
+        solve_time=result.solve_time + found.seconds,
+        stats=stats,
+    )
+    return plan_result, (
+        f" (the solve found none in {options.time_limit:g} s; the heading-window search found "
+        f"this one with headings free at footsteps {lo}..{hi} only, {found.feasible} of "
+        f"{found.tried} windows with a plan)"
+    )
 
 
 def _model_infeasible(

@@ -96,7 +96,8 @@ class PlannerOptions:
             SCIP), ``gurobi`` (optional).
         time_limit: solver wall-time limit [s]; in the smallest-N search
             (:func:`~footfall.planning.run.plan_min_steps`) each N tried gets this long, its
-            checks before the solve included.
+            checks before the solve included. A MIQCQP solve that finds no plan in it is
+            followed by the heading-window search for as long again (``heading_windows``).
         gap: relative optimality gap at which the solver stops.
         threads: solver threads; for ``bnb``, the forked worker processes that solve node
             relaxations in parallel (1, the default: the serial search in the calling process, so
@@ -123,6 +124,11 @@ class PlannerOptions:
             regular ``SWING_SIDES``-gon (linear rows, never longer than L_swing).
         bnb: settings of the ``bnb`` backend (:class:`footfall.solvers.bnb.BnbSettings`; part of
             the plan cache key).
+        heading_windows: beyond the document: when the MIQCQP's solve ends at its time limit
+            without a plan, the heading-window search (:mod:`footfall.planning.windows`) gets as
+            long again: headings pinned to the start-goal band except in a window of
+            ``2 heading_windows + 1`` footsteps. 0: no search. It only runs where the solve
+            found nothing, so it changes no plan the solve finds.
     """
 
     weights: PlannerWeights = field(default_factory=PlannerWeights)
@@ -137,6 +143,7 @@ class PlannerOptions:
     reach_both_frames: bool = False
     swing_max: float | None = None
     bnb: BnbSettings = field(default_factory=BnbSettings)
+    heading_windows: int = 2
 
     def __post_init__(self) -> None:
         segments = self.heading_segments
@@ -166,6 +173,9 @@ class PlannerOptions:
             object.__setattr__(self, "swing_max", positive("swing_max", self.swing_max))
         if not isinstance(self.bnb, BnbSettings):
             raise InputError("bnb", self.bnb, "a footfall.solvers.bnb.BnbSettings")
+        windows = self.heading_windows
+        if isinstance(windows, bool) or not isinstance(windows, int) or windows < 0:
+            raise InputError("heading_windows", windows, "an integer >= 0 (0: no search)")
 
     def solver_options(self) -> SolverOptions:
         """The backend options these planner options imply."""

@@ -1,0 +1,162 @@
+"""A primal heuristic for the MIQCQP: every heading pinned but those of a window of footsteps.
+
+Beyond the document (its section 5.3 solves the model with a commercial solver). Some terrains
+can only be crossed with the robot turned: a gap longer than the forward reach of eq. (5.12f) is
+crossed by a step along the reach trapezoid's far corner, with the stance heading 15-25 degrees off
+the path (the G1 on stairs_slope_gap: forward reach 0.23 m, the gap with the sole's half length
+on either side 0.294 m). The branch and bound then finds no feasible point: its relaxation mixes
+heading segments at every footstep (the union of their reaches), and each dive leaves several
+footsteps on the wrong segments at once, so no incumbent is found before the time limit.
+
+This heuristic restricts the model and solves the restrictions with the same backend:
+
+* outside a window of footsteps ``|i - k| <= width`` every heading ``theta_i`` is pinned to the
+  band between the start and goal headings, widened by a quarter of a heading segment, so that
+  both segments that meet at a breakpoint there stay available (the optimum of eq. 5.11 holds
+  the heading on a breakpoint to get both segments' reach); the segment binaries outside the band
+  are fixed to 0;
+* inside the window the headings keep the model's bounds (a full turn).
+
+A restriction only tightens variable bounds, so each of its solutions satisfies every row of the
+model: it is a feasible plan of the model (and the independent checker checks it as any other).
+A restriction proven infeasible proves nothing about the model.
+
+Windows are tried in the order of where a turn is likely needed: the centre ``k`` whose footstep,
+spaced evenly on the straight line from the start to the goal, lies nearest to a hole in the
+terrain (a point of that line inside no region); on a line without holes, from the middle
+outward. Each window is solved to the model's gap; the search keeps the best plan and stops when
+every window is tried or its time is up.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from footfall._typing import FloatArray
+from footfall.planning.plan import PlannerOptions
+from footfall.solvers import SolveStatus, solve
+from footfall.terrain.scene import Scene
+
+if TYPE_CHECKING:  # miqcqp imports this module
+    from footfall.planning.miqcqp import FootstepProblem
+
+#: points per metre of the straight start-to-goal line tested for holes
+HOLE_SAMPLES_PER_M = 200
+
+
+@dataclass(frozen=True)
+class WindowResult:
+    """The best plan the heading-window search found.
+
+    Attributes:
+        x: the model's variable vector (n,).
+        objective: its objective (eq. 5.11).
+        centre: the window's centre footstep k.
+        tried: windows solved (or stopped by the clock).
+        feasible: windows with a plan.
+        seconds: wall time of the search [s].
+    """
+
+    x: FloatArray
+    objective: float
+    centre: int
+    tried: int
+    feasible: int
+    seconds: float
+
+
+def window_order(scene: Scene, n_steps: int, width: int) -> list[int]:
+    """Window centres ``k`` in the order the search tries them (module docstring): the free
+    footsteps are 1..N-2 (the last two stand at the goal), so the centres are ``1 + width``
+    .. ``N - 2 - width`` (at least one centre)."""
+    first, last = 1 + width, max(1 + width, n_steps - 2 - width)
+    centres = list(range(first, last + 1))
+    start = 0.5 * (scene.start.left[:2] + scene.start.right[:2])
+    goal = np.asarray(scene.goal.position[:2], dtype=float)
+    length = float(np.linalg.norm(goal - start))
+    fractions = np.linspace(0.0, 1.0, max(2, int(length * HOLE_SAMPLES_PER_M) + 1))
+    points = start + fractions[:, None] * (goal - start)
+    covered = np.zeros(len(points), dtype=bool)
+    for region in scene.terrain:
+        a, b = region.halfspaces()
+        covered |= np.all(points @ a.T <= b + 1e-9, axis=1)
+    holes = fractions[~covered]
+
+    # distances rounded so that ties (equally far either side) go to the lower k on any machine
+    def where(k: int) -> float:  # fraction of the line of footstep k, spaced evenly
+        return k / max(1, n_steps - 1)
+
+    if len(holes) == 0:
+        return sorted(centres, key=lambda k: (round(abs(where(k) - 0.5), 9), k))
+    return sorted(centres, key=lambda k: (round(float(np.min(np.abs(holes - where(k)))), 9), k))
+
+
+def pin_headings(fp: FootstepProblem, centre: int, width: int) -> FootstepProblem:
+    """``fp`` with every heading outside
+    the window ``|i - centre| <= width`` pinned to the start-goal heading band (module
+    docstring) and the segment binaries outside its bounds fixed to 0."""
+    problem = fp.problem
+    theta, segments, breaks = fp.theta, fp.segments, fp.breakpoints
+    lb, ub = problem.lb.copy(), problem.ub.copy()
+    seg_width = float(breaks[1] - breaks[0])
+    # footstep 0's heading is the start's, footstep N's the goal's (both fixed by their bounds)
+    theta0, theta_goal = float(lb[int(theta[0])]), float(lb[int(theta[-1])])
+    lo = min(theta0, theta_goal) - 0.25 * seg_width
+    hi = max(theta0, theta_goal) + 0.25 * seg_width
+    for i in range(1, len(theta)):
+        t = int(theta[i])
+        if abs(i - centre) > width:
+            lb[t], ub[t] = max(lb[t], lo), min(ub[t], hi)
+        for ell, z in enumerate(segments[i]):
+            if z >= 0 and (breaks[ell + 1] < lb[t] - 1e-12 or breaks[ell] > ub[t] + 1e-12):
+                ub[int(z)] = 0.0
+    return replace(fp, problem=replace(problem, lb=lb, ub=ub))
+
+
+def heading_window_search(
+    fp: FootstepProblem, scene: Scene, options: PlannerOptions, seconds: float
+) -> WindowResult | None:
+    """The best plan of the restrictions (module docstring) found within ``seconds`` [s], or
+    None when none has one. ``fp``: the model, with any members already fixed out."""
+    width = options.heading_windows
+    t0 = time.perf_counter()
+    deadline = t0 + seconds
+    best: tuple[float, FloatArray, int] | None = None
+    tried = feasible = 0
+    n_steps = fp.n_steps
+    for centre in window_order(scene, n_steps, width):
+        left = deadline - time.perf_counter()
+        if left <= 0.0:
+            break
+        restricted = pin_headings(fp, centre, width)
+        if restricted.problem.bounds_conflict():
+            continue
+        tried += 1
+        opts = replace(options.solver_options(), time_limit=left)
+        result = solve(restricted.problem, options.solver, opts)
+        if result.x is None or result.status not in (
+            SolveStatus.OPTIMAL,
+            SolveStatus.FEASIBLE,
+            SolveStatus.TIME_LIMIT,
+        ):
+            continue
+        feasible += 1
+        if best is None or result.objective < best[0]:
+            best = (float(result.objective), np.asarray(result.x, dtype=float), centre)
+    if best is None:
+        return None
+    return WindowResult(
+        x=best[1],
+        objective=best[0],
+        centre=best[2],
+        tried=tried,
+        feasible=feasible,
+        seconds=time.perf_counter() - t0,
+    )
+
+
+__all__ = ["WindowResult", "heading_window_search", "pin_headings", "window_order"]
