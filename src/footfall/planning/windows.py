@@ -32,17 +32,34 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import Protocol, TypeVar
 
 import numpy as np
 
-from footfall._typing import FloatArray
+from footfall._typing import FloatArray, IntArray
 from footfall.planning.plan import PlannerOptions
 from footfall.solvers import SolveStatus, solve
+from footfall.solvers.problem import MIQCQP
 from footfall.terrain.scene import Scene
 
-if TYPE_CHECKING:  # miqcqp imports this module
-    from footfall.planning.miqcqp import FootstepProblem
+
+class HeadingModel(Protocol):
+    """What the search reads of a :class:`~footfall.planning.miqcqp.FootstepProblem` (a
+    structural type: the planner's module calls this one, so this one does not import it)."""
+
+    @property
+    def problem(self) -> MIQCQP: ...
+    @property
+    def n_steps(self) -> int: ...
+    @property
+    def theta(self) -> IntArray: ...
+    @property
+    def segments(self) -> IntArray: ...
+    @property
+    def breakpoints(self) -> FloatArray: ...
+
+
+M = TypeVar("M", bound=HeadingModel)
 
 #: points per metre of the straight start-to-goal line tested for holes
 HOLE_SAMPLES_PER_M = 200
@@ -95,7 +112,7 @@ def window_order(scene: Scene, n_steps: int, width: int) -> list[int]:
     return sorted(centres, key=lambda k: (round(float(np.min(np.abs(holes - where(k)))), 9), k))
 
 
-def pin_headings(fp: FootstepProblem, centre: int, width: int) -> FootstepProblem:
+def pin_headings(fp: M, centre: int, width: int) -> M:
     """``fp`` with every heading outside
     the window ``|i - centre| <= width`` pinned to the start-goal heading band (module
     docstring) and the segment binaries outside its bounds fixed to 0."""
@@ -114,11 +131,11 @@ def pin_headings(fp: FootstepProblem, centre: int, width: int) -> FootstepProble
         for ell, z in enumerate(segments[i]):
             if z >= 0 and (breaks[ell + 1] < lb[t] - 1e-12 or breaks[ell] > ub[t] + 1e-12):
                 ub[int(z)] = 0.0
-    return replace(fp, problem=replace(problem, lb=lb, ub=ub))
+    return replace(fp, problem=replace(problem, lb=lb, ub=ub))  # type: ignore[type-var]
 
 
 def heading_window_search(
-    fp: FootstepProblem, scene: Scene, options: PlannerOptions, seconds: float
+    fp: HeadingModel, scene: Scene, options: PlannerOptions, seconds: float
 ) -> WindowResult | None:
     """The best plan of the restrictions (module docstring) found within ``seconds`` [s], or
     None when none has one. ``fp``: the model, with any members already fixed out."""
@@ -159,4 +176,4 @@ def heading_window_search(
     )
 
 
-__all__ = ["WindowResult", "heading_window_search", "pin_headings", "window_order"]
+__all__ = ["HeadingModel", "WindowResult", "heading_window_search", "pin_headings", "window_order"]
