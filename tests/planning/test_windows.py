@@ -16,6 +16,7 @@ from footfall.planning import PlannerOptions, build_footstep_problem, check_plan
 from footfall.planning.cache import plan_key
 from footfall.planning.windows import heading_window_search, pin_headings, window_order
 from footfall.solvers import SolverResult, SolveStatus, solve
+from footfall.solvers.base import SolveProgress
 from tests.conftest import VirtualClock
 from tests.planning.scenes import SHORT_FLAT, scene
 
@@ -191,3 +192,30 @@ def test_the_default_leaves_cached_plans_keys_unchanged() -> None:
     default = plan_key(sc, "miqcqp", 4, PlannerOptions())
     assert plan_key(sc, "miqcqp", 4, PlannerOptions(heading_windows=2)) == default
     assert plan_key(sc, "miqcqp", 4, PlannerOptions(heading_windows=0)) != default
+
+
+def test_progress_goes_on_from_the_solve_with_its_bound(
+    gap, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The window solves report as one search that continues the unrestricted solve: nodes and
+    seconds counted on, the unrestricted bound kept (a restriction's bound is not the model's)."""
+    import footfall.planning.windows as windows
+
+    sc, fp = gap
+    real = windows.solve
+
+    def reporting(problem, backend, options):  # each window solve reports once, then solves
+        options.progress(SolveProgress(nodes=5, seconds=0.1, incumbent=9.0, bound=8.0, gap=0.1))
+        return real(problem, backend, replace(options, progress=None))
+
+    monkeypatch.setattr(windows, "solve", reporting)
+    heard: list[SolveProgress] = []
+    after = SolveProgress(nodes=100, seconds=60.0, incumbent=None, bound=1.0, gap=math.inf)
+    found = heading_window_search(fp, sc, OPTS, 600.0, heard.append, after)
+    assert found is not None and len(heard) == found.tried
+    first = heard[0]
+    assert first.nodes == 105 and first.seconds >= 60.0
+    assert first.bound == 1.0 and first.incumbent == 9.0 and first.gap == pytest.approx(8.0)
+    for later in heard[1:]:  # once a window has a plan, the best plan so far is the incumbent
+        assert later.bound == 1.0 and later.nodes > 105
+        assert later.incumbent is not None and later.incumbent <= 9.0

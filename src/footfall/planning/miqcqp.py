@@ -607,7 +607,7 @@ def plan_footsteps(
         result.stats["members_fixed_out"] = fixed_out
     searched = ""
     if result.x is None and result.status is SolveStatus.TIME_LIMIT and options.heading_windows:
-        result, searched = _windows(fp, scene, options, result)
+        result, searched = _windows(fp, scene, options, result, solve_progress)
     meta = result_meta(result)
     if result.x is None:
         if result.status is SolveStatus.INFEASIBLE:
@@ -629,7 +629,11 @@ def plan_footsteps(
 
 
 def _windows(
-    fp: FootstepProblem, scene: Scene, options: PlannerOptions, result: SolverResult
+    fp: FootstepProblem,
+    scene: Scene,
+    options: PlannerOptions,
+    result: SolverResult,
+    solve_progress: Callable[[SolveProgress], None] | None,
 ) -> tuple[SolverResult, str]:
     """After a solve that ended at its time limit without a plan: the heading-window search
     (:mod:`footfall.planning.windows`) for as long again, and the message it adds. Its plan is
@@ -637,7 +641,9 @@ def _windows(
     gap claims no more than the solve proved."""
     from footfall.planning.windows import heading_window_search
 
-    found = heading_window_search(fp, scene, options, options.time_limit)
+    nodes = int(result.stats.get("nodes", 0))
+    after = SolveProgress(nodes, result.solve_time, None, result.bound, math.inf)
+    found = heading_window_search(fp, scene, options, options.time_limit, solve_progress, after)
     stats = dict(result.stats)
     if found is None:
         stats["heading_windows"] = {"found": False}

@@ -30,7 +30,9 @@ every window is tried or its time is up.
 
 from __future__ import annotations
 
+import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Protocol, TypeVar
 
@@ -39,6 +41,7 @@ import numpy as np
 from footfall._typing import FloatArray, IntArray
 from footfall.planning.plan import PlannerOptions
 from footfall.solvers import SolveStatus, solve
+from footfall.solvers.base import SolveProgress, relative_gap
 from footfall.solvers.problem import MIQCQP
 from footfall.terrain.scene import Scene
 
@@ -135,17 +138,43 @@ def pin_headings(fp: M, centre: int, width: int) -> M:
 
 
 def heading_window_search(
-    fp: HeadingModel, scene: Scene, options: PlannerOptions, seconds: float
+    fp: HeadingModel,
+    scene: Scene,
+    options: PlannerOptions,
+    seconds: float,
+    progress: Callable[[SolveProgress], None] | None = None,
+    after: SolveProgress | None = None,
 ) -> WindowResult | None:
     """The best plan of the restrictions (module docstring) found within ``seconds`` [s], or
-    None when none has one. ``fp``: the model, with any members already fixed out."""
+    None when none has one. ``fp``: the model, with any members already fixed out.
+
+    ``progress`` hears of the search about once a second, as one solve that goes on from
+    ``after`` (where the unrestricted solve ended: its nodes and seconds are counted on, and its
+    bound, which holds for the whole model, stays the bound; a restriction's own bound does not).
+    The incumbent is the best plan found so far."""
     width = options.heading_windows
     t0 = time.perf_counter()
     deadline = t0 + seconds
     best: tuple[float, FloatArray, int] | None = None
-    tried = feasible = 0
-    n_steps = fp.n_steps
-    for centre in window_order(scene, n_steps, width):
+    tried = feasible = nodes_done = 0
+    start = after or SolveProgress(0, 0.0, None, math.nan, math.inf)
+
+    def report(p: SolveProgress) -> None:  # a window solve's progress, as the search's
+        if progress is None:
+            return
+        found = [v for v in (p.incumbent, best[0] if best else None) if v is not None]
+        incumbent = min(found) if found else None
+        progress(
+            SolveProgress(
+                nodes=start.nodes + nodes_done + p.nodes,
+                seconds=start.seconds + time.perf_counter() - t0,
+                incumbent=incumbent,
+                bound=start.bound,
+                gap=math.inf if incumbent is None else relative_gap(incumbent, start.bound),
+            )
+        )
+
+    for centre in window_order(scene, fp.n_steps, width):
         left = deadline - time.perf_counter()
         if left <= 0.0:
             break
@@ -153,8 +182,9 @@ def heading_window_search(
         if restricted.problem.bounds_conflict():
             continue
         tried += 1
-        opts = replace(options.solver_options(), time_limit=left)
+        opts = replace(options.solver_options(), time_limit=left, progress=report)
         result = solve(restricted.problem, options.solver, opts)
+        nodes_done += int(result.stats.get("nodes", 0))
         if result.x is None or result.status not in (
             SolveStatus.OPTIMAL,
             SolveStatus.FEASIBLE,
