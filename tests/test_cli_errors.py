@@ -100,3 +100,13 @@ def test_a_missing_optional_package_exits_2_naming_the_extra(
     lines = [line for line in r.stderr.splitlines() if line.strip()]
     assert len(lines) == 1 and "Traceback" not in r.stderr, r.stderr
     assert "pip install" in lines[0] and "footfall[" in lines[0], lines[0]
+
+
+@pytest.mark.parametrize("command", ["plan", "walk"])
+@pytest.mark.parametrize("value", ["-1", "x"])
+def test_a_bad_heading_window_count_is_refused(command: str, value: str, tmp_path: Path) -> None:
+    r = _run(command, "--scene", "flat", "--heading-windows", value, "--out", str(tmp_path / "o"))
+    assert r.returncode == 2
+    assert "Traceback" not in r.stderr
+    assert "heading" in r.stderr and "integer" in r.stderr  # the option and what it takes
+    assert not (tmp_path / "o" / "plan.json").exists()

@@ -219,3 +219,20 @@ def test_progress_goes_on_from_the_solve_with_its_bound(
     for later in heard[1:]:  # once a window has a plan, the best plan so far is the incumbent
         assert later.bound == 1.0 and later.nodes > 105
         assert later.incumbent is not None and later.incumbent <= 9.0
+
+
+def test_the_walks_plans_take_the_option(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``plan_for_walk(heading_windows=0)`` reaches the planner's options (``footfall walk
+    --heading-windows``), so a walk's planning can be kept to its time limit."""
+    import footfall.sim.biped.plans as plans
+
+    seen: list[PlannerOptions] = []
+
+    def record(scene, planner, n_steps, options, robot, cache, monitor):
+        seen.append(options)
+        raise RuntimeError("stop here")
+
+    monkeypatch.setattr(plans, "cached_plan", record)
+    with pytest.raises(RuntimeError, match="stop here"):
+        plans.plan_for_walk(scene(SHORT_FLAT), "miqcqp", 4, 60.0, heading_windows=0)
+    assert seen[0].heading_windows == 0

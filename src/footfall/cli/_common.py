@@ -140,6 +140,13 @@ def _positive_int(field: str, value: int) -> int:
     return value
 
 
+#: help of ``--heading-windows`` (plan, walk)
+HEADING_WINDOWS_HELP = (
+    "Beyond the document: when the MIQCQP solve ends at its time limit without a plan, search "
+    "for as long again with every heading pinned to the start-goal band except at 2 W + 1 "
+    "consecutive footsteps (W = this value); 0: no search."
+)
+
 #: help of ``--robot``
 ROBOT_HELP = (
     "The robot: biped (footfall's 30 kg biped), g1 or talos (robot files of models in "

@@ -12,6 +12,7 @@ from rich.console import Console
 from footfall._io import remove_outputs, write_json, write_text
 from footfall.cli._common import (
     _THREADS_HELP,
+    HEADING_WINDOWS_HELP,
     ROBOT_HELP,
     _threads,
     app,
@@ -185,6 +186,10 @@ def plan(
         help="Heading segments L of the linear reach model (eq. 5.12f-h): more segments make it "
         "less conservative (longer steps allowed) and the problem larger.",
     ),
+    heading_windows: int = typer.Option(
+        2,
+        help=HEADING_WINDOWS_HELP,
+    ),
     out: Path = typer.Option(Path("out/plan"), help="Output folder for plan.json and plan.png."),
     quiet: bool = typer.Option(
         False, "--quiet", help="No progress lines or status line (the result is still printed)."
@@ -226,6 +231,7 @@ def plan(
         reach_both_frames=reach_both_frames,
         swing_max=swing_max,
         heading_segments=heading_segments,
+        heading_windows=heading_windows,
     )
     robot_params = None if robot is None else _walker_params(robot, sc.robot)
     with ProgressLog(f"{sc.name} with {planner}", quiet, log_json) as log:

@@ -14,6 +14,7 @@ import typer
 from footfall._io import remove_outputs, write_json
 from footfall.cli._common import (
     _THREADS_HELP,
+    HEADING_WINDOWS_HELP,
     ROBOT_HELP,
     PushDirectionOption,
     PushDurationOption,
@@ -516,6 +517,7 @@ def walk_cmd(
         "frames, swing bound); --document-reach: eq. (5.12f) in the stance foot's frame only.",
     ),
     heading_segments: int | None = typer.Option(None, help=_WALK_SEGMENTS_HELP),
+    heading_windows: int = typer.Option(2, help=HEADING_WINDOWS_HELP),
     controller: str = typer.Option(DEFAULT_CONTROLLER, help=_CONTROLLER_HELP),
     region_aware: str = typer.Option(
         "horizon",  # WalkOptions.region_aware's default (a test keeps them equal)
@@ -608,6 +610,7 @@ def walk_cmd(
             robot_aware=robot_aware,
             heading_segments=heading_segments,
             monitor=log,
+            heading_windows=heading_windows,
         )
         log.done(plan)
     write_json(out / "plan.json", plan.to_dict(sc.name))

@@ -60,6 +60,7 @@ def plan_for_walk(
     heading_segments: int | None = None,
     monitor: SearchMonitor | None = None,
     threads: int | None = None,
+    heading_windows: int = PlannerOptions.heading_windows,
 ) -> FootstepPlan:
     """The plan of ``scene`` for the MuJoCo biped or another walker model (robot parameters from
     :func:`planner_params`).
@@ -82,6 +83,9 @@ def plan_for_walk(
     (stairs_slope_gap N = 16: to y = 0.39 m). 64 segments (5.6 deg) lose at most 4 cm of width
     there (0.329 m forward at 0.16 m); the plans take longer (stairs_slope_gap N = 16: 38 s
     instead of 4 s).
+
+    ``heading_windows``: :attr:`PlannerOptions.heading_windows` (0: no heading-window search
+    after a solve that found no plan).
 
     ``threads``: worker processes of the ``bnb`` backend (default: 2, or the cores if fewer; not
     part of the plan cache key).
@@ -114,6 +118,7 @@ def plan_for_walk(
         region_margin=margin,
         heading_segments=heading_segments,
         threads=threads,
+        heading_windows=heading_windows,
         **aware,
     )
     plan = cached_plan(
