@@ -14,7 +14,12 @@ import footfall.planning.miqcqp as miqcqp
 from footfall.errors import InputError
 from footfall.planning import PlannerOptions, build_footstep_problem, check_plan, plan_footsteps
 from footfall.planning.cache import plan_key
-from footfall.planning.windows import heading_window_search, pin_headings, window_order
+from footfall.planning.windows import (
+    heading_window_search,
+    pin_headings,
+    window_order,
+    window_schedule,
+)
 from footfall.solvers import SolverResult, SolveStatus, solve
 from footfall.solvers.base import SolveProgress
 from tests.conftest import VirtualClock
@@ -102,7 +107,7 @@ def test_the_search_finds_a_turned_plan_the_checker_accepts(gap) -> None:
     seg_width = 2.0 * math.pi / OPTS.heading_segments
     turned = np.flatnonzero(np.abs(plan.headings) > 0.25 * seg_width + 1e-9)
     assert len(turned) > 0
-    assert np.all(np.abs(turned - found.centre) <= OPTS.heading_windows)
+    assert np.all(np.abs(turned - found.centre) <= found.width)
     # no plan of the whole model is better than the optimum the full solve proves
     best = _solve(fp.problem)
     assert found.objective >= best.objective * (1.0 - 1e-6)
@@ -236,3 +241,57 @@ def test_the_walks_plans_take_the_option(monkeypatch: pytest.MonkeyPatch) -> Non
     with pytest.raises(RuntimeError, match="stop here"):
         plans.plan_for_walk(scene(SHORT_FLAT), "miqcqp", 4, 60.0, heading_windows=0)
     assert seen[0].heading_windows == 0
+
+
+def test_windows_widen_when_none_has_a_plan() -> None:
+    """Hand count, N = 21 (free footsteps 1..19): width 2 has centres 3..17 (15 windows), width 4
+    centres 5..15 (11), width 8 centres 9..11 (3); width 16 would free all 19 (2 x 16 + 1 >= 19),
+    the unrestricted model, so it is not tried."""
+    sched = window_schedule(scene(TURNED_GAP), 21, 2)
+    widths = [w for w, _ in sched]
+    assert widths == [2] * 15 + [4] * 11 + [8] * 3
+    for w in (2, 4, 8):
+        assert [k for ww, k in sched if ww == w] == window_order(scene(TURNED_GAP), 21, w)
+    # a model too short for any window still gets its one window
+    assert window_schedule(scene(TURNED_GAP), 6, 2) == [(2, 3)]
+
+
+def test_the_search_widens_until_a_window_has_a_plan(gap, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Narrow windows made plan-less (an injected solver refuses width 1): the search goes on to
+    width 2 and returns its plan, and tries no width beyond it."""
+    import footfall.planning.windows as windows
+
+    sc, fp = gap
+    real, widths = windows.solve, []
+    pinned_at = windows.pin_headings
+
+    def pin(fp_, centre, width):
+        widths.append(width)
+        return pinned_at(fp_, centre, width)
+
+    def narrow_fails(problem, backend, options):
+        if widths[-1] == 1:
+            return SolverResult(
+                SolveStatus.INFEASIBLE, None, math.nan, math.nan, math.inf, 0.0, backend
+            )
+        return real(problem, backend, options)
+
+    monkeypatch.setattr(windows, "pin_headings", pin)
+    monkeypatch.setattr(windows, "solve", narrow_fails)
+    found = heading_window_search(fp, sc, replace(OPTS, heading_windows=1), 600.0)
+    assert found is not None and found.width == 2
+    assert set(widths) == {1, 2} and widths == sorted(widths)
+    assert check_plan(
+        miqcqp.extract_plan(
+            fp,
+            found.x,
+            status=SolveStatus.TIME_LIMIT,
+            objective=found.objective,
+            bound=math.nan,
+            gap=math.inf,
+            solve_time=0.0,
+            solver="bnb",
+            stats={},
+        ),
+        sc,
+    ).ok

@@ -144,7 +144,7 @@ def _positive_int(field: str, value: int) -> int:
 HEADING_WINDOWS_HELP = (
     "Beyond the document: when the MIQCQP solve ends at its time limit without a plan, search "
     "for as long again with every heading pinned to the start-goal band except at 2 W + 1 "
-    "consecutive footsteps (W = this value); 0: no search."
+    "consecutive footsteps (W = this value, doubled while no window has a plan); 0: no search."
 )
 
 #: help of ``--robot``

@@ -653,11 +653,12 @@ def _windows(
     stats["heading_windows"] = {
         "found": True,
         "centre": found.centre,
+        "width": found.width,
         "tried": found.tried,
         "feasible": found.feasible,
         "seconds": found.seconds,
     }
-    lo, hi = found.centre - options.heading_windows, found.centre + options.heading_windows
+    lo, hi = max(1, found.centre - found.width), min(fp.n_steps - 2, found.centre + found.width)
     plan_result = replace(
         result,
         x=found.x,

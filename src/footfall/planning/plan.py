@@ -127,7 +127,8 @@ class PlannerOptions:
         heading_windows: beyond the document: when the MIQCQP's solve ends at its time limit
             without a plan, the heading-window search (:mod:`footfall.planning.windows`) gets as
             long again: headings pinned to the start-goal band except in a window of
-            ``2 heading_windows + 1`` footsteps. 0: no search. It only runs where the solve
+            ``2 heading_windows + 1`` footsteps (doubled while no window has a plan). 0: no
+            search. It only runs where the solve
             found nothing, so it changes no plan the solve finds.
     """
 

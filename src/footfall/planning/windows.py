@@ -24,8 +24,11 @@ A restriction proven infeasible proves nothing about the model.
 Windows are tried in the order of where a turn is likely needed: the centre ``k`` whose footstep,
 spaced evenly on the straight line from the start to the goal, lies nearest to a hole in the
 terrain (a point of that line inside no region); on a line without holes, from the middle
-outward. Each window is solved to the model's gap; the search keeps the best plan and stops when
-every window is tried or its time is up.
+outward. When no window of that width has a plan, the width doubles (fewer, wider windows; the
+G1's N = 21 plan of stairs_slope_gap turns gradually over footsteps 7-20, which no five-footstep
+window holds), as long as a window leaves some free footstep pinned. Each window is solved to
+the model's gap; the search keeps the best plan, tries no wider windows once it has one, and
+stops when the windows are tried or its time is up.
 """
 
 from __future__ import annotations
@@ -76,6 +79,7 @@ class WindowResult:
         x: the model's variable vector (n,).
         objective: its objective (eq. 5.11).
         centre: the window's centre footstep k.
+        width: its half-width: footsteps k - width .. k + width were free.
         tried: windows solved (or stopped by the clock).
         feasible: windows with a plan.
         seconds: wall time of the search [s].
@@ -84,6 +88,7 @@ class WindowResult:
     x: FloatArray
     objective: float
     centre: int
+    width: int
     tried: int
     feasible: int
     seconds: float
@@ -113,6 +118,20 @@ def window_order(scene: Scene, n_steps: int, width: int) -> list[int]:
     if len(holes) == 0:
         return sorted(centres, key=lambda k: (round(abs(where(k) - 0.5), 9), k))
     return sorted(centres, key=lambda k: (round(float(np.min(np.abs(holes - where(k)))), 9), k))
+
+
+def window_schedule(scene: Scene, n_steps: int, width: int) -> list[tuple[int, int]]:
+    """``(width, centre)`` pairs in the order the search tries them: every centre of
+    :func:`window_order` at ``width``, then at twice the width, and so on while a window leaves
+    some free footstep (1..N-2) pinned (a window over all of them is the unrestricted model,
+    which the solve before the search has had)."""
+    out: list[tuple[int, int]] = []
+    free = n_steps - 2
+    w = width
+    while w >= 1 and (2 * w + 1 < free or not out):
+        out.extend((w, k) for k in window_order(scene, n_steps, w))
+        w *= 2
+    return out
 
 
 def pin_headings(fp: M, centre: int, width: int) -> M:
@@ -152,10 +171,9 @@ def heading_window_search(
     ``after`` (where the unrestricted solve ended: its nodes and seconds are counted on, and its
     bound, which holds for the whole model, stays the bound; a restriction's own bound does not).
     The incumbent is the best plan found so far."""
-    width = options.heading_windows
     t0 = time.perf_counter()
     deadline = t0 + seconds
-    best: tuple[float, FloatArray, int] | None = None
+    best: tuple[float, FloatArray, int, int] | None = None  # objective, x, centre, width
     tried = feasible = nodes_done = 0
     start = after or SolveProgress(0, 0.0, None, math.nan, math.inf)
 
@@ -174,11 +192,13 @@ def heading_window_search(
             )
         )
 
-    for centre in window_order(scene, fp.n_steps, width):
+    for w, centre in window_schedule(scene, fp.n_steps, options.heading_windows):
+        if best is not None and w > best[3]:
+            break  # a plan at this width: no wider windows (slower, and not needed)
         left = deadline - time.perf_counter()
         if left <= 0.0:
             break
-        restricted = pin_headings(fp, centre, width)
+        restricted = pin_headings(fp, centre, w)
         if restricted.problem.bounds_conflict():
             continue
         tried += 1
@@ -193,17 +213,25 @@ def heading_window_search(
             continue
         feasible += 1
         if best is None or result.objective < best[0]:
-            best = (float(result.objective), np.asarray(result.x, dtype=float), centre)
+            best = (float(result.objective), np.asarray(result.x, dtype=float), centre, w)
     if best is None:
         return None
     return WindowResult(
         x=best[1],
         objective=best[0],
         centre=best[2],
+        width=best[3],
         tried=tried,
         feasible=feasible,
         seconds=time.perf_counter() - t0,
     )
 
 
-__all__ = ["HeadingModel", "WindowResult", "heading_window_search", "pin_headings", "window_order"]
+__all__ = [
+    "HeadingModel",
+    "WindowResult",
+    "heading_window_search",
+    "pin_headings",
+    "window_order",
+    "window_schedule",
+]
