@@ -86,11 +86,9 @@ def test_pinning_changes_only_heading_bounds_and_segments_outside_the_window(gap
             assert (pinned.problem.ub[z] == 0.0) == (not meets) or fp.problem.ub[z] == 0.0
 
 
-def test_the_search_finds_a_turned_plan_the_checker_accepts(gap) -> None:
-    sc, fp = gap
-    found = heading_window_search(fp, sc, OPTS, 600.0)
-    assert found is not None and found.feasible >= 1
-    plan = miqcqp.extract_plan(
+def _plan_of(fp, found):
+    """The search's point as a plan (for the independent checker)."""
+    return miqcqp.extract_plan(
         fp,
         found.x,
         status=SolveStatus.TIME_LIMIT,
@@ -101,6 +99,13 @@ def test_the_search_finds_a_turned_plan_the_checker_accepts(gap) -> None:
         solver="bnb",
         stats={},
     )
+
+
+def test_the_search_finds_a_turned_plan_the_checker_accepts(gap) -> None:
+    sc, fp = gap
+    found = heading_window_search(fp, sc, OPTS, 600.0)
+    assert found is not None and found.feasible >= 1
+    plan = _plan_of(fp, found)
     report = check_plan(plan, sc)  # the independent checker, not the solver's rows
     assert report.ok, report.summary()
     # the crossing step is turned (more than a segment) and only the window turns
@@ -281,17 +286,4 @@ def test_the_search_widens_until_a_window_has_a_plan(gap, monkeypatch: pytest.Mo
     found = heading_window_search(fp, sc, replace(OPTS, heading_windows=1), 600.0)
     assert found is not None and found.width == 2
     assert set(widths) == {1, 2} and widths == sorted(widths)
-    assert check_plan(
-        miqcqp.extract_plan(
-            fp,
-            found.x,
-            status=SolveStatus.TIME_LIMIT,
-            objective=found.objective,
-            bound=math.nan,
-            gap=math.inf,
-            solve_time=0.0,
-            solver="bnb",
-            stats={},
-        ),
-        sc,
-    ).ok
+    assert check_plan(_plan_of(fp, found), sc).ok
