@@ -287,3 +287,14 @@ def test_the_search_widens_until_a_window_has_a_plan(gap, monkeypatch: pytest.Mo
     assert found is not None and found.width == 2
     assert set(widths) == {1, 2} and widths == sorted(widths)
     assert check_plan(_plan_of(fp, found), sc).ok
+
+
+def test_a_plan_after_a_solve_without_a_bound_claims_no_gap(
+    gap, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A solve stopped before it had any bound (nan): the window plan's gap is inf, not nan."""
+    sc, _ = gap
+    _no_plan_solve(monkeypatch, bound=math.nan)
+    plan = plan_footsteps(sc, n_steps=N, options=OPTS)
+    assert plan.has_solution and plan.gap == math.inf
+    assert check_plan(plan, sc).ok

@@ -135,9 +135,9 @@ def window_schedule(scene: Scene, n_steps: int, width: int) -> list[tuple[int, i
 
 
 def pin_headings(fp: M, centre: int, width: int) -> M:
-    """``fp`` with every heading outside
-    the window ``|i - centre| <= width`` pinned to the start-goal heading band (module
-    docstring) and the segment binaries outside its bounds fixed to 0."""
+    """``fp`` with every heading outside the window ``|i - centre| <= width`` pinned to the
+    start-goal heading band (module docstring) and the segment binaries outside its bounds fixed
+    to 0."""
     problem = fp.problem
     theta, segments, breaks = fp.theta, fp.segments, fp.breakpoints
     lb, ub = problem.lb.copy(), problem.ub.copy()

@@ -18,8 +18,9 @@ from footfall.solvers.settings import BnbSettings
 
 def relative_gap(objective: float, bound: float) -> float:
     """SCIP's relative gap ``(objective - bound) / min(|objective|, |bound|)`` of a minimisation:
-    0 when the bound reaches the objective, inf without an objective or with a zero denominator."""
-    if not math.isfinite(objective):
+    0 when the bound reaches the objective, inf without an objective, without a bound (nan) or
+    with a zero denominator."""
+    if not math.isfinite(objective) or math.isnan(bound):
         return math.inf
     if objective <= bound:
         return 0.0
