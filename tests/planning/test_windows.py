@@ -298,3 +298,14 @@ def test_a_plan_after_a_solve_without_a_bound_claims_no_gap(
     plan = plan_footsteps(sc, n_steps=N, options=OPTS)
     assert plan.has_solution and plan.gap == math.inf
     assert check_plan(plan, sc).ok
+
+
+@pytest.mark.parametrize("command", ["plan", "walk"])
+def test_the_command_lines_default_is_the_options(command: str) -> None:
+    import inspect
+
+    from footfall.cli import planning, simulation
+
+    fn = planning.plan if command == "plan" else simulation.walk_cmd
+    default = inspect.signature(fn).parameters["heading_windows"].default.default
+    assert default == PlannerOptions.heading_windows

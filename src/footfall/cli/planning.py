@@ -187,7 +187,7 @@ def plan(
         "less conservative (longer steps allowed) and the problem larger.",
     ),
     heading_windows: int = typer.Option(
-        2,
+        2,  # PlannerOptions.heading_windows (a test keeps them equal)
         help=HEADING_WINDOWS_HELP,
     ),
     out: Path = typer.Option(Path("out/plan"), help="Output folder for plan.json and plan.png."),

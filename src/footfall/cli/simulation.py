@@ -517,6 +517,7 @@ def walk_cmd(
         "frames, swing bound); --document-reach: eq. (5.12f) in the stance foot's frame only.",
     ),
     heading_segments: int | None = typer.Option(None, help=_WALK_SEGMENTS_HELP),
+    # PlannerOptions.heading_windows (a test keeps them equal)
     heading_windows: int = typer.Option(2, help=HEADING_WINDOWS_HELP),
     controller: str = typer.Option(DEFAULT_CONTROLLER, help=_CONTROLLER_HELP),
     region_aware: str = typer.Option(

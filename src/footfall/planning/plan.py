@@ -128,8 +128,8 @@ class PlannerOptions:
             without a plan, the heading-window search (:mod:`footfall.planning.windows`) gets as
             long again: headings pinned to the start-goal band except in a window of
             ``2 heading_windows + 1`` footsteps (doubled while no window has a plan). 0: no
-            search. It only runs where the solve
-            found nothing, so it changes no plan the solve finds.
+            search. It only runs where the solve found nothing, so it changes no plan the solve
+            finds.
     """
 
     weights: PlannerWeights = field(default_factory=PlannerWeights)
