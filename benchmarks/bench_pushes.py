@@ -82,7 +82,9 @@ def _walk(
     from footfall.sim.trial import run_trial
     from footfall.terrain.scene import builtin_scene
 
-    scene_name, controller, region, size, seed, cache, robot, unit, steps, leg, literal = job
+    scene_name, controller, region, size, seed, cache, robot, unit, steps, leg, literal, timing = (
+        job
+    )
     scene = builtin_scene(scene_name)
     model = robot_model(robot)
     n = steps or SCENES.get(scene_name)
@@ -90,6 +92,8 @@ def _walk(
     options = WalkOptions(controller=controller, region_aware=region, leg_momentum=leg)
     if literal:
         options = replace(options, torque_weight_mass=None)
+    if timing is not None:
+        options = replace(options, step_timing=timing == "on")
     plant = MujocoBipedPlant(options, robot=model)
     push = (
         Disturbance.of_seed(seed, dv=size)
@@ -167,6 +171,13 @@ def main() -> None:
         help="WalkOptions.torque_weight_mass=None: the MPC's ankle-torque weight R the same for "
         "every robot (default: scaled by the robot's mass, the same weight per metre of CoP)",
     )
+    ap.add_argument(
+        "--step-timing",
+        choices=("on", "off"),
+        default=None,
+        help="WalkOptions.step_timing: the MPC may end a single support sooner (default: the "
+        "walker's, on)",
+    )
     ap.add_argument("--seeds", type=int, default=10, help="walks per scene, controller, impulse")
     ap.add_argument("--seed-start", type=int, default=0, help="first seed (held-out seeds)")
     ap.add_argument("--workers", type=int, default=2)
@@ -207,7 +218,7 @@ def main() -> None:
     variants = [(ctl, mode) for ctl in controllers for mode in modes]
     a.out.mkdir(parents=True, exist_ok=True)
     cache = str(a.out / "plans")
-    common = (a.robot, unit, a.steps, a.leg_momentum, a.literal_torque_weight)
+    common = (a.robot, unit, a.steps, a.leg_momentum, a.literal_torque_weight, a.step_timing)
     jobs = [
         (sc, ctl, mode, imp, seed, cache, *common)
         for sc in scenes

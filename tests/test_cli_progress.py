@@ -132,6 +132,7 @@ def test_walk_logs_its_smallest_n_search_and_records_its_controller(tmp_path: Pa
         "capture_stop": True,
         "walk_on": 4,
         "torque_weight_mass": 30.1,
+        "step_timing": True,  # the walker's default
     }
 
 

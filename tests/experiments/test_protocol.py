@@ -274,6 +274,17 @@ def test_walker_defaults_are_stored_resolved() -> None:
     assert proto.leg_momentum == 0.5 and proto.walk_on == 4
     assert PushProtocol(dv=(0.1,), walk_on=0).walk_on == 0
     assert PushProtocol(dv=(0.1,), controller="servo").leg_momentum == 0.0
+    assert proto.step_timing is True
+    assert PushProtocol(dv=(0.1,), step_timing=False).step_timing is False
+
+
+def test_the_protocols_walker_takes_the_step_timing() -> None:
+    pytest.importorskip("mujoco")
+    from footfall.experiments import protocol as proto
+
+    for on in (True, False):
+        plant = proto._plant("biped", "wbc", "horizon", None, None, on)
+        assert plant.options.step_timing is on
 
 
 def test_reports_name_the_leg_momentum_share_only_when_on() -> None:

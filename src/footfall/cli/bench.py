@@ -325,6 +325,12 @@ def bench_pushes_cmd(
         help="Stopping steps the walker may add, two at a time, to reach the goal after a push "
         "(0: never; default: the walker's, 4; see footfall walk --walk-on).",
     ),
+    step_timing: bool | None = typer.Option(
+        None,
+        "--step-timing/--no-step-timing",
+        help="Whether the walker's MPC may end a single support sooner when that saves cost "
+        "(default: the walker's, on; see footfall walk --step-timing).",
+    ),
     dv: str = typer.Option("0.1,0.2,0.3", "--dv", help=_DV_HELP),
     phases: str = typer.Option(
         "0.2,0.45,0.7",
@@ -393,6 +399,7 @@ def bench_pushes_cmd(
         region_aware=region_aware,
         leg_momentum=leg_momentum,
         walk_on=walk_on,
+        step_timing=step_timing,
     )
     from footfall.robots.registry import resolve_robot_file
     from footfall.terrain.resolve import resolve_scene

@@ -50,6 +50,19 @@ def check_region_mode(value: object) -> str:
     return value
 
 
+#: shortest time to touchdown the MPC's step timing may leave, as a share of what the planned
+#: single support has left: the swing runs at most 1 / 0.7 = 1.43 times as fast as planned (at
+#: 0.5 Alexander's heavy legs landed 20 cm off the commanded footstep and it fell)
+TIMING_MIN_SHARE = 0.7
+#: the step timing moves a touchdown only in this first share of the single support: moved
+#: later, the sole is already descending and lands late (the biped's discrete_steps walk pushed
+#: forward at 20 % of a support at 0.2 m/s fell when its next support was shortened at 58 %)
+TIMING_UNTIL = 0.5
+#: eq. (5.19a) cost a shorter single support must save (0.5: a 22 cm footstep deviation at the
+#: default W). Unpushed walks cost 0.01-0.1 and differ by up to 0.1 between touchdown times; a
+#: 0.3 m/s push makes the cost 1-30
+TIMING_MARGIN = 0.5
+
 #: another region is chosen over the preferred one when its eq. (5.19a) cost is lower by more
 #: than this: the cost of a 10 cm footstep deviation at the default W (MPCWeights.w = 10)
 SWITCH_MARGIN = 0.1
@@ -407,6 +420,24 @@ class MPCAdjuster(PlanFollower):
             decision.
         landing_margin: extra inset [m] of the regions beyond the sole (``region_aware``).
         switch_margin: cost margin of a region switch (``nearby``).
+        step_timing: choose the touchdown time with the footstep, against the MPC's own cost
+            (beyond document 000, whose single support has a fixed length; dairlib's ALIP
+            footstep MPC does the same). At every tick before the footstep freezes, eq. (5.19)
+            is solved as if the single support ended ``j`` ticks sooner (the condensed problem
+            of tick ``k_s + j``, which has ``j`` ticks less to go) for every ``j`` that leaves
+            at least ``timing_min_share`` of the planned time to touchdown; the touchdown moves
+            forward when one of them costs less than the fixed timing by more than
+            ``timing_margin``. Only shortening: the MPC is precomputed for the planned T_ss.
+            The walker reads the time gained with :meth:`take_advance` and moves its clock.
+            Never on the last stopping step (its footstep is the capture stop's).
+        timing_min_share: the shortest time to touchdown the timing may leave, as a share of
+            the time the planned single support has left (the swing runs at most
+            ``1 / timing_min_share`` times as fast as planned).
+        timing_until: the touchdown moves only while the single support (on the moved clock)
+            is in this first share of T_ss.
+        timing_margin: cost of eq. (5.19a) a shorter single support must save.
+        timing_stride: ticks between the touchdown times compared (the latest allowed one is
+            always compared).
     """
 
     control_dt: float = 0.01
@@ -419,7 +450,15 @@ class MPCAdjuster(PlanFollower):
     region_aware: str = "off"
     landing_margin: float = 0.0
     switch_margin: float = SWITCH_MARGIN
+    step_timing: bool = False
+    timing_min_share: float = TIMING_MIN_SHARE
+    timing_margin: float = TIMING_MARGIN
+    timing_until: float = TIMING_UNTIL
+    timing_stride: int = 2
     mpc: MPC = field(init=False, repr=False)
+    #: ticks each phase's single support was shortened by (``step_timing``)
+    saved_ticks: dict[int, int] = field(default_factory=dict, repr=False)
+    _advance: float = field(default=0.0, repr=False)
     choices: dict[int, RegionChoice] = field(default_factory=dict, repr=False)
     _frozen_torque: dict[int, FloatArray] = field(default_factory=dict, repr=False)
     _nearby: dict[int, tuple[str, ...]] = field(default_factory=dict, repr=False)
@@ -434,6 +473,16 @@ class MPCAdjuster(PlanFollower):
             raise InputError("landing_margin", self.landing_margin, "a finite number >= 0 [m]")
         if not (math.isfinite(self.switch_margin) and self.switch_margin >= 0.0):
             raise InputError("switch_margin", self.switch_margin, "a finite number >= 0")
+        if not (math.isfinite(self.timing_min_share) and 0.0 < self.timing_min_share <= 1.0):
+            raise InputError("timing_min_share", self.timing_min_share, "a share in (0, 1]")
+        if not (math.isfinite(self.timing_until) and 0.0 <= self.timing_until <= 1.0):
+            raise InputError("timing_until", self.timing_until, "a share in [0, 1]")
+        if not (math.isfinite(self.timing_margin) and self.timing_margin >= 0.0):
+            raise InputError("timing_margin", self.timing_margin, "a finite number >= 0")
+        if isinstance(self.timing_stride, bool) or not (
+            isinstance(self.timing_stride, int) and self.timing_stride >= 1
+        ):
+            raise InputError("timing_stride", self.timing_stride, "an integer >= 1 [ticks]")
         super().__post_init__()
         mdl = build_mpc(self.plan.robot, self.weights, self.control_dt, None, self.torque_limits)
         self.mpc = MPC(mdl)
@@ -466,6 +515,18 @@ class MPCAdjuster(PlanFollower):
         )
         if phase in self._frozen and self.hold_frozen:
             return self._frozen[phase], self._frozen_torque[phase]
+        if (
+            self.step_timing
+            and phase not in self._frozen
+            and not (self.capture_stop and phase == plan.n_steps - 1)
+        ):
+            k_new = self._touchdown_tick(phase, args, stance)
+            if k_new > k_s:
+                self._advance += (k_new - k_s) * mdl.control_dt
+                self.saved_ticks[phase] = self.saved_ticks.get(phase, 0) + k_new - k_s
+                k_s = k_new
+                t = k_s * mdl.control_dt
+                args = (k_s, *args[1:])
         if self.region_aware != "off" and phase not in self._frozen:
             target, u = self._region_aware(t, phase, args, rot, state, stance, ref_next)
             if self.capture_stop and phase == plan.n_steps - 1:
@@ -494,6 +555,68 @@ class MPCAdjuster(PlanFollower):
         if phase in self._frozen:
             self._frozen_torque[phase] = u
         return target, u
+
+    def take_advance(self) -> float:
+        """Seconds the touchdown moved forward since the last call (``step_timing``); the
+        walker moves its clock by them. 0.0 without ``step_timing``."""
+        out, self._advance = self._advance, 0.0
+        return out
+
+    def _touchdown_tick(
+        self,
+        phase: int,
+        args: tuple[int, FloatArray, FloatArray, FloatArray, FloatArray],
+        stance: FloatArray,
+    ) -> int:
+        """The tick of the MPC's condensed problem to solve now (``step_timing``): ``k_s``, or
+        a later one whose shorter time to touchdown costs less by ``timing_margin``.
+
+        The cost of a touchdown time is eq. (5.19a)'s optimum with the footstep in the region
+        it is in now (the region chosen earlier in this support, else the planned one), or
+        unconstrained when the regions do not hold it. Every cost is >= 0, so when the fixed
+        timing costs ``timing_margin`` or less no other is solved. The MPC's warm starts and
+        counters are left as they were (:meth:`RegionMPC.probe`): the solve that is applied
+        runs as it would have.
+        """
+        mdl = self.mpc.model
+        k_s, x_r, ps_r, pr_r, xn_r = args
+        m = mdl.n_ticks
+        elapsed = k_s - self.saved_ticks.get(phase, 0)  # ticks really spent in this support
+        # the swing may run at most 1 / timing_min_share times as fast as planned: the ticks
+        # left keep that share of what the planned single support has left
+        left = math.ceil(self.timing_min_share * (m - elapsed) - 1e-9)
+        k_hi = min(m - 1, m - left)
+        if k_s >= self.timing_until * m or k_hi <= k_s:
+            return k_s
+        theta = np.concatenate([x_r, pr_r[:2] - ps_r[:2], xn_r])
+        rows = None
+        if self.region_aware != "off" or self.footstep_in_region:
+            name = self.choices[phase].region if phase in self.choices else ""
+            name = name or self.plan.regions[phase + 1]
+            if name in self.regions:
+                rot, _ = self._stance_frame(phase)
+                heading = float(self.plan.headings[phase + 1])
+                rows = self._rows(phase, name, stance, heading, rot)
+
+        def cost(k: int) -> float:
+            if rows is not None:
+                return self.region_mpc.solve_region(k, theta, ps_r, pr_r, rows).cost
+            sol = self.mpc.solve_theta(k, theta, ps_r, pr_r)
+            if sol.fallback:
+                return math.inf
+            d = sol.next_footstep[:2] - ps_r[:2]
+            return mdl.cost(k, np.concatenate([sol.torques.ravel(), d]), theta)
+
+        with self.region_mpc.probe():
+            now = cost(k_s)
+            if not now > self.timing_margin:  # nothing to save
+                return k_s
+            ticks = list(range(k_s + self.timing_stride, k_hi + 1, self.timing_stride))
+            if not ticks or ticks[-1] != k_hi:
+                ticks.append(k_hi)
+            costs = [cost(k) for k in ticks]
+        best = int(np.argmin(costs))
+        return ticks[best] if costs[best] < now - self.timing_margin else k_s
 
     def _stance_frame(self, phase: int) -> tuple[FloatArray, FloatArray]:
         """The stance heading's rotation (2, 2) of ``phase`` and its ALIP-state form (4, 4)

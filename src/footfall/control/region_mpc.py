@@ -40,7 +40,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -267,6 +268,19 @@ class RegionMPC:
             self._m_inv.append(np.asarray(np.linalg.inv(m), dtype=float))
             self._lam_min.append(float(np.linalg.eigvalsh(m)[0]))
             self._m_lin.append(f[n_u:] + h_ud.T @ u0)
+
+    @contextmanager
+    def probe(self) -> Iterator[None]:
+        """Solves inside leave no trace: the warm starts (this object's and the wrapped
+        :class:`MPC`'s last solution) and the MPC's counters are restored on exit. For
+        questions asked beside the solve that is applied (the adjuster's step timing solves
+        other touchdown times), so that solve runs exactly as it would have."""
+        mpc = self.mpc
+        saved = (dict(self._warm), mpc._last, mpc.n_solves, mpc.n_fallbacks)
+        try:
+            yield
+        finally:
+            self._warm, mpc._last, mpc.n_solves, mpc.n_fallbacks = saved
 
     def relaxed(
         self, k_s: int, theta: FloatArray, rows: RegionRows

@@ -95,6 +95,9 @@ class PushProtocol:
         walk_on: stopping steps the walker may add to reach the goal
             (:attr:`footfall.sim.biped.options.WalkOptions.walk_on`; 0: never; None: the
             walker's default, stored resolved).
+        step_timing: whether the walker's MPC may end a single support sooner
+            (:attr:`footfall.sim.biped.options.WalkOptions.step_timing`; None: the walker's
+            default, stored resolved).
     """
 
     dv: tuple[float, ...]
@@ -110,6 +113,7 @@ class PushProtocol:
     region_aware: str = "horizon"  # WalkOptions.region_aware's default (a test keeps them equal)
     leg_momentum: float | None = None
     walk_on: int | None = None
+    step_timing: bool | None = None
 
     def __post_init__(self) -> None:
         from footfall.control.adjusters import check_region_mode
@@ -120,7 +124,10 @@ class PushProtocol:
             walker = WalkOptions(controller=self.controller, leg_momentum=self.leg_momentum)
             if self.walk_on is not None:
                 walker = dataclasses.replace(walker, walk_on=self.walk_on)
+            if self.step_timing is not None:
+                walker = dataclasses.replace(walker, step_timing=self.step_timing)
             object.__setattr__(self, "walk_on", walker.walk_on)
+            object.__setattr__(self, "step_timing", walker.step_timing)
             object.__setattr__(self, "leg_momentum", walker.legs_share)
         dv = tuple(finite("dv [m/s]", v) for v in self.dv)
         if not dv or any(v <= 0 for v in dv) or len(set(dv)) != len(dv):
@@ -210,10 +217,11 @@ def _plant(
     region_aware: str,
     leg_momentum: float | None = None,
     walk_on: int | None = None,
+    step_timing: bool | None = None,
 ) -> Any:
     """The MuJoCo plant of ``robot`` with ``controller``, the MPC's ``region_aware`` mode, the
-    ``leg_momentum`` share and the stopping steps it may add (``walk_on``; None: the walker's
-    defaults), one per worker process."""
+    ``leg_momentum`` share, the stopping steps it may add (``walk_on``) and its ``step_timing``
+    (None: the walker's defaults), one per worker process."""
     from footfall.sim.biped.options import WalkOptions
     from footfall.sim.biped.plans import robot_model
     from footfall.sim.trial import make_plant
@@ -223,6 +231,8 @@ def _plant(
     )
     if walk_on is not None:
         options = dataclasses.replace(options, walk_on=walk_on)
+    if step_timing is not None:
+        options = dataclasses.replace(options, step_timing=step_timing)
     return make_plant(
         "mujoco",
         options=options,
@@ -236,6 +246,7 @@ def _walk_case(
     region_aware: str,
     leg_momentum: float | None,
     walk_on: int | None,
+    step_timing: bool | None,
     scene: Any,
     plan: Any,
     case: PushCase,
@@ -244,7 +255,7 @@ def _walk_case(
     """Walk one case; its row (:data:`COLUMNS`)."""
     from footfall.sim.trial import run_trial, trial_pushes
 
-    plant = _plant(robot, controller, region_aware, leg_momentum, walk_on)
+    plant = _plant(robot, controller, region_aware, leg_momentum, walk_on, step_timing)
     pushes = trial_pushes(plant, plan, d)
     out = run_trial(plant, scene, plan, d)
     reached = bool(out.detail.metrics.reached_goal)
@@ -309,7 +320,9 @@ def run_protocol(
             progress(row)
     p = protocol
     mass = float(
-        _plant(p.robot, p.controller, p.region_aware, p.leg_momentum, p.walk_on).mass(plan)
+        _plant(
+            p.robot, p.controller, p.region_aware, p.leg_momentum, p.walk_on, p.step_timing
+        ).mass(plan)
     )
     return ProtocolResult(
         protocol, scene.name, int(plan.n_steps), step, mass, [rows[c] for c in cases]
@@ -324,7 +337,16 @@ def _walks(
     workers: int,
 ) -> Iterator[tuple[PushCase, dict[str, Any]]]:
     p = protocol
-    args = (p.robot, p.controller, p.region_aware, p.leg_momentum, p.walk_on, scene, plan)
+    args = (
+        p.robot,
+        p.controller,
+        p.region_aware,
+        p.leg_momentum,
+        p.walk_on,
+        p.step_timing,
+        scene,
+        plan,
+    )
     if workers <= 1 or len(jobs) <= 1:
         for case, d in jobs:
             yield case, _walk_case(*args, case, d)
@@ -415,9 +437,10 @@ def format_summary(result: ProtocolResult) -> str:
 
 
 def _legs(p: PushProtocol) -> str:
-    """The leg-momentum share in a summary line (nothing when it is off)."""
+    """The leg-momentum share and the step timing in a summary line (nothing when off)."""
     share = float(p.leg_momentum or 0.0)
-    return f", legs' momentum {share:g}" if share > 0 else ""
+    legs = f", legs' momentum {share:g}" if share > 0 else ""
+    return legs + (", step timing" if p.step_timing else "")
 
 
 def format_markdown(result: ProtocolResult) -> str:

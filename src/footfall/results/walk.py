@@ -288,6 +288,10 @@ class WalkMetrics:
             plan's (by geometry: ``{"step", "planned", "region"}``, region "" for none).
         region_choices: the region-aware adjuster's last decision per phase
             (:class:`~footfall.control.adjusters.RegionChoice` as dicts; empty otherwise).
+        touchdowns_moved: the single supports the MPC's step timing shortened
+            (``{"step", "earlier_s"}``: the single support and how much sooner [s] its swing
+            foot was to land; empty when none was,
+            :attr:`~footfall.control.adjusters.MPCAdjuster.step_timing`).
     """
 
     fell: bool
@@ -311,6 +315,7 @@ class WalkMetrics:
     correction_m: MeanMax = MeanMax(math.nan, math.nan)
     region_changes: tuple[dict[str, Any], ...] = ()
     region_choices: tuple[dict[str, Any], ...] = ()
+    touchdowns_moved: tuple[dict[str, Any], ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """The metrics as JSON-ready nested dicts and lists (walk.json's ``metrics``)."""
@@ -336,6 +341,7 @@ class WalkMetrics:
             "correction_m": self.correction_m.to_dict(),
             "region_changes": list(self.region_changes),
             "region_choices": list(self.region_choices),
+            "touchdowns_moved": list(self.touchdowns_moved),
         }
 
 

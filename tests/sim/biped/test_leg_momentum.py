@@ -170,5 +170,6 @@ def test_walk_command_records_the_share(tmp_path):
         "capture_stop": True,
         "walk_on": 4,
         "torque_weight_mass": 30.1,
+        "step_timing": True,
     }
     assert walked["metrics"]["reached_goal"]

@@ -80,7 +80,8 @@ def test_adjuster_takes_the_added_steps_and_its_capture_stop_moves():
 @pytest.fixture(scope="module")
 def inward_push():  # type: ignore[no-untyped-def]
     """flat_long, 20 steps, pushed inward at 0.5 m/s at 70 % of single support 10 (the push
-    protocol's hardest case for the biped): walked with and without added steps."""
+    protocol's hardest case for the biped with the fixed timing): walked with and without added
+    steps."""
     pytest.importorskip("mujoco")
     from footfall.planning.plan_file import load_plan
     from footfall.sim.biped.trial import MujocoBipedPlant
@@ -97,7 +98,10 @@ def inward_push():  # type: ignore[no-untyped-def]
     )
     out = {}
     for walk_on in (0, WALK_ON):
-        plant = MujocoBipedPlant(WalkOptions(walk_on=walk_on))
+        # with the fixed timing: the MPC's step timing lands the next support 0.12 s sooner and
+        # the stop is then at the goal without added steps (goal error 25 mm), so this case
+        # no longer tests them
+        plant = MujocoBipedPlant(WalkOptions(walk_on=walk_on, step_timing=False))
         out[walk_on] = run_trial(plant, scene, plan, push).detail
     return scene, plan, out
 

@@ -54,6 +54,11 @@ class SwingState:
     rot1: FloatArray = field(default_factory=lambda: np.eye(3))
     #: ``rot1`` pitched for the heel strike, the swing's end orientation (3, 3)
     rot1_strike: FloatArray = field(default_factory=lambda: np.eye(3))
+    #: the swing path's progress share and the step time [s] (on the moved clock) when its
+    #: touchdown last moved forward (the MPC's step timing; 0.0 and 0.0: never): from there
+    #: the path runs to its end by T_ss on the moved clock
+    tau0: float = 0.0
+    tp0: float = 0.0
 
 
 @dataclass

@@ -163,6 +163,9 @@ class BipedWalk:
         self.target_speed = swing_target_speed(robot)
         self.t_step = self.t_ss + self.t_ds
         self.t_walk0 = opts.settle_time + opts.shift_time
+        #: time the MPC's step timing moved the touchdowns forward by, in all and before the
+        #: last planned step ended [s]
+        self.t_saved = self.t_saved_planned = 0.0
         self._set_timeline()
         self._init_state()
         #: records the joint positions for ``footfall view`` when :meth:`run` is given one
@@ -186,6 +189,7 @@ class BipedWalk:
             landing_margin=opts.landing_margin,
             capture_stop=opts.capture_stop,
             weights=MPCWeights(r_mass=opts.torque_weight_mass),
+            step_timing=opts.step_timing,
         )
 
     def _init_state(self) -> None:
@@ -329,7 +333,7 @@ class BipedWalk:
 
     def _stepping(self, k: int, t: float, obs: Observation, c_next: FloatArray) -> Command:
         """Step i of the plan: single support (adjuster, ALIP reference, swing), then double."""
-        tw = t - self.t_walk0
+        tw = t - self.t_walk0 + self.t_saved
         i = min(int(tw / self.t_step), self.n - 1)
         tp = tw - i * self.t_step
         if i != self.swing.phase:
@@ -338,7 +342,7 @@ class BipedWalk:
         single = tp < self.t_ss
         if single:
             self.log.phase[k] = i
-            ref_xy, feet, yaw = self._single_support(k, i, tp, stance, obs)
+            ref_xy, feet, yaw, tp = self._single_support(k, i, tp, stance, obs)
         else:
             ref_xy, feet, yaw = self._double_support(i, stance)
         support = i if single else i + 1
@@ -363,6 +367,7 @@ class BipedWalk:
                 self._maybe_walk_on(i)
                 plan = self.plan
         swing.phase = i
+        swing.tau0 = swing.tp0 = 0.0
         swing.stance = plan.sides[i]
         swing_side = swing.stance.other
         swing.start = sim.sole(swing_side)[0]
@@ -383,8 +388,11 @@ class BipedWalk:
     def _set_timeline(self) -> None:
         """When the steps end and the walk's ticks (steps, stop, hold), from the steps ``n``."""
         opts = self.opts
-        self.t_end_steps = self.t_walk0 + self.n * self.t_step
-        self.n_ticks = round((self.t_end_steps + opts.stop_time + opts.hold_time) / self.dt)
+        # touchdowns moved forward end the steps sooner; the walk keeps its length (the hold
+        # grows), so the trace is never shorter than the ticks already walked
+        t_steps = self.t_walk0 + self.n * self.t_step
+        self.t_end_steps = t_steps - self.t_saved
+        self.n_ticks = round((t_steps + opts.stop_time + opts.hold_time) / self.dt)
 
     def _maybe_walk_on(self, i: int) -> None:
         """Before the last stopping step ``i``: when the foot that just landed lies more than
@@ -422,13 +430,17 @@ class BipedWalk:
         """
         swing = self.swing
         free = not self.opts.swing_target_rate
-        if not free and tp < SWING_MOVE[0] * self.t_ss - 1e-9:
-            left = SWING_MOVE[1] * self.t_ss - tp
-            free = float(np.linalg.norm(nxt - swing.target)) > self.target_speed * left
+        # a swing shortened by the step timing runs faster, and so may its target
+        fast = self._swing_speedup()
+        speed = self.target_speed * fast
+        t_path = self._swing_time(tp)
+        if not free and t_path < SWING_MOVE[0] * self.t_ss - 1e-9:
+            left = (SWING_MOVE[1] * self.t_ss - t_path) / fast
+            free = float(np.linalg.norm(nxt - swing.target)) > speed * left
         if free:
             swing.target = np.array(nxt, dtype=float)
         else:
-            swing.target = step_toward(swing.target, nxt, self.target_speed * self.dt)
+            swing.target = step_toward(swing.target, nxt, speed * self.dt)
         return swing.target.copy()
 
     def _raise_swing(self, tp: float, nxt: FloatArray) -> None:
@@ -436,7 +448,7 @@ class BipedWalk:
         one: while the sole is still rising, raise the apex over the regions under the new path
         (never lower it) and re-time the descent to the new target height."""
         swing = self.swing
-        if self.opts.region_aware == "off" or tp / self.t_ss >= swing.rise:
+        if self.opts.region_aware == "off" or self._swing_time(tp) / self.t_ss >= swing.rise:
             return
         if float(np.linalg.norm(nxt - swing.apex_for)) <= SWING_RETARGET:
             return
@@ -446,12 +458,48 @@ class BipedWalk:
         _, swing.descend = swing_shares(0.0, swing.apex - float(nxt[2]), self.t_ss)
         swing.apex_for = np.array(nxt, dtype=float)
 
+    def _swing_speedup(self) -> float:
+        """How much faster than planned the swing path runs: exactly 1.0 until a touchdown
+        moved forward (:attr:`~footfall.control.adjusters.MPCAdjuster.step_timing`), then the
+        path left at the move over the time left to the new touchdown."""
+        swing = self.swing
+        if swing.tp0 == 0.0:
+            return 1.0
+        return (1.0 - swing.tau0) * self.t_ss / (self.t_ss - swing.tp0)
+
+    def _swing_time(self, tp: float) -> float:
+        """Where the swing path is at step time ``tp`` [s], as the time [s] of the planned path
+        (``tp`` itself until a touchdown moved forward; the path is a function of this time over
+        T_ss)."""
+        swing = self.swing
+        if swing.tp0 == 0.0:
+            return tp
+        return swing.tau0 * self.t_ss + (tp - swing.tp0) * self._swing_speedup()
+
+    def _move_touchdown(self, i: int, tp: float) -> float:
+        """The adjuster moved the touchdown of single support ``i`` forward by some seconds (its
+        step timing): move the walk's clock by them and re-time the swing path from where it is
+        to land at the new touchdown. Returns the step time [s] on the moved clock."""
+        take = getattr(self.src, "take_advance", None)
+        adv = take() if take is not None else 0.0
+        if adv <= 0.0:
+            return tp
+        swing = self.swing
+        swing.tau0 = min(1.0, self._swing_time(tp) / self.t_ss)
+        swing.tp0 = tp + adv
+        self.t_saved += adv
+        if i < self.n_planned:
+            self.t_saved_planned += adv
+        self.t_end_steps -= adv
+        return tp + adv
+
     def _single_support(
         self, k: int, i: int, tp: float, stance: FloatArray, obs: Observation
-    ) -> tuple[FloatArray, SolePoses, float]:
+    ) -> tuple[FloatArray, SolePoses, float, float]:
         """Ask the adjuster, advance the ALIP reference (eq. 5.5), place the swing sole.
 
-        Returns the reference CoM (2,) [m], the sole targets and the torso yaw [rad].
+        Returns the reference CoM (2,) [m], the sole targets, the torso yaw [rad] and the step
+        time [s] (moved when the adjuster moved the touchdown forward).
         """
         opts, alip, ref = self.opts, self.alip, self.ref
         # measured ALIP state about the stance sole centre (eq. 5.1)
@@ -465,6 +513,7 @@ class BipedWalk:
         if self.leg_momentum is not None:
             x_meas = x_meas + self.leg_momentum.shift(i, tp, obs.l_g, float(self.plan.headings[i]))
         nxt, u = self.src.update(tp, x_meas, stance, i)
+        tp = self._move_touchdown(i, tp)
         nxt = self._limit_target(nxt, tp)
         self._raise_swing(tp, nxt)
         self.log.targets[i] = nxt
@@ -482,7 +531,7 @@ class BipedWalk:
         ref.ds_aug = np.concatenate(
             [ref.x, np.zeros(3), (self.log.targets[i] - stance) / self.t_ds]
         )
-        return ref_xy, feet, yaw
+        return ref_xy, feet, yaw, tp
 
     def _swing_targets(
         self, i: int, tp: float, stance: FloatArray, nxt: FloatArray
@@ -491,7 +540,7 @@ class BipedWalk:
         opts, plan, swing, feet = self.opts, self.plan, self.swing, self.feet
         stance_side = swing.stance
         swing_side = stance_side.other
-        tau = min(1.0, (tp + self.dt) / self.t_ss)
+        tau = min(1.0, self._swing_time(tp + self.dt) / self.t_ss)
         gap = self.robot.foot_width + opts.swing_side_gap if opts.swing_side_gap > 0 else 0.0
         pos, s_h = swing_reference(
             tau, swing.start, nxt, swing.apex, swing.rise, swing.descend, stance, gap
@@ -582,7 +631,7 @@ class BipedWalk:
         if opts.ankle_torque and cmd.single:
             ankle[stance_side] = act.ankle_u
             i = cmd.phase
-            late = cmd.tp >= self.swing.descend * self.t_ss
+            late = self._swing_time(cmd.tp) >= self.swing.descend * self.t_ss
             if opts.passive_landing and act.landed_in != i and late:
                 if self._loaded_cop(swing_side, obs) is not None:
                     act.landed_in = i
@@ -735,13 +784,17 @@ class BipedWalk:
         elif self.ik is not None:
             self.log.controller = {"name": "servo", "ik_failures": self.ik.failures}
         log = self.log.trimmed(k_end, self.dt)
-        t_goal = self.t_walk0 + self.n_planned * self.t_step
+        t_goal = self.t_walk0 + self.n_planned * self.t_step - self.t_saved_planned
         metrics = summarise(log, self.scene, self.plan, self.sim.params, t_goal)
         choices = getattr(self.src, "choices", None)
         if choices:
             metrics = dataclasses.replace(
                 metrics, region_choices=tuple(c.to_dict() for c in choices.values())
             )
+        saved = getattr(self.src, "saved_ticks", None)
+        if saved:
+            moved = tuple({"step": i, "earlier_s": n * self.dt} for i, n in sorted(saved.items()))
+            metrics = dataclasses.replace(metrics, touchdowns_moved=moved)
         return WalkResult(
             trace=log,
             metrics=metrics,
