@@ -43,7 +43,8 @@ def stones() -> tuple[Scene, FootstepPlan]:
     return scene, plan
 
 
-def _adjuster(plan: FootstepPlan, scene: Scene, mode: str) -> MPCAdjuster:
+def _adjuster(plan: FootstepPlan, scene: Scene, mode: str, **kw: object) -> MPCAdjuster:
+    """The walker's MPC adjuster (its control period and sole torque ellipse) in ``mode``."""
     regions = {r.name: r for r in scene.terrain.regions}
     return MPCAdjuster(
         plan,
@@ -51,6 +52,7 @@ def _adjuster(plan: FootstepPlan, scene: Scene, mode: str) -> MPCAdjuster:
         control_dt=DT,
         torque_limits=sole_torque_limits(plan.robot),
         region_aware=mode,
+        **kw,  # type: ignore[arg-type]
     )
 
 

@@ -22,7 +22,6 @@ from footfall.control.adjusters import (
     TIMING_MIN_SHARE,
     TIMING_UNTIL,
     MPCAdjuster,
-    sole_torque_limits,
 )
 from footfall.control.region_mpc import RegionMPC
 from footfall.errors import InputError
@@ -30,10 +29,10 @@ from footfall.experiments.bench_horizon import _pushed_state
 from footfall.planning.plan import FootstepPlan
 from footfall.planning.reactive import plan_reactive
 from footfall.terrain import Scene, builtin_scene
+from tests.control.test_horizon_regions import DT
+from tests.control.test_horizon_regions import _adjuster as walker_adjuster
 from tests.control.test_mpc import reference_solve
 
-#: the walker's control period [s]
-DT = 0.01
 #: the pushed single support and the push: forward, at its start
 STEP, PUSH = 4, (0.6, 0.0)
 #: the reference SOCP's optimal cost against the adjuster's (relative), as in test_mpc
@@ -49,15 +48,7 @@ def flat() -> tuple[Scene, FootstepPlan]:
 
 
 def _adjuster(scene: Scene, plan: FootstepPlan, **kw: object) -> MPCAdjuster:
-    regions = {r.name: r for r in scene.terrain.regions}
-    return MPCAdjuster(
-        plan,
-        regions,
-        control_dt=DT,
-        torque_limits=sole_torque_limits(plan.robot),
-        region_aware="planned",
-        **kw,  # type: ignore[arg-type]
-    )
+    return walker_adjuster(plan, scene, "planned", **kw)
 
 
 def _theta(adj: MPCAdjuster, x: np.ndarray, step: int) -> np.ndarray:
