@@ -229,9 +229,24 @@ def test_the_swing_target_jumps_only_to_a_footstep_the_bound_could_not_reach_in_
     assert walker._limit_target(jump, 0.0) == pytest.approx(
         planned + np.array([0.0, -0.01375, 0.0]), abs=1e-12
     )
-    # once the sole moves (tp >= 0.04 s) even a far footstep is approached at the bound
+    # once the sole moves (tp >= 0.04 s) a far footstep is approached at a bounded speed: the
+    # one that reaches it by the end of the horizontal move, 0.6 m / (0.36 - 0.04) s = 1.875 m/s
+    # (18.75 mm per tick), above the bound because it is more than FAST_TARGET_GAP away ...
     walker._begin_step(0)
     assert walker._limit_target(far, 0.04) == pytest.approx(
+        planned + np.array([0.0, -0.01875, 0.0]), abs=1e-12
+    )
+    # ... and never above FAST_TARGET_FACTOR (2) times the bound: 1.0 m at tp = 0.2 s would need
+    # 6.25 m/s, it gets 2.75 m/s (27.5 mm per tick)
+    walker._begin_step(0)
+    very = planned + np.array([0.0, -1.0, 0.0])
+    assert walker._limit_target(very, 0.2) == pytest.approx(
+        planned + np.array([0.0, -0.0275, 0.0]), abs=1e-12
+    )
+    # a footstep within FAST_TARGET_GAP (0.1 m) is approached at the bound, late as well
+    walker._begin_step(0)
+    close = planned + np.array([0.0, -0.09, 0.0])
+    assert walker._limit_target(close, 0.3) == pytest.approx(
         planned + np.array([0.0, -0.01375, 0.0]), abs=1e-12
     )
 

@@ -169,6 +169,11 @@ class WalkOptions:
             corrections faster than the bound. Hence one exception: before the sole moves
             horizontally a footstep the bound could not reach in time is taken at once
             (``BipedWalk._limit_target``), which brought the biped's 0.5 m/s protocol to 11 of 12.
+            And later, a footstep more than ``FAST_TARGET_GAP`` (0.1 m) from the target is
+            approached at the speed that reaches it by the end of the horizontal move, at most
+            twice the bound: over six push protocols, 10 cases gained and 3 lost, Alexander at
+            0.3 m/s 6 of 12 instead of 3 (benchmarks/RESULTS.md, "A swing target that can
+            catch up").
         leg_momentum: share [0, 1] of the legs' sagittal momentum about the CoM, forecast over
             the rest of each single support by the previous one's measured profile, that the
             MPC's end-of-step prediction carries (:mod:`footfall.sim.biped.leg_momentum`; 0:
