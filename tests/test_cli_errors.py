@@ -109,4 +109,20 @@ def test_a_bad_heading_window_count_is_refused(command: str, value: str, tmp_pat
     assert r.returncode == 2
     assert "Traceback" not in r.stderr
     assert "heading" in r.stderr and "integer" in r.stderr  # the option and what it takes
-    assert not (tmp_path / "o" / "plan.json").exists()
+    assert not (tmp_path / "o").exists()  # the output folder it made is not left behind
+
+
+def test_a_failed_command_removes_only_the_empty_folders_it_created(tmp_path: Path) -> None:
+    from footfall.cli._common import _CREATED, output_folder, remove_unused_folders
+
+    _CREATED.clear()
+    kept = tmp_path / "existing"
+    kept.mkdir()
+    output_folder(kept)  # existed before: never removed
+    output_folder(tmp_path / "a" / "b" / "c")  # three new folders
+    output_folder(tmp_path / "used")
+    (tmp_path / "used" / "result.json").write_text("{}")  # written into: kept
+    remove_unused_folders()
+    assert kept.is_dir() and (tmp_path / "used" / "result.json").is_file()
+    assert not (tmp_path / "a").exists()
+    assert not _CREATED

@@ -14,13 +14,8 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-from footfall.control.mpc import (
-    _ball_dual,
-    _check_polygon,
-    _clarabel_in_polygon,
-    _cold_start,
-    solve_ball_qp,
-)
+from footfall.control.ball_qp import _ball_dual, _cold_start, solve_ball_qp
+from footfall.control.mpc import _check_polygon, _clarabel_in_polygon
 from footfall.errors import InputError
 
 
@@ -183,10 +178,10 @@ def _trace(monkeypatch: pytest.MonkeyPatch, p, q, lam0):  # type: ignore[no-unty
     the iterate, ``step`` the Newton direction, ``trials`` the evaluations of the line search in
     order (the last one is accepted). A solve that evaluates the dual 2000 times is stopped (a
     line search that never ends must fail the test, not hang it)."""
-    from footfall.control import mpc
+    from footfall.control import ball_qp
 
     events: list[tuple[str, object]] = []
-    real_dual, real_step = mpc._ball_dual, mpc._newton_step
+    real_dual, real_step = ball_qp._ball_dual, ball_qp._newton_step
 
     def dual(pp, qq, lam):  # type: ignore[no-untyped-def]
         if len(events) > 2000:
@@ -200,9 +195,9 @@ def _trace(monkeypatch: pytest.MonkeyPatch, p, q, lam0):  # type: ignore[no-unty
         events.append(("step", np.array(out)))
         return out
 
-    monkeypatch.setattr(mpc, "_ball_dual", dual)
-    monkeypatch.setattr(mpc, "_newton_step", step)
-    result = mpc.solve_ball_qp(p, q, lam0)
+    monkeypatch.setattr(ball_qp, "_ball_dual", dual)
+    monkeypatch.setattr(ball_qp, "_newton_step", step)
+    result = ball_qp.solve_ball_qp(p, q, lam0)
     iterations = []
     base = events[0][1]
     i = 1
@@ -325,11 +320,11 @@ def test_a_line_search_that_finds_no_decrease_takes_a_tiny_step_and_goes_on(
     the Armijo test, the search halves down to alpha < 1e-10 (2^-34 of the step), takes that
     tiny step and continues with the true Newton steps to the same answer as an undisturbed
     solve."""
-    from footfall.control import mpc
+    from footfall.control import ball_qp
 
     p, q, lam0 = _backtracking_case(12)
     v_ref, lam_ref, _, ok_ref = solve_ball_qp(p, q, lam0)
-    real_step = mpc._newton_step
+    real_step = ball_qp._newton_step
     calls = {"n": 0}
 
     def reversed_first(*args):  # type: ignore[no-untyped-def]
@@ -337,7 +332,7 @@ def test_a_line_search_that_finds_no_decrease_takes_a_tiny_step_and_goes_on(
         calls["n"] += 1
         return -d if calls["n"] == 1 else d
 
-    monkeypatch.setattr(mpc, "_newton_step", reversed_first)
+    monkeypatch.setattr(ball_qp, "_newton_step", reversed_first)
     (v, lam, _, ok), iterations = _trace(monkeypatch, p, q, lam0)
     (lam_b, _, _, _), d, trials = iterations[0]
     assert len(trials) == 35  # alpha = 1, 1/2, ..., 2^-34 < 1e-10
@@ -418,7 +413,7 @@ def test_secular_newton_takes_far_fewer_iterations_than_plain_newton(
 ) -> None:
     """The module's claim: the secular (More-Sorensen) step needs far fewer dual iterations than
     Newton on the dual gradient, on the same problems (here under 3/4 of them)."""
-    import footfall.control.mpc as mpc
+    import footfall.control.ball_qp as ball_qp
 
     problems = []
     for seed in range(120):
@@ -429,7 +424,7 @@ def test_secular_newton_takes_far_fewer_iterations_than_plain_newton(
             (a @ a.T + rng.uniform(0.01, 1.0) * np.eye(n), rng.normal(0, rng.uniform(1, 50), n))
         )
     secular = _iterations(problems)
-    monkeypatch.setattr(mpc, "_newton_step", _plain_newton_step)
+    monkeypatch.setattr(ball_qp, "_newton_step", _plain_newton_step)
     plain = _iterations(problems)
     assert secular < 0.75 * plain
 

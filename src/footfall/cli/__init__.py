@@ -13,7 +13,7 @@ import signal
 import sys
 import time
 
-from footfall.cli._common import _say_error, app
+from footfall.cli._common import _say_error, app, remove_unused_folders
 from footfall.errors import (
     FootfallError,
     InputError,
@@ -58,7 +58,8 @@ def main() -> None:
     (:class:`~footfall.errors.MissingExtraError`, :class:`~footfall.errors.SolverUnavailableError`:
     nothing ran, the message says what to install), 128 + the signal number when
     stopped by SIGINT (130) or SIGTERM (143), after ending every worker process. Errors footfall
-    raises are printed as one line, never as a traceback.
+    raises are printed as one line, never as a traceback; an output folder the command created
+    and left empty is removed.
     """
     global _MAIN_PID
     _MAIN_PID = os.getpid()
@@ -67,12 +68,15 @@ def main() -> None:
     try:
         app()
     except (InputError, MissingExtraError, SolverUnavailableError) as exc:
+        remove_unused_folders()
         _say_error("error", str(exc))
         sys.exit(2)
     except FootfallError as exc:
+        remove_unused_folders()
         _say_error("failed", str(exc))
         sys.exit(1)
     except Stopped as exc:
+        remove_unused_folders()
         _say_error("stopped", f"by {signal.Signals(exc.signum).name}")
         sys.exit(128 + exc.signum)
 

@@ -56,20 +56,40 @@ def _threads(threads: int | None) -> int:
     return min(2, available_cores())
 
 
+#: folders :func:`output_folder` created in this process, the deepest last
+_CREATED: list[Path] = []
+
+
 def output_folder(out: Path) -> Path:
     """Create ``out`` (and its parents) and check that it is a writable folder, before any work
-    whose result would otherwise be lost."""
+    whose result would otherwise be lost. The folders it creates are remembered, so that a run
+    that fails before writing into them leaves none behind (:func:`remove_unused_folders`)."""
+    missing = [p for p in (out, *out.parents) if not p.exists()]
     try:
         out.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
         raise InputError("out", str(out), "a folder (a file of that name exists)") from None
     except OSError as e:
         raise InputError("out", str(out), f"a folder that can be created ({e.strerror})") from None
+    finally:
+        _CREATED.extend(p for p in reversed(missing) if p.is_dir())
     if not out.is_dir():
         raise InputError("out", str(out), "a folder (a file of that name exists)")
     if not os.access(out, os.W_OK | os.X_OK):
         raise InputError("out", str(out), "a folder this user may write to")
     return out
+
+
+def remove_unused_folders() -> None:
+    """Remove the folders :func:`output_folder` created that are still empty, deepest first
+    (called when a command fails: bad input found after ``--out`` was made must not leave an
+    empty folder). A folder with anything in it, or one that existed before, is left alone."""
+    while _CREATED:
+        folder = _CREATED.pop()
+        try:
+            folder.rmdir()  # only an empty folder can be removed
+        except OSError:
+            pass
 
 
 def _same_file(a: Path, b: Path) -> bool:

@@ -9,6 +9,7 @@ from footfall.control.adjusters import (
     extend_plan,
     sole_torque_limits,
 )
+from footfall.control.ball_qp import solve_ball_qp
 from footfall.control.horizon_regions import HorizonRegions
 from footfall.control.mpc import (
     MPC,
@@ -17,7 +18,6 @@ from footfall.control.mpc import (
     MPCStatus,
     MPCWeights,
     build_mpc,
-    solve_ball_qp,
 )
 from footfall.control.region_mpc import RegionMPC, RegionRows, RegionSolution, sole_inset_offsets
 

@@ -26,7 +26,7 @@ Solution (exact, three stages, cheapest first):
    pair is a KKT point of the full problem (zero ball multipliers) and hence optimal;
 3. otherwise the torque bounds bind: for a guess of the active rows (stage 2's first, then
    every single row and pair) the footstep is eliminated and the torques solve the ball QP of
-   eq. (5.19e) exactly (:func:`footfall.control.mpc.solve_ball_qp`); the first guess whose point
+   eq. (5.19e) exactly (:func:`footfall.control.ball_qp.solve_ball_qp`); the first guess whose point
    satisfies every row with multipliers >= 0 is a KKT point of the whole convex problem, hence
    optimal. Clarabel on the full second-order cone program is the last resort.
 
@@ -48,13 +48,8 @@ import numpy as np
 
 from footfall._geometry import polygons_intersect, rot2
 from footfall._typing import FloatArray
-from footfall.control.mpc import (
-    MPC,
-    MPCSolution,
-    MPCStatus,
-    _clarabel_in_polygon,
-    solve_ball_qp,
-)
+from footfall.control.ball_qp import solve_ball_qp
+from footfall.control.mpc import MPC, MPCSolution, MPCStatus, _clarabel_in_polygon
 from footfall.errors import InputError
 from footfall.models.biped import BipedParams, Side
 from footfall.terrain.region import Region
@@ -370,7 +365,7 @@ class RegionMPC:
         """Stage 3 with the torque bounds active: for a guess of the active rows (``first``,
         then every single row, then every pair) the footstep is eliminated (on the row's line,
         or fixed at the pair's corner), the torques solve the ball QP of eq. (5.19e) exactly
-        (:func:`footfall.control.mpc.solve_ball_qp`), and the guess is kept when the KKT
+        (:func:`footfall.control.ball_qp.solve_ball_qp`), and the guess is kept when the KKT
         conditions of the whole problem hold: the footstep satisfies every row and the rows'
         multipliers are >= 0. The problem is convex, so that point is the optimum.
 

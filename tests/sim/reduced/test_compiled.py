@@ -12,7 +12,8 @@ import pytest
 
 import footfall.sim.reduced.closed_loop as reduced
 from footfall.control import MPC, MPCWeights, build_mpc, solve_ball_qp
-from footfall.control.mpc import DUAL_TOL, MAX_NEWTON_ITER, CondensedMPC
+from footfall.control.ball_qp import DUAL_TOL, MAX_NEWTON_ITER
+from footfall.control.mpc import CondensedMPC
 from footfall.errors import InputError, SolverUnavailableError
 from footfall.models.biped import BipedParams
 from footfall.planning.plan import FootstepPlan

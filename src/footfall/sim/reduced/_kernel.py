@@ -6,7 +6,7 @@ trajectories up to rounding:
 * :func:`mpc_step` is :meth:`footfall.control.MPC.solve_theta` with the ``newton`` backend: the
   condensed MPC of document 000 eq. (5.19) at one control tick, the footstep eliminated, the torque
   discs (eq. 5.19e) handled by the projected Newton method on the dual of
-  :func:`footfall.control.mpc.solve_ball_qp`, warm-started from the previous tick, with the same
+  :func:`footfall.control.ball_qp.solve_ball_qp`, warm-started from the previous tick, with the same
   fallback (the last good solution shifted, or zero torque and the reference footstep) when a solve
   fails. It reads the zero-padded per-tick matrices of
   :attr:`footfall.control.mpc.CondensedMPC.padded`, which are built once by the Python code.
@@ -193,7 +193,7 @@ def ball_qp(
     max_iter: int,
     v_out: np.ndarray,
 ) -> tuple[int, int]:
-    """Compiled :func:`footfall.control.mpc.solve_ball_qp`: minimise ``1/2 v^T P v + q^T v``
+    """Compiled :func:`footfall.control.ball_qp.solve_ball_qp`: minimise ``1/2 v^T P v + q^T v``
     s.t. ``||v_j|| <= 1`` per 2-D block, by projected (secular) Newton on the dual.
 
     Args:

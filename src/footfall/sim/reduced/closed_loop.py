@@ -606,7 +606,7 @@ class _PythonLoop:
 
 def _walk_compiled(w: _Walk) -> _Trace:
     """The same loop in the numba kernel :func:`footfall.sim.reduced._kernel.walk`."""
-    from footfall.control.mpc import DUAL_TOL, MAX_NEWTON_ITER
+    from footfall.control.ball_qp import DUAL_TOL, MAX_NEWTON_ITER
     from footfall.sim.reduced import _kernel as kernel
 
     tr = _new_trace(w)
