@@ -32,9 +32,9 @@ from footfall.planning.horizon import (
     HorizonPlanner,
     HorizonSolution,
     horizon_input,
-    horizon_problem,
     torque_facets,
 )
+from footfall.planning.horizon_model import horizon_problem
 from footfall.planning.plan import FootstepPlan
 from footfall.planning.reactive import plan_reactive
 from footfall.solvers import SolverOptions, SolveStatus, solve

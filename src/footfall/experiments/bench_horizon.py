@@ -5,7 +5,7 @@ solve) is followed tick by tick: at ``ticks`` times per single support the measu
 plan's, pushed at the start of the step by a velocity change of up to ``push`` [m/s] in a random
 direction (seeded) and carried by the ALIP with the plan's torques. Each tick is solved twice in
 the same process, warm-started from the previous tick's regions as in the loop, and cold; the
-first tick of every step is also solved by SCIP on :func:`~footfall.planning.horizon.horizon_problem`
+first tick of every step is also solved by SCIP on :func:`~footfall.planning.horizon_model.horizon_problem`
 (the same problem written independently) as the same-run baseline and certificate.
 
 Times are wall times of :meth:`HorizonPlanner.solve` (``time.perf_counter``) in this process, one
@@ -28,8 +28,8 @@ from footfall.planning.horizon import (
     HorizonPlanner,
     HorizonSolution,
     horizon_input,
-    horizon_problem,
 )
+from footfall.planning.horizon_model import horizon_problem
 from footfall.planning.plan import FootstepPlan
 
 #: scenes of the default horizon benchmark: every built-in scene with more than one region

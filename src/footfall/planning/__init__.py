@@ -29,8 +29,8 @@ if TYPE_CHECKING:
         HorizonPlanner,
         HorizonSolution,
         horizon_input,
-        horizon_problem,
     )
+    from footfall.planning.horizon_model import horizon_problem
     from footfall.planning.kinematic import plan_kinematic
     from footfall.planning.lip_examples import example as lip_example
     from footfall.planning.miqcqp import FootstepProblem, build_footstep_problem, plan_footsteps
@@ -52,7 +52,7 @@ _WHERE = {
     "HorizonPlanner": ("footfall.planning.horizon", "HorizonPlanner"),
     "HorizonSolution": ("footfall.planning.horizon", "HorizonSolution"),
     "horizon_input": ("footfall.planning.horizon", "horizon_input"),
-    "horizon_problem": ("footfall.planning.horizon", "horizon_problem"),
+    "horizon_problem": ("footfall.planning.horizon_model", "horizon_problem"),
     "plan_kinematic": ("footfall.planning.kinematic", "plan_kinematic"),
     "lip_example": ("footfall.planning.lip_examples", "example"),
     "FootstepProblem": ("footfall.planning.miqcqp", "FootstepProblem"),
