@@ -1,7 +1,7 @@
 """The walker's MPC in ``horizon`` mode (:class:`footfall.control.horizon_regions.HorizonRegions`
 inside :class:`footfall.control.adjusters.MPCAdjuster`): after a push, the region it puts the next
 footstep in is the one SCIP puts footstep 1 in when it solves the same short-horizon problem
-written independently (:func:`footfall.planning.horizon.horizon_problem`); the commanded footstep
+written independently (:func:`footfall.planning.horizon_model.horizon_problem`); the commanded footstep
 stands in that region with the sole inside it (shapely); the solves follow the 50 Hz schedule."""
 
 from __future__ import annotations
