@@ -670,7 +670,7 @@ def summarise(root: Root, exact: list[dict[str, Any]], variants: list[Variant]) 
     rows = [
         f"| search's node solve (assembly + Clarabel) | - | - | {np.median(t_search) * 1e3:.2f} / "
         f"{pct(t_search, 90) * 1e3:.2f} ms (Clarabel alone {np.median(t_clar) * 1e3:.2f}) | 1 | "
-        f"- | - | {sum(r['exact'] >= cut for r in exact)} |"
+        f"- | - | - | {sum(r['exact'] >= cut for r in exact)} |"
     ]
     for var in variants:
         recs = var.records
@@ -686,13 +686,15 @@ def summarise(root: Root, exact: list[dict[str, Any]], variants: list[Variant]) 
                 missed += 1
         loss_a = np.array(loss) if loss else np.array([math.nan])
         n_set = sum(r["set_basis"] for r in recs[1:])
+        hot = [r["it"] for r in recs[1:] if not r["set_basis"]]
+        cold = [r["it"] for r in recs[1:] if r["set_basis"]]
         per_pivot = float(np.sum(t) / max(1, int(np.sum(its))))
         rows.append(
             f"| {var.name} | {var.node_lp.n_cols} x {var.node_lp.n_rows} ({var.node_lp.nnz} nnz) "
             f"| {var.node_lp.eps:.1e} | {np.median(t) * 1e3:.2f} / {pct(t, 90) * 1e3:.2f} ms "
             f"| {np.median(ratio):.2f} (p90 {pct(ratio, 90):.2f}) "
             f"| {np.median(its):.0f} (p90 {pct(its, 90):.0f}; {per_pivot * 1e6:.0f} us each; "
-            f"{n_set} of {len(t)} set a basis) "
+            f"{n_set} of {len(t)} set a basis) | {pct(hot, 50):.0f} / {pct(cold, 50):.0f} "
             f"| {pct(loss_a, 50):.1e} / {pct(loss_a, 90):.1e} / {np.max(loss_a):.1e} "
             f"| {sum(r['exact'] >= cut for r in exact) - missed} ({missed} missed) |"
         )
@@ -757,8 +759,8 @@ def run_instance(steps: int, seed: int, nus: list[int], qp: int, max_nodes: int)
         )
     print(
         "\n| solver | size (cols x rows) | eps | node time median / p90 | time / search's, "
-        "per node | simplex iterations | bound loss median / p90 / max | prunable nodes "
-        "pruned |\n|---|---|---|---|---|---|---|---|"
+        "per node | simplex iterations | iterations: child of the last node / basis set | bound loss median / p90 / max | prunable nodes "
+        "pruned |\n|---|---|---|---|---|---|---|---|---|"
     )
     for row in summarise(root, exact, variants):
         print(row)
