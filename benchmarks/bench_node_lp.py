@@ -23,18 +23,20 @@ For each instance (random stepping stones, 8 regions, K = 10, one thread, gap 1e
    (``HullRelaxation.solve``: per-node assembly and Clarabel), the fixed-shape problem with
    Clarabel (the same bound: a check of the fixed-shape encoding), and every HiGHS variant
    warm-started from the parent's basis: the LP for each ``nu`` with the quadratic objective as
-   an epigraph (one more polyhedral cone), and, with ``--qp``, HiGHS's QP solver with the
-   Hessian on the same polytope;
+   an epigraph (one more polyhedral cone), and, with ``--qp n``, HiGHS's QP solver with the
+   Hessian on the same polytope (the last ``--nus`` depth, the first n nodes: it is slow);
 4. a summary per instance and variant: median / p90 time of a node against the search's node
    solve (ratios from the same run), median simplex iterations, the bound loss against the exact
-   bound, and the nodes the exact bound prunes (bound >= the planner's objective) that the LP
-   bound does not.
+   bound, and the nodes the exact bound prunes (within the search's gap 1e-4 of the planner's
+   objective) that the LP bound does not.
 
 Needs ``pip install highspy`` (HiGHS 1.16; not a footfall dependency). Run from the repository
-root (one thread; a few minutes)::
+root (one thread; 1-3 minutes per instance)::
 
     OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_node_lp.py \\
-        --steps 10,15 --seeds 0 --nus 5,6,7,8 --nodes 300 --qp
+        --steps 10 --seeds 0 --nus 5,6,7,8 --nodes 300 --qp 3
+    OPENBLAS_NUM_THREADS=1 PYTHONPATH=src python benchmarks/bench_node_lp.py \\
+        --steps 15 --seeds 0 --nus 5,6,7,8 --nodes 300
 
 Results: ``benchmarks/RESULTS.md``, "A fixed-shape LP node relaxation, measured".
 """
