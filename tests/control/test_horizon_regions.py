@@ -17,12 +17,8 @@ from footfall.control.adjusters import MPCAdjuster, sole_torque_limits
 from footfall.control.horizon_regions import HORIZON_PERIOD, HorizonRegions
 from footfall.errors import InputError
 from footfall.experiments.bench_horizon import _pushed_state
-from footfall.planning.horizon import (
-    HorizonOptions,
-    HorizonPlanner,
-    horizon_input,
-    horizon_problem,
-)
+from footfall.planning.horizon import HorizonOptions, HorizonPlanner, horizon_input
+from footfall.planning.horizon_model import horizon_problem
 from footfall.planning.plan import FootstepPlan
 from footfall.planning.reactive import plan_reactive
 from footfall.solvers import SolverOptions, SolveStatus, solve
